@@ -1,0 +1,27 @@
+# `make test` and `make run` set everything up from a fresh clone: a virtual
+# environment in .venv with dcsim installed (editable) and its test dependencies.
+PYTHON ?= python3
+VENV ?= .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed
+
+.PHONY: test run docs clean
+
+$(STAMP): pyproject.toml
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[test]'
+	touch $(STAMP)
+
+test: $(STAMP)
+	$(BIN)/python -m pytest
+
+run: $(STAMP)
+	$(BIN)/dcsim run
+
+# Regenerate the generated parts of docs/ (a test fails while they are stale).
+docs: $(STAMP)
+	$(BIN)/python -m dcsim.scenario.reference docs/scenarios.md
+
+clean:
+	rm -rf $(VENV) build *.egg-info

@@ -1,0 +1,164 @@
+"""The ``dcsim`` command line.
+
+Every error a user can cause is printed as ``error: <message>`` with exit status 2 and
+no traceback; ``dcsim --debug ...`` shows the traceback instead.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import warnings
+from pathlib import Path
+
+import click
+
+from dcsim import __version__
+from dcsim.errors import DcsimError, PluginLoadWarning
+from dcsim.interfaces import PLUGIN_KINDS
+from dcsim.registry import PluginRegistry
+from dcsim.runsetup import prepare_run
+from dcsim.scenario import dump_scenario, load_scenario
+
+EXIT_USER_ERROR = 2
+
+
+class _Group(click.Group):
+    """A click group that prints dcsim errors without a traceback."""
+
+    def invoke(self, ctx: click.Context) -> object:
+        try:
+            return super().invoke(ctx)
+        except DcsimError as exc:
+            if ctx.meta.get("dcsim.debug"):
+                raise
+            click.echo(f"error: {exc}", err=True)
+            ctx.exit(EXIT_USER_ERROR)
+
+
+def _registry() -> PluginRegistry:
+    """Discover plugins, printing loading problems as warnings on stderr."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PluginLoadWarning)
+        registry = PluginRegistry.discover()
+    for message in registry.warnings:
+        click.echo(f"warning: {message}", err=True)
+    return registry
+
+
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, "--version", "-V", prog_name="dcsim")
+@click.option("--debug", is_flag=True, help="Show full tracebacks for errors.")
+@click.pass_context
+def cli(ctx: click.Context, debug: bool) -> None:
+    """dcsim: simulate space debris collectors and free-flying space robots.
+
+    Run a scenario with `dcsim run`, check scenario files with `dcsim validate`, and
+    list the installed localisers, planners and controllers with `dcsim plugins`.
+    """
+    ctx.meta["dcsim.debug"] = debug
+
+
+@cli.command("plugins")
+@click.option(
+    "--kind",
+    type=click.Choice(list(PLUGIN_KINDS)),
+    help="Only list plugins of this kind.",
+)
+@click.option("--json", "as_json", is_flag=True, help="Print a JSON list instead of a table.")
+def plugins_command(kind: str | None, as_json: bool) -> None:
+    """List registered plugins: kind, name, summary and origin.
+
+    The origin is the installed distribution (and version) that provides the plugin.
+    Set DCSIM_LOAD_PLUGINS to a comma-separated list of distributions to restrict
+    which external plugins load.
+    """
+    entries = [p.as_dict() for p in _registry().plugins(kind)]
+    if as_json:
+        click.echo(json.dumps(entries, indent=2))
+        return
+    rows = [
+        (e["kind"], e["name"], e["summary"], f"{e['distribution']} {e['version']}") for e in entries
+    ]
+    _print_table(("KIND", "NAME", "SUMMARY", "ORIGIN"), rows)
+
+
+def _print_table(header: tuple[str, ...], rows: list[tuple[str, ...]]) -> None:
+    widths = [max(len(str(r[i])) for r in [header, *rows]) for i in range(len(header))]
+    for row in [header, *rows]:
+        click.echo("  ".join(str(cell).ljust(w) for cell, w in zip(row, widths)).rstrip())
+
+
+@cli.command("validate")
+@click.argument("files", nargs=-1, required=True, type=click.Path(dir_okay=False, path_type=Path))
+def validate_command(files: tuple[Path, ...]) -> None:
+    """Check scenario FILES without running anything.
+
+    Each file is parsed, checked against the schema, and its plugin names and
+    parameters are checked against the installed plugins. Prints `ok FILE` for each
+    valid file and every problem of each invalid one; exits with status 2 if any file
+    is invalid.
+    """
+    registry = _registry()
+    failed = False
+    for path in files:
+        try:
+            load_scenario(path, registry=registry)
+        except DcsimError as exc:
+            click.echo(f"error: {exc}", err=True)
+            failed = True
+        else:
+            click.echo(f"ok {path}")
+    if failed:
+        sys.exit(EXIT_USER_ERROR)
+
+
+@cli.command("run")
+@click.argument("scenario", required=False, type=click.Path(dir_okay=False, path_type=Path))
+@click.option(
+    "--out",
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Run directory to write results into (created if missing).",
+)
+@click.option("--seed", type=click.IntRange(min=0), help="Seed for this run; replaces world.seed.")
+@click.option(
+    "--set",
+    "overrides",
+    multiple=True,
+    metavar="KEY.PATH=VALUE",
+    help="Override one scenario value, e.g. --set robot.max_force=20 or "
+    "--set targets[0].motion.r=150000; the value is read as YAML. Repeatable.",
+)
+def run_command(
+    scenario: Path | None, out: Path | None, seed: int | None, overrides: tuple[str, ...]
+) -> None:
+    """Run SCENARIO (default: the scenario shipped with dcsim).
+
+    The scenario is validated, its overrides applied, and its plugins constructed with
+    their validated parameters. This version stops there: it prints the resolved
+    scenario and the plugins of each role, and writes the resolved scenario to
+    OUT/scenario.yaml when --out is given. Simulation arrives with the world engine.
+    """
+    setup = prepare_run(scenario, overrides, seed, registry=_registry())
+    resolved = dump_scenario(setup.scenario)
+    label = str(scenario) if scenario is not None else "default (packaged)"
+    click.echo(f"scenario: {setup.scenario.name} from {label}, seed {setup.scenario.world.seed}")
+    _print_table(
+        ("ROLE", "PLUGIN", "ORIGIN"),
+        [
+            (role, entry.name, f"{entry.origin.distribution} {entry.origin.version}")
+            for role, entry in setup.sources.items()
+        ],
+    )
+    click.echo("--- resolved scenario ---")
+    click.echo(resolved, nl=False)
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "scenario.yaml").write_text(resolved, encoding="utf-8")
+        click.echo(f"wrote {out / 'scenario.yaml'}")
+    click.echo("not simulated: this dcsim version has no world engine yet")
+
+
+def main() -> None:
+    """Entry point of the ``dcsim`` console script."""
+    cli(prog_name="dcsim")

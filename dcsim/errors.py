@@ -1,0 +1,108 @@
+"""Error classes for mistakes a user can make.
+
+Every error a user can cause (a bad scenario file, an unknown plugin name, an invalid
+parameter, a broken plugin package) is raised as a subclass of :class:`DcsimError`
+whose message says what to change. The command line prints such errors as
+``error: <message>`` and exits with status 2; anything else is a bug in dcsim or in a
+plugin and keeps its traceback.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+class DcsimError(Exception):
+    """Base class of every error a user can cause and fix."""
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One problem found while validating a document.
+
+    Parameters
+    ----------
+    path : str
+        Key path of the offending value, e.g. ``targets[3].motion.r``.
+    message : str
+        What is wrong and what is allowed.
+    line, column : int or None
+        1-based position in the source file, when the parser knows it.
+    source : str or None
+        Where the value came from when it was not the file itself, e.g.
+        ``--set world.seed=3``.
+    """
+
+    path: str
+    message: str
+    line: int | None = None
+    column: int | None = None
+    source: str | None = None
+
+    def describe(self, filename: str) -> str:
+        """Return the problem as one line: ``file:line:col: path: message``."""
+        if self.source is not None:
+            where = self.source
+        elif self.line is not None:
+            where = f"{filename}:{self.line}:{self.column}"
+        else:
+            where = filename
+        path = f"{self.path}: " if self.path else ""
+        return f"{where}: {path}{self.message}"
+
+
+class ScenarioError(DcsimError):
+    """A scenario file (or an override of it) does not describe a valid scenario.
+
+    Parameters
+    ----------
+    filename : str
+        The scenario file's name as the user gave it.
+    problems : list of Problem
+        Every problem found, in document order.
+    """
+
+    def __init__(self, filename: str, problems: list[Problem]) -> None:
+        self.filename = filename
+        self.problems = list(problems)
+        lines = [p.describe(filename) for p in self.problems]
+        head = f"{filename}: invalid scenario ({len(lines)} problem{'s' if len(lines) != 1 else ''})"
+        super().__init__("\n".join([head, *("  " + line for line in lines)]))
+
+
+class PluginError(DcsimError):
+    """Base class of errors about plugins and the plugin registry."""
+
+
+class PluginNotFoundError(PluginError):
+    """No registered plugin of the requested kind has the requested name."""
+
+
+class DuplicatePluginError(PluginError):
+    """Two plugins registered the same kind and name."""
+
+
+class PluginInterfaceError(PluginError):
+    """A plugin class does not satisfy its kind's interface."""
+
+
+class PluginParameterError(PluginError):
+    """Parameters given to a plugin are invalid.
+
+    Parameters
+    ----------
+    plugin : str
+        The plugin's name.
+    problems : list of Problem
+        One entry per invalid parameter; ``path`` is the parameter name.
+    """
+
+    def __init__(self, plugin: str, problems: list[Problem]) -> None:
+        self.plugin = plugin
+        self.problems = list(problems)
+        lines = [f"{p.path}: {p.message}" if p.path else p.message for p in self.problems]
+        super().__init__(f"invalid parameters for plugin '{plugin}': " + "; ".join(lines))
+
+
+class PluginLoadWarning(UserWarning):
+    """A plugin package could not be loaded; every other plugin still is."""

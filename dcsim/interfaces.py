@@ -1,0 +1,162 @@
+"""The four plugin kinds: abstract base classes a plugin class derives from.
+
+A plugin is a class deriving from one of :class:`Localiser`, :class:`TaskPlanner`,
+:class:`PathPlanner` or :class:`Controller`. It declares
+
+- ``name``: unique within its kind, lower case (``"pd"``, ``"straight-line"``);
+- ``summary``: one line saying what it is;
+- ``Params``: a :class:`~dcsim.params.PluginParams` subclass (defaults, bounds, units);
+
+and implements its kind's abstract methods. The framework constructs it with validated
+parameters and its own random generator, spawned from the scenario seed, so that a
+scenario and seed always give the same result. A plugin never sees ground truth, never
+mutates its inputs, and returns within its time budget.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Mapping, Sequence
+from typing import Any, ClassVar
+
+import numpy as np
+
+from dcsim.messages import (
+    BeaconRange,
+    Command,
+    LocationEstimate,
+    MotionInput,
+    NoPath,
+    PathProblem,
+    Plan,
+    Prior,
+    Reference,
+    RobotSpec,
+    Surroundings,
+    TaskRequest,
+    Trajectory,
+)
+from dcsim.params import PluginParams
+
+
+class Plugin(ABC):
+    """Common base of all plugin kinds.
+
+    Parameters
+    ----------
+    params : PluginParams or mapping, optional
+        Parameters; a mapping is validated against ``Params``; None means defaults.
+    rng : numpy.random.Generator, optional
+        The plugin's own random generator; a fixed-seed one if omitted.
+
+    Attributes
+    ----------
+    kind : str
+        The plugin kind (set on the four kind classes).
+    name : str
+        Unique name within the kind.
+    summary : str
+        One line describing the plugin.
+    Params : type of PluginParams
+        The parameter model.
+    params : PluginParams
+        The validated parameters of this instance.
+    rng : numpy.random.Generator
+        This instance's random generator.
+    """
+
+    kind: ClassVar[str]
+    name: ClassVar[str]
+    summary: ClassVar[str]
+    Params: ClassVar[type[PluginParams]] = PluginParams
+
+    def __init__(
+        self,
+        params: PluginParams | Mapping[str, Any] | None = None,
+        rng: np.random.Generator | None = None,
+    ) -> None:
+        if not isinstance(params, self.Params):
+            params = self.Params.parse(self.name, params)  # type: ignore[arg-type]
+        self.params = params
+        self.rng = rng if rng is not None else np.random.default_rng(0)
+
+
+class Localiser(Plugin):
+    """Estimates the collector's position and velocity from beacon ranges.
+
+    Per control tick the framework calls :meth:`predict` with the motion commanded over
+    the last period, then :meth:`update` with the ranges measured now (possibly none),
+    then reads :meth:`estimate`.
+    """
+
+    kind = "localiser"
+
+    @abstractmethod
+    def reset(self, prior: Prior, time: float) -> None:
+        """Start over from the initial belief ``prior`` at scenario time ``time`` (s)."""
+
+    @abstractmethod
+    def predict(self, motion: MotionInput, dt: float) -> None:
+        """Propagate the belief over ``dt`` seconds under the commanded ``motion``."""
+
+    @abstractmethod
+    def update(self, ranges: Sequence[BeaconRange]) -> None:
+        """Correct the belief with the beacon ranges measured now (may be empty)."""
+
+    @abstractmethod
+    def estimate(self) -> LocationEstimate:
+        """Return the current estimate; ``converged`` says whether to trust it."""
+
+
+class TaskPlanner(Plugin):
+    """Orders pickups of moving targets, with drop-point visits when full."""
+
+    kind = "task_planner"
+
+    @abstractmethod
+    def plan(self, request: TaskRequest) -> Plan:
+        """Plan pickups of ``request.targets``.
+
+        Returns
+        -------
+        Plan
+            Tasks with strictly increasing pickup times later than ``request.time``,
+            each target at most once, a drop visit whenever the collector is full and
+            after the last pickup; an empty plan when there is nothing to plan.
+        """
+
+
+class PathPlanner(Plugin):
+    """Finds a time-stamped trajectory to a goal region among moving obstacles."""
+
+    kind = "path_planner"
+
+    @abstractmethod
+    def plan(self, problem: PathProblem) -> Trajectory | NoPath:
+        """Solve ``problem``; return a :class:`Trajectory` or a :class:`NoPath` with a reason."""
+
+
+class Controller(Plugin):
+    """Turns an estimate and a reference into force and torque commands."""
+
+    kind = "controller"
+
+    @abstractmethod
+    def reset(self, robot: RobotSpec) -> None:
+        """Prepare for a new run of a collector with the limits in ``robot``."""
+
+    @abstractmethod
+    def command(
+        self,
+        time: float,
+        estimate: LocationEstimate,
+        reference: Reference,
+        surroundings: Surroundings,
+    ) -> Command:
+        """Return the command for the coming control period, within the robot's limits."""
+
+
+PLUGIN_KINDS: dict[str, type[Plugin]] = {
+    cls.kind: cls for cls in (Localiser, TaskPlanner, PathPlanner, Controller)
+}
+"""Every plugin kind by its name, in data-flow order."""

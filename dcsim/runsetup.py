@@ -1,0 +1,84 @@
+"""Assembling a run: a resolved scenario and one constructed plugin per role."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from dcsim.interfaces import PLUGIN_KINDS, Plugin
+from dcsim.registry import PluginRegistry, RegisteredPlugin
+from dcsim.scenario import Scenario, load_scenario
+from dcsim.seeding import component_rng
+
+
+@dataclass(frozen=True)
+class RunSetup:
+    """Everything a run needs before the first step.
+
+    Attributes
+    ----------
+    scenario : Scenario
+        The resolved scenario (plugin parameters with defaults filled in).
+    plugins : dict of str to Plugin
+        The constructed plugin of each role (``localiser``, ``task_planner``,
+        ``path_planner``, ``controller``), each with its own random generator.
+    sources : dict of str to RegisteredPlugin
+        Where each role's plugin came from.
+    """
+
+    scenario: Scenario
+    plugins: dict[str, Plugin]
+    sources: dict[str, RegisteredPlugin]
+
+    def plugin_versions(self) -> dict[str, dict[str, str]]:
+        """Name, distribution and version of each role's plugin (for run summaries)."""
+        return {
+            role: {
+                "name": entry.name,
+                "distribution": entry.origin.distribution,
+                "version": entry.origin.version,
+            }
+            for role, entry in self.sources.items()
+        }
+
+
+def prepare_run(
+    path: str | Path | None = None,
+    overrides: Sequence[str] = (),
+    seed: int | None = None,
+    registry: PluginRegistry | None = None,
+) -> RunSetup:
+    """Load and resolve a scenario and construct its plugins.
+
+    Parameters
+    ----------
+    path : str or Path, optional
+        Scenario file; the packaged default if None.
+    overrides : sequence of str
+        ``key.path=value`` overrides.
+    seed : int, optional
+        Replaces ``world.seed`` (same as the override ``world.seed=N``).
+    registry : PluginRegistry, optional
+        Registry to use; discovered from installed packages if None.
+
+    Returns
+    -------
+    RunSetup
+        The resolved scenario and its plugins.
+
+    Raises
+    ------
+    ScenarioError
+        If the scenario, an override or a plugin choice is invalid.
+    """
+    registry = registry if registry is not None else PluginRegistry.discover()
+    if seed is not None:
+        overrides = [*overrides, f"world.seed={seed}"]
+    scenario = load_scenario(path, overrides, registry)
+    sources = {role: registry.get(role, getattr(scenario, role).plugin) for role in PLUGIN_KINDS}
+    plugins = {
+        role: entry.cls(getattr(scenario, role).params, component_rng(scenario.world.seed, role))
+        for role, entry in sources.items()
+    }
+    return RunSetup(scenario, plugins, sources)

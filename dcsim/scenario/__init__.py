@@ -1,0 +1,23 @@
+"""Scenario files: schema, loading with precise errors, overrides, and resolution."""
+
+from dcsim.scenario.document import ScenarioDocument, format_key_path, parse_key_path
+from dcsim.scenario.loader import (
+    default_scenario_path,
+    dump_scenario,
+    load_scenario,
+    resolve_plugins,
+    validate,
+)
+from dcsim.scenario.model import Scenario
+
+__all__ = [
+    "Scenario",
+    "ScenarioDocument",
+    "default_scenario_path",
+    "dump_scenario",
+    "format_key_path",
+    "load_scenario",
+    "parse_key_path",
+    "resolve_plugins",
+    "validate",
+]

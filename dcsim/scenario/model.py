@@ -1,0 +1,251 @@
+"""The scenario schema: typed, validated models of every section of a scenario file.
+
+Units are SI unless the key says otherwise; angles are in degrees where the source
+thesis uses degrees, with the unit in the key name (``polar_deg``, ``beta_deg_s``).
+Unknown keys are errors. docs/scenarios.md is generated from these models.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from dcsim.geometry import Vector, spherical_to_cartesian
+from dcsim.motion import (
+    STANDARD_GRAVITATIONAL_PARAMETER_EARTH,
+    ClohessyWiltshireMotion,
+    LinearMotion,
+    MotionModel,
+    SphericalMotion,
+    StaticMotion,
+    mean_motion,
+)
+from dcsim.params import quantity
+
+Vec3 = tuple[float, float, float]
+
+
+class Section(BaseModel):
+    """Base of every scenario section: immutable, unknown keys rejected."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class SphericalPoint(Section):
+    """A point in the thesis's spherical coordinates."""
+
+    r: float = quantity(unit="m", ge=0, description="Radial distance from the origin.")
+    polar_deg: float = quantity(unit="deg", description="Polar angle from +z.")
+    azimuth_deg: float = quantity(unit="deg", description="Azimuth from +x towards +y.")
+
+
+Point = Vec3 | SphericalPoint
+"""A point given either as ``[x, y, z]`` (m) or as ``{r, polar_deg, azimuth_deg}``."""
+
+
+def point_to_cartesian(point: Point) -> Vector:
+    """Cartesian position (m) of a scenario point."""
+    if isinstance(point, SphericalPoint):
+        return spherical_to_cartesian(point.r, point.polar_deg, point.azimuth_deg)
+    return np.array(point, dtype=float)
+
+
+class StaticMotionSpec(Section):
+    """An object at rest."""
+
+    type: Literal["static"]
+    position: Point = quantity(unit="m", description="Fixed position: [x, y, z] or spherical.")
+
+    def build(self, mean_motion: float) -> MotionModel:
+        """The motion model this spec describes."""
+        return StaticMotion(point_to_cartesian(self.position))
+
+
+class CartesianMotionSpec(Section):
+    """Force-free straight-line motion from a Cartesian state at t = 0."""
+
+    type: Literal["cartesian"]
+    position: Point = quantity(unit="m", description="Position at t = 0.")
+    velocity: Vec3 = quantity((0.0, 0.0, 0.0), unit="m/s", description="Constant velocity.")
+
+    def build(self, mean_motion: float) -> MotionModel:
+        """The motion model this spec describes."""
+        return LinearMotion(point_to_cartesian(self.position), self.velocity)
+
+
+class SphericalMotionSpec(Section):
+    """The thesis's linear spherical model: r, θ, φ advance at v, α, β."""
+
+    type: Literal["spherical"]
+    r: float = quantity(unit="m", ge=0, description="Radial distance at t = 0.")
+    polar_deg: float = quantity(unit="deg", description="Polar angle θ at t = 0.")
+    azimuth_deg: float = quantity(unit="deg", description="Azimuth φ at t = 0.")
+    v: float = quantity(0.0, unit="m/s", description="Radial speed.")
+    alpha_deg_s: float = quantity(0.0, unit="deg/s", description="Polar rate α.")
+    beta_deg_s: float = quantity(0.0, unit="deg/s", description="Azimuthal rate β.")
+
+    def build(self, mean_motion: float) -> MotionModel:
+        """The motion model this spec describes."""
+        return SphericalMotion(
+            self.r, self.polar_deg, self.azimuth_deg, self.v, self.alpha_deg_s, self.beta_deg_s
+        )
+
+
+class CWMotionSpec(Section):
+    """Clohessy–Wiltshire relative motion from an LVLH state at t = 0 (frame ``lvlh`` only)."""
+
+    type: Literal["cw"]
+    position: Vec3 = quantity(unit="m", description="LVLH position at t = 0 (x radial, y along-track).")
+    velocity: Vec3 = quantity((0.0, 0.0, 0.0), unit="m/s", description="LVLH velocity at t = 0.")
+
+    def build(self, mean_motion: float) -> MotionModel:
+        """The motion model this spec describes."""
+        return ClohessyWiltshireMotion(self.position, self.velocity, mean_motion)
+
+
+MotionSpec = Annotated[
+    StaticMotionSpec | CartesianMotionSpec | SphericalMotionSpec | CWMotionSpec,
+    Field(discriminator="type"),
+]
+"""A motion, chosen by its ``type`` key: static, cartesian, spherical or cw."""
+
+
+class OrbitSpec(Section):
+    """The circular reference orbit of the LVLH frame."""
+
+    radius: float = quantity(6_778_137.0, unit="m", gt=0, description="Orbit radius (Earth radius + altitude).")
+    mu: float = quantity(
+        STANDARD_GRAVITATIONAL_PARAMETER_EARTH, unit="m^3/s^2", gt=0,
+        description="Gravitational parameter of the central body.",
+    )
+
+    @property
+    def mean_motion(self) -> float:
+        """Mean motion of the orbit, rad/s."""
+        return mean_motion(self.radius, self.mu)
+
+
+class WorldSpec(Section):
+    """Frame, time steps and seed."""
+
+    frame: Literal["lvlh", "geocentric"] = Field(
+        "lvlh",
+        description="lvlh: Clohessy–Wiltshire relative motion about the reference orbit; "
+        "geocentric: the thesis's force-free spherical world.",
+    )
+    orbit: OrbitSpec = Field(default_factory=OrbitSpec, description="Reference orbit (lvlh only).")
+    physics_step: float = quantity(0.01, unit="s", gt=0, le=1, description="Fixed physics time step.")
+    control_period: float = quantity(
+        0.1, unit="s", gt=0, description="Control period; a whole number of physics steps."
+    )
+    duration: float = quantity(600.0, unit="s", gt=0, description="Simulated time after which the run ends.")
+    seed: int = quantity(0, ge=0, description="Seed of every random number in the run.")
+
+
+class InitialStateSpec(Section):
+    """The collector's state at t = 0."""
+
+    position: Point = quantity((0.0, 0.0, 0.0), unit="m", description="Position: [x, y, z] or spherical.")
+    velocity: Vec3 = quantity((0.0, 0.0, 0.0), unit="m/s", description="Velocity.")
+    attitude: tuple[float, float, float, float] = quantity(
+        (0.0, 0.0, 0.0, 1.0), description="Attitude quaternion [x, y, z, w]."
+    )
+    angular_velocity: Vec3 = quantity((0.0, 0.0, 0.0), unit="rad/s", description="Angular velocity.")
+
+
+class RobotSection(Section):
+    """The debris collector: mass, limits, sensors, grabber."""
+
+    mass: float = quantity(100.0, unit="kg", gt=0, description="Initial mass, propellant included.")
+    propellant_mass: float = quantity(10.0, unit="kg", ge=0, description="Usable propellant (part of mass).")
+    radius: float = quantity(1.0, unit="m", gt=0, description="Radius of the bounding sphere.")
+    max_force: float = quantity(10.0, unit="N", gt=0, description="Largest thrust magnitude.")
+    max_torque: float = quantity(1.0, unit="N*m", gt=0, description="Largest torque magnitude.")
+    max_speed: float = quantity(1.0, unit="m/s", gt=0, description="Speed guidance must not exceed.")
+    specific_impulse: float = quantity(220.0, unit="s", gt=0, description="Thruster specific impulse.")
+    sensor_range: float = quantity(200.0, unit="m", gt=0, description="Objects farther away are not tracked.")
+    grab_distance: float = quantity(2.0, unit="m", gt=0, description="Largest centre distance at which a grab succeeds.")
+    capacity: int = quantity(2, ge=1, description="Targets carried at once.")
+    initial: InitialStateSpec = Field(default_factory=InitialStateSpec, description="State at t = 0.")
+
+
+class SpaceObjectSpec(Section):
+    """A target or an obstacle."""
+
+    id: int = quantity(ge=0, description="Unique id among targets and obstacles.")
+    radius: float = quantity(1.0, unit="m", gt=0, description="Radius of the bounding sphere.")
+    mass: float = quantity(10.0, unit="kg", gt=0, description="Mass.")
+    motion: MotionSpec = Field(description="How the object moves until grabbed.")
+
+
+class BeaconsSection(Section):
+    """Fixed localisation beacons and their range sensor."""
+
+    positions: list[Point] = Field(default_factory=list, description="Beacon positions: [x, y, z] or spherical.")
+    max_range: float | None = quantity(None, unit="m", gt=0, description="Beacons farther away give no range; null for unlimited.")
+    noise_sigma: float = quantity(0.1, unit="m", ge=0, description="Standard deviation of the range noise.")
+    report_nearest: int = quantity(3, ge=1, description="Ranges reported per step (the nearest beacons).")
+
+
+class DropPointSection(Section):
+    """Where targets are delivered: a fixed ``position`` or a ``motion``."""
+
+    position: Point | None = quantity(None, unit="m", description="Fixed position (or give `motion`).")
+    motion: MotionSpec | None = Field(None, description="Motion of a moving drop point (or give `position`).")
+    tolerance: float = quantity(2.0, unit="m", gt=0, description="Distance within which cargo is released.")
+
+    def build(self, mean_motion: float) -> MotionModel:
+        """The drop point's motion model."""
+        if self.motion is not None:
+            return self.motion.build(mean_motion)
+        return StaticMotion(point_to_cartesian(self.position or (0.0, 0.0, 0.0)))
+
+
+class PluginChoice(Section):
+    """Which plugin fills a role, and its parameters."""
+
+    plugin: str = Field(description="Registered plugin name (see `dcsim plugins`).")
+    params: dict[str, Any] = Field(default_factory=dict, description="Plugin parameters (see the plugin's docs).")
+
+
+class StopSection(Section):
+    """When a run ends before ``world.duration``."""
+
+    on_collision: bool = Field(True, description="End the run at the first collision.")
+    on_all_delivered: bool = Field(True, description="End the run once every target is delivered.")
+    max_wall_time: float | None = quantity(
+        None, unit="s", gt=0, description="End the run after this much wall-clock time; null for no limit."
+    )
+
+
+class Scenario(Section):
+    """A complete scenario: world, collector, objects, sensors, plugins, stop rules."""
+
+    name: str = Field("unnamed", description="Short name of the scenario.")
+    description: str = Field("", description="What the scenario shows.")
+    world: WorldSpec = Field(default_factory=WorldSpec, description="Frame, steps and seed.")
+    robot: RobotSection = Field(default_factory=RobotSection, description="The collector.")
+    targets: list[SpaceObjectSpec] = Field(default_factory=list, description="Objects to collect.")
+    obstacles: list[SpaceObjectSpec] = Field(default_factory=list, description="Objects to avoid.")
+    beacons: BeaconsSection = Field(default_factory=BeaconsSection, description="Localisation beacons.")
+    drop_point: DropPointSection = Field(default_factory=DropPointSection, description="Delivery point.")
+    localiser: PluginChoice = Field(
+        default_factory=lambda: PluginChoice(plugin="trilateration"), description="Localiser plugin."
+    )
+    task_planner: PluginChoice = Field(
+        default_factory=lambda: PluginChoice(plugin="nearest"), description="Task planner plugin."
+    )
+    path_planner: PluginChoice = Field(
+        default_factory=lambda: PluginChoice(plugin="straight-line"), description="Path planner plugin."
+    )
+    controller: PluginChoice = Field(
+        default_factory=lambda: PluginChoice(plugin="pd"), description="Controller plugin."
+    )
+    stop: StopSection = Field(default_factory=StopSection, description="Stop rules.")
+
+    @property
+    def mean_motion(self) -> float:
+        """Mean motion of the reference orbit, rad/s (used by ``cw`` motions)."""
+        return self.world.orbit.mean_motion

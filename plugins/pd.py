@@ -1,0 +1,100 @@
+"""``pd`` controller: proportional-derivative tracking with force and speed limits.
+
+The gains come from pole placement on the double integrator ẍ = u (per axis, per unit
+mass) with python-control: the closed-loop poles are those of a second-order system of
+natural frequency ``bandwidth`` and damping ratio ``damping``, giving ``kp = ω²`` and
+``kd = 2ζω``. The law is written in its speed-limited form
+
+    v_cmd = v_ref + (kp / kd) (p_ref − p),   |v_cmd| ≤ max_speed
+    F = m (kd (v_cmd − v) + a_ref),          |F| ≤ max_force
+
+which equals ``F = m (kp e + kd ė + a_ref)`` while no limit is active. It commands no
+torque: the collector's attitude is left free.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dcsim.api import (
+    Command,
+    Controller,
+    LocationEstimate,
+    PluginParams,
+    Reference,
+    RobotSpec,
+    Surroundings,
+    hookimpl,
+    quantity,
+)
+
+
+class PDParams(PluginParams):
+    """Parameters of :class:`PDController`."""
+
+    bandwidth: float = quantity(
+        0.2, unit="rad/s", gt=0, description="Natural frequency ω of the closed position loop."
+    )
+    damping: float = quantity(0.9, gt=0, le=5, description="Damping ratio ζ of the closed loop.")
+
+
+def design_gains(bandwidth: float, damping: float) -> tuple[float, float]:
+    """Place the double integrator's poles at those of ``s² + 2ζω s + ω²``.
+
+    Parameters
+    ----------
+    bandwidth : float
+        Natural frequency ω, rad/s.
+    damping : float
+        Damping ratio ζ.
+
+    Returns
+    -------
+    kp, kd : float
+        Position gain (1/s²) and velocity gain (1/s), per unit mass.
+    """
+    import control  # imported here: it is slow to import and only needed at reset
+
+    a = np.array([[0.0, 1.0], [0.0, 0.0]])
+    b = np.array([[0.0], [1.0]])
+    poles = np.roots([1.0, 2.0 * damping * bandwidth, bandwidth**2])
+    gains = np.asarray(control.acker(a, b, poles)).ravel()
+    return float(gains[0]), float(gains[1])
+
+
+def _limit(vector: np.ndarray, largest: float) -> np.ndarray:
+    norm = float(np.linalg.norm(vector))
+    return vector * (largest / norm) if norm > largest else vector
+
+
+class PDController(Controller):
+    """Speed- and force-limited PD tracking with pole-placed gains."""
+
+    name = "pd"
+    summary = "PD tracking with pole-placed gains, force and speed limits (baseline)"
+    Params = PDParams
+    params: PDParams
+
+    def reset(self, robot: RobotSpec) -> None:
+        """Design the gains and remember the robot's limits."""
+        self.robot = robot
+        self.kp, self.kd = design_gains(self.params.bandwidth, self.params.damping)
+
+    def command(
+        self,
+        time: float,
+        estimate: LocationEstimate,
+        reference: Reference,
+        surroundings: Surroundings,
+    ) -> Command:
+        """Force towards the reference; zero torque."""
+        error = reference.position - estimate.position
+        v_cmd = _limit(reference.velocity + (self.kp / self.kd) * error, self.robot.max_speed)
+        acceleration = self.kd * (v_cmd - estimate.velocity) + reference.acceleration
+        return Command(force=_limit(self.robot.mass * acceleration, self.robot.max_force))
+
+
+@hookimpl
+def dcsim_plugin_classes() -> list[type]:
+    """Register the PD controller."""
+    return [PDController]
