@@ -66,7 +66,9 @@ class ScenarioError(DcsimError):
         self.filename = filename
         self.problems = list(problems)
         lines = [p.describe(filename) for p in self.problems]
-        head = f"{filename}: invalid scenario ({len(lines)} problem{'s' if len(lines) != 1 else ''})"
+        head = (
+            f"{filename}: invalid scenario ({len(lines)} problem{'s' if len(lines) != 1 else ''})"
+        )
         super().__init__("\n".join([head, *("  " + line for line in lines)]))
 
 

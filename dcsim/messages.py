@@ -46,7 +46,7 @@ class Message:
                 continue
             value = np.array(getattr(self, f.name), dtype=float)
             if value.ndim != len(shape) or any(
-                want not in (-1, got) for want, got in zip(shape, value.shape)
+                want not in (-1, got) for want, got in zip(shape, value.shape, strict=True)
             ):
                 raise ValueError(
                     f"{type(self).__name__}.{f.name} must have shape {shape}, got {value.shape}"
@@ -73,7 +73,7 @@ def _message(cls: type) -> type:
     return dataclass(frozen=True, eq=False)(cls)
 
 
-class ObjectKind(str, enum.Enum):
+class ObjectKind(enum.StrEnum):
     """What a space object is to the collector."""
 
     TARGET = "target"

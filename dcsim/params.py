@@ -2,13 +2,15 @@
 
 Plugin parameters and scenario sections are pydantic models built from
 :func:`quantity` fields. Each field carries its unit, default, bounds and a one-line
-description, which the documentation generator, the ``dcsim plugins`` listing and the
-error messages all read from the same place.
+description, which the documentation generator and the error messages read from the
+same place.
 
 Examples
 --------
 >>> class Params(PluginParams):
-...     bandwidth: float = quantity(0.5, unit="rad/s", gt=0, description="Closed-loop natural frequency.")
+...     bandwidth: float = quantity(
+...         0.5, unit="rad/s", gt=0, description="Closed-loop natural frequency."
+...     )
 """
 
 from __future__ import annotations
@@ -61,7 +63,14 @@ def quantity(
             description=description, gt=gt, ge=ge, lt=lt, le=le, json_schema_extra=extra, **kwargs
         )
     return Field(
-        default, description=description, gt=gt, ge=ge, lt=lt, le=le, json_schema_extra=extra, **kwargs
+        default,
+        description=description,
+        gt=gt,
+        ge=ge,
+        lt=lt,
+        le=le,
+        json_schema_extra=extra,
+        **kwargs,
     )
 
 
@@ -93,7 +102,7 @@ class PluginParams(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, validate_default=True)
 
     @classmethod
-    def parse(cls, plugin: str, values: Mapping[str, Any] | None) -> "PluginParams":
+    def parse(cls, plugin: str, values: Mapping[str, Any] | None) -> PluginParams:
         """Validate raw parameter values for plugin ``plugin``.
 
         Parameters
@@ -126,9 +135,7 @@ class PluginParams(BaseModel):
             raise PluginParameterError(plugin, problems) from None
 
 
-def describe_error(
-    model: type[BaseModel] | None, field: str | None, error: ErrorDetails
-) -> str:
+def describe_error(model: type[BaseModel] | None, field: str | None, error: ErrorDetails) -> str:
     """Turn one pydantic error into a message naming the value and what is allowed.
 
     Parameters

@@ -117,8 +117,7 @@ def check_plugin_class(obj: Any) -> type[Plugin]:
     name = obj.__dict__.get("name", getattr(obj, "name", None))
     if not isinstance(name, str) or not _NAME_PATTERN.match(name):
         raise PluginInterfaceError(
-            f"{label} must set `name` to a lower-case identifier such as 'my-planner', "
-            f"got {name!r}"
+            f"{label} must set `name` to a lower-case identifier such as 'my-planner', got {name!r}"
         )
     summary = getattr(obj, "summary", None)
     if not isinstance(summary, str) or not summary.strip() or "\n" in summary.strip():
@@ -132,8 +131,7 @@ def check_plugin_class(obj: Any) -> type[Plugin]:
     if missing:
         methods = ", ".join(f"{m}()" for m in missing)
         raise PluginInterfaceError(
-            f"plugin '{name}' ({label}) does not implement {methods} "
-            f"of the {obj.kind} interface"
+            f"plugin '{name}' ({label}) does not implement {methods} of the {obj.kind} interface"
         )
     return obj
 
@@ -163,7 +161,7 @@ class PluginRegistry:
         self.warnings: list[str] = []
 
     @classmethod
-    def discover(cls, group: str = hookspecs.PROJECT_NAME) -> "PluginRegistry":
+    def discover(cls, group: str = hookspecs.PROJECT_NAME) -> PluginRegistry:
         """Build a registry from the installed entry points of ``group``.
 
         A package that fails to import, or provides a broken class, is reported as a

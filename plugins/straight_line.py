@@ -29,7 +29,10 @@ class StraightLineParams(PluginParams):
     """Parameters of :class:`StraightLinePlanner`."""
 
     speed_fraction: float = quantity(
-        0.8, gt=0, le=1, description="Fraction of the speed limit flown when no arrival time is set."
+        0.8,
+        gt=0,
+        le=1,
+        description="Fraction of the speed limit flown when no arrival time is set.",
     )
     clearance: float = quantity(
         0.5, unit="m", ge=0, description="Margin kept beyond the sum of robot and obstacle radii."
@@ -43,7 +46,9 @@ class StraightLinePlanner(PathPlanner):
     """Direct constant-velocity segment, rejected if it meets a predicted obstacle."""
 
     name = "straight-line"
-    summary = "Direct segment at a speed limit; no path if it crosses a predicted obstacle (baseline)"
+    summary = (
+        "Direct segment at a speed limit; no path if it crosses a predicted obstacle (baseline)"
+    )
     Params = StraightLineParams
     params: StraightLineParams
 
@@ -55,7 +60,9 @@ class StraightLinePlanner(PathPlanner):
         if goal.time is not None:
             duration = goal.time - start.time
             if duration <= 0:
-                return NoPath(f"the goal time {goal.time:g} s is not after the start {start.time:g} s")
+                return NoPath(
+                    f"the goal time {goal.time:g} s is not after the start {start.time:g} s"
+                )
         else:
             duration = distance / (self.params.speed_fraction * problem.max_speed)
         duration = max(duration, _MIN_DURATION)
@@ -66,13 +73,18 @@ class StraightLinePlanner(PathPlanner):
                 f"reaching the goal by t = {goal.time:g} s needs {speed:.3g} m/s, "
                 f"above the {problem.max_speed:g} m/s limit"
             )
-        if problem.bounds is not None and not problem.bounds.contains([start.position, goal.position]).all():
+        if (
+            problem.bounds is not None
+            and not problem.bounds.contains([start.position, goal.position]).all()
+        ):
             return NoPath("the start or the goal lies outside the bounds")
         delta_v = float(
             np.linalg.norm(velocity - start.velocity) + np.linalg.norm(goal.velocity - velocity)
         )
         if delta_v > problem.max_delta_v:
-            return NoPath(f"the segment needs {delta_v:.3g} m/s of delta-v, above {problem.max_delta_v:g}")
+            return NoPath(
+                f"the segment needs {delta_v:.3g} m/s of delta-v, above {problem.max_delta_v:g}"
+            )
         t1 = start.time + duration
         blocked = self._first_conflict(problem, start.time, t1, start.position, velocity, distance)
         if blocked is not None:

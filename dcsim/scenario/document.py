@@ -73,7 +73,7 @@ class ScenarioDocument:
     overrides: dict[KeyPath, str] = field(default_factory=dict)
 
     @classmethod
-    def from_text(cls, text: str, filename: str) -> "ScenarioDocument":
+    def from_text(cls, text: str, filename: str) -> ScenarioDocument:
         """Parse YAML ``text`` (safe loader) into a document.
 
         Raises
@@ -93,7 +93,9 @@ class ScenarioDocument:
         finally:
             loader.dispose()
         if not isinstance(data, dict):
-            raise ScenarioError(filename, [Problem("", "the top level must be a mapping of sections", 1, 1)])
+            raise ScenarioError(
+                filename, [Problem("", "the top level must be a mapping of sections", 1, 1)]
+            )
         doc = cls(filename, data)
         duplicates: list[Problem] = []
         if node is not None:
@@ -103,7 +105,7 @@ class ScenarioDocument:
         return doc
 
     @classmethod
-    def from_file(cls, path: str | Path) -> "ScenarioDocument":
+    def from_file(cls, path: str | Path) -> ScenarioDocument:
         """Read and parse the scenario file at ``path``.
 
         Raises
@@ -114,7 +116,9 @@ class ScenarioDocument:
         try:
             text = Path(path).read_text(encoding="utf-8")
         except OSError as exc:
-            raise ScenarioError(str(path), [Problem("", f"cannot read the file: {exc.strerror}")]) from None
+            raise ScenarioError(
+                str(path), [Problem("", f"cannot read the file: {exc.strerror}")]
+            ) from None
         return cls.from_text(text, str(path))
 
     def _collect_marks(self, node: yaml.Node, path: KeyPath, duplicates: list[Problem]) -> None:
@@ -160,7 +164,9 @@ class ScenarioDocument:
         self._assign(container, path, value, source)
         self.overrides[path] = source
 
-    def _descend(self, container: Any, key: str | int, where: KeyPath, nxt: str | int, source: str) -> Any:
+    def _descend(
+        self, container: Any, key: str | int, where: KeyPath, nxt: str | int, source: str
+    ) -> Any:
         if isinstance(key, int):
             self._check_index(container, key, where, source)
             return container[key]
@@ -182,16 +188,18 @@ class ScenarioDocument:
         if not isinstance(container, list):
             self._fail(where, "is not a list here", source)
         if index >= len(container):
-            self._fail(where, f"index {index} is out of range (the list has {len(container)} items)", source)
+            self._fail(
+                where,
+                f"index {index} is out of range (the list has {len(container)} items)",
+                source,
+            )
 
     def _fail(self, path: KeyPath, message: str, source: str) -> None:
         raise ScenarioError(self.filename, [Problem(format_key_path(path), message, source=source)])
 
     def problem(self, path: KeyPath, message: str) -> Problem:
         """A :class:`Problem` at ``path``, located at the nearest known key or override."""
-        source = next(
-            (src for p, src in self.overrides.items() if path[: len(p)] == p), None
-        )
+        source = next((src for p, src in self.overrides.items() if path[: len(p)] == p), None)
         for end in range(len(path), -1, -1):
             mark = self.marks.get(path[:end])
             if mark is not None:

@@ -89,7 +89,9 @@ def validate(doc: ScenarioDocument) -> Scenario:
     return scenario
 
 
-def resolve_plugins(doc: ScenarioDocument, scenario: Scenario, registry: PluginRegistry) -> Scenario:
+def resolve_plugins(
+    doc: ScenarioDocument, scenario: Scenario, registry: PluginRegistry
+) -> Scenario:
     """Check each role's plugin name and parameters; return the scenario with defaults filled.
 
     Raises
@@ -127,16 +129,20 @@ def _rule_violations(scenario: Scenario) -> list[tuple[KeyPath, str]]:
     world, robot = scenario.world, scenario.robot
     ratio = world.control_period / world.physics_step
     if abs(ratio - round(ratio)) > 1e-9 * ratio or round(ratio) < 1:
-        found.append((
-            ("world", "control_period"),
-            f"{world.control_period:g} s is not a whole multiple of physics_step "
-            f"({world.physics_step:g} s)",
-        ))
+        found.append(
+            (
+                ("world", "control_period"),
+                f"{world.control_period:g} s is not a whole multiple of physics_step "
+                f"({world.physics_step:g} s)",
+            )
+        )
     if robot.propellant_mass >= robot.mass:
-        found.append((
-            ("robot", "propellant_mass"),
-            f"{robot.propellant_mass:g} kg must be less than robot.mass ({robot.mass:g} kg)",
-        ))
+        found.append(
+            (
+                ("robot", "propellant_mass"),
+                f"{robot.propellant_mass:g} kg must be less than robot.mass ({robot.mass:g} kg)",
+            )
+        )
     if sum(q * q for q in robot.initial.attitude) < 1e-12:
         found.append((("robot", "initial", "attitude"), "the quaternion must not be zero"))
     owners: dict[int, str] = {}
@@ -144,13 +150,17 @@ def _rule_violations(scenario: Scenario) -> list[tuple[KeyPath, str]]:
         for index, obj in enumerate(getattr(scenario, section)):
             here = f"{section}[{index}]"
             if obj.id in owners:
-                found.append(((section, index, "id"), f"id {obj.id} is already used by {owners[obj.id]}"))
+                found.append(
+                    ((section, index, "id"), f"id {obj.id} is already used by {owners[obj.id]}")
+                )
             owners.setdefault(obj.id, here)
             if isinstance(obj.motion, CWMotionSpec) and world.frame != "lvlh":
-                found.append((
-                    (section, index, "motion", "type"),
-                    "'cw' motion needs world.frame: lvlh",
-                ))
+                found.append(
+                    (
+                        (section, index, "motion", "type"),
+                        "'cw' motion needs world.frame: lvlh",
+                    )
+                )
     drop = scenario.drop_point
     if drop.position is not None and drop.motion is not None:
         found.append((("drop_point", "motion"), "give either position or motion, not both"))
@@ -172,7 +182,10 @@ def _schema_problems(doc: ScenarioDocument, exc: ValidationError) -> list[Proble
         else:
             message = f"{err['input']!r} is not allowed: {err['msg']}"
         messages.setdefault(path, []).append(message)
-    return [doc.problem(path, "; or ".join(dict.fromkeys(msgs))) for path, msgs in messages.items()]
+    found = [
+        doc.problem(path, "; or ".join(dict.fromkeys(msgs))) for path, msgs in messages.items()
+    ]
+    return sorted(found, key=lambda p: (p.line is None, p.line or 0, p.column or 0))
 
 
 def _locate(data: Any, loc: tuple[Any, ...]) -> tuple[KeyPath, type[BaseModel] | None, str | None]:
@@ -192,7 +205,11 @@ def _locate(data: Any, loc: tuple[Any, ...]) -> tuple[KeyPath, type[BaseModel] |
             path.append(item)
             owner, field = model, item
             data = data.get(item)
-            annotation = model.model_fields[item].annotation if model and item in model.model_fields else None
+            annotation = (
+                model.model_fields[item].annotation
+                if model and item in model.model_fields
+                else None
+            )
             model = _pick_model(annotation, data)
         elif isinstance(data, list) and isinstance(item, int) and 0 <= item < len(data):
             path.append(item)

@@ -97,7 +97,9 @@ class CWMotionSpec(Section):
     """Clohessy–Wiltshire relative motion from an LVLH state at t = 0 (frame ``lvlh`` only)."""
 
     type: Literal["cw"]
-    position: Vec3 = quantity(unit="m", description="LVLH position at t = 0 (x radial, y along-track).")
+    position: Vec3 = quantity(
+        unit="m", description="LVLH position at t = 0 (x radial, y along-track)."
+    )
     velocity: Vec3 = quantity((0.0, 0.0, 0.0), unit="m/s", description="LVLH velocity at t = 0.")
 
     def build(self, mean_motion: float) -> MotionModel:
@@ -115,9 +117,13 @@ MotionSpec = Annotated[
 class OrbitSpec(Section):
     """The circular reference orbit of the LVLH frame."""
 
-    radius: float = quantity(6_778_137.0, unit="m", gt=0, description="Orbit radius (Earth radius + altitude).")
+    radius: float = quantity(
+        6_778_137.0, unit="m", gt=0, description="Orbit radius (Earth radius + altitude)."
+    )
     mu: float = quantity(
-        STANDARD_GRAVITATIONAL_PARAMETER_EARTH, unit="m^3/s^2", gt=0,
+        STANDARD_GRAVITATIONAL_PARAMETER_EARTH,
+        unit="m^3/s^2",
+        gt=0,
         description="Gravitational parameter of the central body.",
     )
 
@@ -136,39 +142,59 @@ class WorldSpec(Section):
         "geocentric: the thesis's force-free spherical world.",
     )
     orbit: OrbitSpec = Field(default_factory=OrbitSpec, description="Reference orbit (lvlh only).")
-    physics_step: float = quantity(0.01, unit="s", gt=0, le=1, description="Fixed physics time step.")
+    physics_step: float = quantity(
+        0.01, unit="s", gt=0, le=1, description="Fixed physics time step."
+    )
     control_period: float = quantity(
         0.1, unit="s", gt=0, description="Control period; a whole number of physics steps."
     )
-    duration: float = quantity(600.0, unit="s", gt=0, description="Simulated time after which the run ends.")
+    duration: float = quantity(
+        600.0, unit="s", gt=0, description="Simulated time after which the run ends."
+    )
     seed: int = quantity(0, ge=0, description="Seed of every random number in the run.")
 
 
 class InitialStateSpec(Section):
     """The collector's state at t = 0."""
 
-    position: Point = quantity((0.0, 0.0, 0.0), unit="m", description="Position: [x, y, z] or spherical.")
+    position: Point = quantity(
+        (0.0, 0.0, 0.0), unit="m", description="Position: [x, y, z] or spherical."
+    )
     velocity: Vec3 = quantity((0.0, 0.0, 0.0), unit="m/s", description="Velocity.")
     attitude: tuple[float, float, float, float] = quantity(
         (0.0, 0.0, 0.0, 1.0), description="Attitude quaternion [x, y, z, w]."
     )
-    angular_velocity: Vec3 = quantity((0.0, 0.0, 0.0), unit="rad/s", description="Angular velocity.")
+    angular_velocity: Vec3 = quantity(
+        (0.0, 0.0, 0.0), unit="rad/s", description="Angular velocity."
+    )
 
 
 class RobotSection(Section):
     """The debris collector: mass, limits, sensors, grabber."""
 
     mass: float = quantity(100.0, unit="kg", gt=0, description="Initial mass, propellant included.")
-    propellant_mass: float = quantity(10.0, unit="kg", ge=0, description="Usable propellant (part of mass).")
+    propellant_mass: float = quantity(
+        10.0, unit="kg", ge=0, description="Usable propellant (part of mass)."
+    )
     radius: float = quantity(1.0, unit="m", gt=0, description="Radius of the bounding sphere.")
     max_force: float = quantity(10.0, unit="N", gt=0, description="Largest thrust magnitude.")
     max_torque: float = quantity(1.0, unit="N*m", gt=0, description="Largest torque magnitude.")
-    max_speed: float = quantity(1.0, unit="m/s", gt=0, description="Speed guidance must not exceed.")
-    specific_impulse: float = quantity(220.0, unit="s", gt=0, description="Thruster specific impulse.")
-    sensor_range: float = quantity(200.0, unit="m", gt=0, description="Objects farther away are not tracked.")
-    grab_distance: float = quantity(2.0, unit="m", gt=0, description="Largest centre distance at which a grab succeeds.")
+    max_speed: float = quantity(
+        1.0, unit="m/s", gt=0, description="Speed guidance must not exceed."
+    )
+    specific_impulse: float = quantity(
+        220.0, unit="s", gt=0, description="Thruster specific impulse."
+    )
+    sensor_range: float = quantity(
+        200.0, unit="m", gt=0, description="Objects farther away are not tracked."
+    )
+    grab_distance: float = quantity(
+        2.0, unit="m", gt=0, description="Largest centre distance at which a grab succeeds."
+    )
     capacity: int = quantity(2, ge=1, description="Targets carried at once.")
-    initial: InitialStateSpec = Field(default_factory=InitialStateSpec, description="State at t = 0.")
+    initial: InitialStateSpec = Field(
+        default_factory=InitialStateSpec, description="State at t = 0."
+    )
 
 
 class SpaceObjectSpec(Section):
@@ -183,18 +209,32 @@ class SpaceObjectSpec(Section):
 class BeaconsSection(Section):
     """Fixed localisation beacons and their range sensor."""
 
-    positions: list[Point] = Field(default_factory=list, description="Beacon positions: [x, y, z] or spherical.")
-    max_range: float | None = quantity(None, unit="m", gt=0, description="Beacons farther away give no range; null for unlimited.")
-    noise_sigma: float = quantity(0.1, unit="m", ge=0, description="Standard deviation of the range noise.")
-    report_nearest: int = quantity(3, ge=1, description="Ranges reported per step (the nearest beacons).")
+    positions: list[Point] = Field(
+        default_factory=list, description="Beacon positions: [x, y, z] or spherical."
+    )
+    max_range: float | None = quantity(
+        None, unit="m", gt=0, description="Beacons farther away give no range; null for unlimited."
+    )
+    noise_sigma: float = quantity(
+        0.1, unit="m", ge=0, description="Standard deviation of the range noise."
+    )
+    report_nearest: int = quantity(
+        3, ge=1, description="Ranges reported per step (the nearest beacons)."
+    )
 
 
 class DropPointSection(Section):
     """Where targets are delivered: a fixed ``position`` or a ``motion``."""
 
-    position: Point | None = quantity(None, unit="m", description="Fixed position (or give `motion`).")
-    motion: MotionSpec | None = Field(None, description="Motion of a moving drop point (or give `position`).")
-    tolerance: float = quantity(2.0, unit="m", gt=0, description="Distance within which cargo is released.")
+    position: Point | None = quantity(
+        None, unit="m", description="Fixed position (or give `motion`)."
+    )
+    motion: MotionSpec | None = Field(
+        None, description="Motion of a moving drop point (or give `position`)."
+    )
+    tolerance: float = quantity(
+        2.0, unit="m", gt=0, description="Distance within which cargo is released."
+    )
 
     def build(self, mean_motion: float) -> MotionModel:
         """The drop point's motion model."""
@@ -207,7 +247,9 @@ class PluginChoice(Section):
     """Which plugin fills a role, and its parameters."""
 
     plugin: str = Field(description="Registered plugin name (see `dcsim plugins`).")
-    params: dict[str, Any] = Field(default_factory=dict, description="Plugin parameters (see the plugin's docs).")
+    params: dict[str, Any] = Field(
+        default_factory=dict, description="Plugin parameters (see the plugin's docs)."
+    )
 
 
 class StopSection(Section):
@@ -216,7 +258,10 @@ class StopSection(Section):
     on_collision: bool = Field(True, description="End the run at the first collision.")
     on_all_delivered: bool = Field(True, description="End the run once every target is delivered.")
     max_wall_time: float | None = quantity(
-        None, unit="s", gt=0, description="End the run after this much wall-clock time; null for no limit."
+        None,
+        unit="s",
+        gt=0,
+        description="End the run after this much wall-clock time; null for no limit.",
     )
 
 
@@ -229,16 +274,22 @@ class Scenario(Section):
     robot: RobotSection = Field(default_factory=RobotSection, description="The collector.")
     targets: list[SpaceObjectSpec] = Field(default_factory=list, description="Objects to collect.")
     obstacles: list[SpaceObjectSpec] = Field(default_factory=list, description="Objects to avoid.")
-    beacons: BeaconsSection = Field(default_factory=BeaconsSection, description="Localisation beacons.")
-    drop_point: DropPointSection = Field(default_factory=DropPointSection, description="Delivery point.")
+    beacons: BeaconsSection = Field(
+        default_factory=BeaconsSection, description="Localisation beacons."
+    )
+    drop_point: DropPointSection = Field(
+        default_factory=DropPointSection, description="Delivery point."
+    )
     localiser: PluginChoice = Field(
-        default_factory=lambda: PluginChoice(plugin="trilateration"), description="Localiser plugin."
+        default_factory=lambda: PluginChoice(plugin="trilateration"),
+        description="Localiser plugin.",
     )
     task_planner: PluginChoice = Field(
         default_factory=lambda: PluginChoice(plugin="nearest"), description="Task planner plugin."
     )
     path_planner: PluginChoice = Field(
-        default_factory=lambda: PluginChoice(plugin="straight-line"), description="Path planner plugin."
+        default_factory=lambda: PluginChoice(plugin="straight-line"),
+        description="Path planner plugin.",
     )
     controller: PluginChoice = Field(
         default_factory=lambda: PluginChoice(plugin="pd"), description="Controller plugin."

@@ -47,7 +47,9 @@ def _type_name(annotation: Any) -> str:
         return f"[{', '.join('number' for _ in get_args(annotation))}]"
     if isinstance(annotation, type) and issubclass(annotation, BaseModel):
         return "section"
-    return {float: "number", int: "integer", bool: "boolean", str: "string"}.get(annotation, str(annotation))
+    return {float: "number", int: "integer", bool: "boolean", str: "string"}.get(
+        annotation, str(annotation)
+    )
 
 
 def _default(model: type[BaseModel], name: str) -> str:

@@ -1,0 +1,5 @@
+"""``python -m dcsim``: the same as the ``dcsim`` command."""
+
+from dcsim.cli import main
+
+main()

@@ -1,0 +1,102 @@
+"""Shared fixtures: running the real console script and installing throw-away plugins."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+DCSIM = Path(sys.executable).with_name("dcsim")
+
+
+@dataclass
+class CliResult:
+    """Exit status and output of one ``dcsim`` invocation."""
+
+    returncode: int
+    stdout: str
+    stderr: str
+
+
+@pytest.fixture
+def dcsim_cli(tmp_path):
+    """Run the installed ``dcsim`` console script; ``extra_path`` dirs go on PYTHONPATH."""
+
+    def run(
+        *args: str, extra_path: list[Path] = (), env: dict[str, str] | None = None
+    ) -> CliResult:
+        environment = {k: v for k, v in os.environ.items() if k != "DCSIM_LOAD_PLUGINS"}
+        environment["PYTHONPATH"] = os.pathsep.join(str(p) for p in extra_path)
+        environment.update(env or {})
+        done = subprocess.run(
+            [str(DCSIM), *args],
+            capture_output=True,
+            text=True,
+            env=environment,
+            cwd=tmp_path,
+            timeout=120,
+        )
+        return CliResult(done.returncode, done.stdout, done.stderr)
+
+    return run
+
+
+def make_distribution(
+    root: Path, dist: str, version: str, modules: dict[str, str], entry_points: dict[str, str]
+) -> Path:
+    """Install a throw-away distribution under ``root``: modules plus a dist-info.
+
+    ``importlib.metadata`` finds it like any installed package once ``root`` is on the
+    path, so the registry discovers its ``dcsim`` entry points for real.
+    """
+    root.mkdir(parents=True, exist_ok=True)
+    for name, source in modules.items():
+        (root / f"{name}.py").write_text(textwrap.dedent(source))
+    info = root / f"{dist.replace('-', '_')}-{version}.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {dist}\nVersion: {version}\n")
+    lines = "\n".join(f"{k} = {v}" for k, v in entry_points.items())
+    (info / "entry_points.txt").write_text(f"[dcsim]\n{lines}\n")
+    return root
+
+
+GOOD_PLUGIN = """
+    import numpy as np
+    from dcsim.api import Command, Controller, PluginParams, hookimpl, quantity
+
+    class HoldParams(PluginParams):
+        gain: float = quantity(1.0, unit="1/s", gt=0, description="Velocity damping gain.")
+
+    class HoldController(Controller):
+        name = "hold"
+        summary = "Damps the velocity to zero"
+        Params = HoldParams
+
+        def reset(self, robot):
+            self.robot = robot
+
+        def command(self, time, estimate, reference, surroundings):
+            return Command(force=-self.params.gain * self.robot.mass * np.asarray(estimate.velocity))
+
+    @hookimpl
+    def dcsim_plugin_classes():
+        return [HoldController]
+"""
+
+
+@pytest.fixture
+def good_plugin_dist(tmp_path) -> Path:
+    """A third-party distribution ``dcsim-hold`` providing the ``hold`` controller."""
+    return make_distribution(
+        tmp_path / "site_good",
+        "dcsim-hold",
+        "1.2.3",
+        {"dcsim_hold": GOOD_PLUGIN},
+        {"hold": "dcsim_hold"},
+    )

@@ -1,0 +1,168 @@
+"""The dcsim command through its real console entry point."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+import yaml
+
+from dcsim import __version__
+from tests.conftest import REPO
+
+
+def test_version(dcsim_cli):
+    result = dcsim_cli("--version")
+    assert result.returncode == 0
+    assert __version__ in result.stdout
+
+
+def test_help_lists_commands(dcsim_cli):
+    result = dcsim_cli("--help")
+    assert result.returncode == 0
+    for command in ("plugins", "validate", "run"):
+        assert command in result.stdout
+
+
+@pytest.mark.parametrize(
+    "command, options",
+    [
+        ("plugins", ["--kind", "--json"]),
+        ("validate", ["FILES"]),
+        ("run", ["--out", "--seed", "--set", "SCENARIO"]),
+    ],
+)
+def test_command_help_explains_every_option(dcsim_cli, command, options):
+    result = dcsim_cli(command, "--help")
+    assert result.returncode == 0
+    for option in options:
+        assert option in result.stdout
+
+
+def test_plugins_table_lists_builtins_with_origin(dcsim_cli):
+    result = dcsim_cli("plugins")
+    assert result.returncode == 0
+    lines = result.stdout.splitlines()
+    assert lines[0].split() == ["KIND", "NAME", "SUMMARY", "ORIGIN"]
+    for kind, name in [
+        ("localiser", "trilateration"),
+        ("task_planner", "nearest"),
+        ("path_planner", "straight-line"),
+        ("controller", "pd"),
+    ]:
+        row = next(line for line in lines if line.split()[:2] == [kind, name])
+        assert row.rstrip().endswith(f"dcsim {__version__}")
+
+
+def test_plugins_json_and_kind_filter(dcsim_cli):
+    result = dcsim_cli("plugins", "--json", "--kind", "controller")
+    assert result.returncode == 0
+    entries = json.loads(result.stdout)
+    assert [e["name"] for e in entries] == ["pd"]
+    assert entries[0]["kind"] == "controller"
+    assert entries[0]["distribution"] == "dcsim"
+    assert entries[0]["summary"]
+
+
+def test_plugins_rejects_unknown_kind(dcsim_cli):
+    result = dcsim_cli("plugins", "--kind", "teleporter")
+    assert result.returncode == 2
+    assert "Traceback" not in result.stderr
+
+
+def test_validate_prints_ok_per_file(dcsim_cli):
+    files = [
+        str(REPO / "scenarios" / "default.yaml"),
+        str(REPO / "scenarios" / "thesis_debris_field.yaml"),
+    ]
+    result = dcsim_cli("validate", *files)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.splitlines() == [f"ok {f}" for f in files]
+
+
+def test_validate_reports_each_problem_with_line_and_path(dcsim_cli, tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("world:\n  seed: -4\nrobot:\n  mass: 100\n  capcity: 2\n")
+    good = REPO / "scenarios" / "default.yaml"
+    result = dcsim_cli("validate", str(bad), str(good))
+    assert result.returncode == 2
+    assert f"ok {good}" in result.stdout
+    assert f"{bad}:2:3: world.seed: -4 is not allowed" in result.stderr
+    assert f"{bad}:5:3: robot.capcity: unknown key" in result.stderr
+    assert result.stderr.startswith("error: ")
+    assert "Traceback" not in result.stderr
+
+
+def test_run_default_prints_resolved_scenario_and_plugins(dcsim_cli):
+    result = dcsim_cli("run")
+    assert result.returncode == 0, result.stderr
+    assert "scenario: default" in result.stdout
+    for role, plugin in [("localiser", "trilateration"), ("controller", "pd")]:
+        assert any(line.split()[:2] == [role, plugin] for line in result.stdout.splitlines())
+    resolved = yaml.safe_load(
+        result.stdout.split("--- resolved scenario ---\n", 1)[1].rsplit("not simulated", 1)[0]
+    )
+    assert resolved["controller"]["params"]["bandwidth"] > 0  # defaults filled in
+
+
+def test_run_writes_resolved_scenario_with_seed_and_overrides(dcsim_cli, tmp_path):
+    out = tmp_path / "run1"
+    result = dcsim_cli(
+        "run",
+        str(REPO / "scenarios" / "thesis_debris_field.yaml"),
+        "--out",
+        str(out),
+        "--seed",
+        "7",
+        "--set",
+        "robot.max_force=123.5",
+        "--set",
+        "controller.params.damping=1.2",
+    )
+    assert result.returncode == 0, result.stderr
+    written = yaml.safe_load((out / "scenario.yaml").read_text())
+    assert written["world"]["seed"] == 7
+    assert written["robot"]["max_force"] == 123.5
+    assert written["controller"]["params"] == {"bandwidth": 0.2, "damping": 1.2}
+
+
+@pytest.mark.parametrize(
+    "override, expected",
+    [
+        (
+            "controller.plugin=pdd",
+            "no controller plugin named 'pdd' (available: pd); did you mean 'pd'?",
+        ),
+        (
+            "controller.params.bandwidth=-1",
+            "controller.params.bandwidth: -1 is not allowed: Input should be greater than 0 (allowed: > 0 rad/s)",
+        ),
+        (
+            "controller.params.gian=2",
+            "controller.params.gian: unknown key (known keys: bandwidth, damping)",
+        ),
+        ("targets[7].mass=1", "targets[7]: index 7 is out of range (the list has 4 items)"),
+        ("robot.mass", "expected key.path=value"),
+    ],
+)
+def test_run_user_errors_exit_2_without_traceback(dcsim_cli, override, expected):
+    result = dcsim_cli("run", "--set", override)
+    assert result.returncode == 2
+    assert result.stderr.startswith("error: ")
+    assert expected in result.stderr
+    assert f"--set {override}" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_missing_scenario_file_is_a_user_error(dcsim_cli, tmp_path):
+    result = dcsim_cli("run", str(tmp_path / "nope.yaml"))
+    assert result.returncode == 2
+    assert "cannot read the file" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_debug_shows_the_traceback(dcsim_cli):
+    result = dcsim_cli("--debug", "run", "--set", "world.seed=-1")
+    assert result.returncode != 0
+    assert "Traceback" in result.stderr
+    assert "ScenarioError" in result.stderr

@@ -1,0 +1,70 @@
+"""Motion models against their own equations."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from dcsim.api import (
+    ClohessyWiltshireMotion,
+    LinearMotion,
+    SphericalMotion,
+    StaticMotion,
+    mean_motion,
+    spherical_to_cartesian,
+)
+
+N = mean_motion(6_778_137.0)
+
+
+def test_mean_motion_of_a_400_km_orbit():
+    period = 2 * np.pi / N
+    assert period == pytest.approx(5553.6, abs=1.0)  # s, the ISS-like 92.6 min orbit
+
+
+def test_cw_closed_form_matches_numerical_integration_of_the_cw_equations():
+    motion = ClohessyWiltshireMotion((12.0, -30.0, 4.0), (0.02, -0.01, 0.005), N, epoch=10.0)
+
+    def rhs(_, s):
+        x, y, z, vx, vy, vz = s
+        return [vx, vy, vz, 3 * N**2 * x + 2 * N * vy, -2 * N * vx, -(N**2) * z]
+
+    times = np.linspace(10.0, 6000.0, 50)
+    numeric = solve_ivp(
+        rhs, (10.0, 6000.0), [12, -30, 4, 0.02, -0.01, 0.005], t_eval=times, rtol=1e-11, atol=1e-11
+    )
+    position, velocity = motion.state_at(times)
+    np.testing.assert_allclose(position, numeric.y[:3].T, atol=1e-6)
+    np.testing.assert_allclose(velocity, numeric.y[3:].T, atol=1e-9)
+
+
+def test_cw_without_along_track_drift_is_periodic():
+    motion = ClohessyWiltshireMotion((15.0, 30.0, 5.0), (0.0, -2 * N * 15.0, 0.0), N)
+    period = 2 * np.pi / N
+    np.testing.assert_allclose(motion.position_at(period), motion.position_at(0.0), atol=1e-9)
+
+
+def test_spherical_model_follows_eq_2_1():
+    motion = SphericalMotion(
+        150_000.0, 45.0, 10.0, v=2.0, alpha_deg_s=0.003, beta_deg_s=-0.002, epoch=5.0
+    )
+    t = 305.0
+    expected = spherical_to_cartesian(150_000.0 + 2.0 * 300.0, 45.0 + 0.9, 10.0 - 0.6)
+    np.testing.assert_allclose(motion.position_at(t), expected, rtol=1e-14)
+
+
+def test_spherical_velocity_is_the_derivative_of_position():
+    motion = SphericalMotion(150_000.0, 80.0, 330.0, v=-1.0, alpha_deg_s=0.004, beta_deg_s=0.003)
+    t, h = 100.0, 1e-3
+    numeric = (motion.position_at(t + h) - motion.position_at(t - h)) / (2 * h)
+    np.testing.assert_allclose(motion.state_at(t)[1], numeric, rtol=1e-7)
+
+
+def test_linear_and_static_models_vectorise_over_time():
+    times = np.array([0.0, 1.0, 2.5])
+    position, velocity = LinearMotion((1.0, 2.0, 3.0), (0.5, 0.0, -1.0), epoch=1.0).state_at(times)
+    np.testing.assert_allclose(position[2], [1.75, 2.0, 1.5])
+    assert velocity.shape == (3, 3)
+    position, velocity = StaticMotion((4.0, 5.0, 6.0)).state_at(times)
+    assert position.shape == (3, 3) and not velocity.any()

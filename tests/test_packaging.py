@@ -1,0 +1,85 @@
+"""Packaging: every package is listed, and a wheel installs and runs on its own."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tomllib
+import venv
+import zipfile
+
+import pytest
+
+from tests.conftest import REPO
+
+
+def _source_packages() -> set[str]:
+    config = tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["setuptools"]
+    found = set()
+    for name, directory in config["package-dir"].items():
+        for init in (REPO / directory).rglob("__init__.py"):
+            relative = init.parent.relative_to(REPO / directory)
+            found.add(".".join([name, *relative.parts]))
+    return found
+
+
+def test_every_package_directory_is_listed_in_pyproject():
+    config = tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["setuptools"]
+    assert set(config["packages"]) == _source_packages()
+
+
+@pytest.fixture(scope="module")
+def wheel(tmp_path_factory):
+    out = tmp_path_factory.mktemp("wheel")
+    subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "--quiet", "--no-deps", "-w", str(out), str(REPO)],
+        check=True,
+        capture_output=True,
+        timeout=300,
+    )
+    return next(out.glob("dcsim-*.whl"))
+
+
+def test_wheel_carries_the_default_scenario_plugins_and_entry_points(wheel):
+    with zipfile.ZipFile(wheel) as archive:
+        names = set(archive.namelist())
+        entry_points = next(
+            archive.read(n).decode() for n in names if n.endswith("entry_points.txt")
+        )
+    assert "dcsim/scenarios/default.yaml" in names
+    assert {"dcsim_plugins/pd.py", "dcsim_plugins/nearest.py"} <= names
+    assert not any(n.startswith("plugins/") for n in names)
+    assert "pd = dcsim_plugins.pd" in entry_points and "dcsim = dcsim.cli:main" in entry_points
+
+
+def test_wheel_installs_into_a_fresh_environment_and_runs(wheel, tmp_path):
+    env_dir = tmp_path / "env"
+    venv.create(env_dir, with_pip=True)
+    python = env_dir / "bin" / "python"
+    subprocess.run(
+        [str(python), "-m", "pip", "install", "--quiet", str(wheel)],
+        check=True,
+        capture_output=True,
+        timeout=600,
+    )
+    environment = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
+    run = subprocess.run(
+        [str(env_dir / "bin" / "dcsim"), "run", "--out", "out"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        env=environment,
+        timeout=120,
+    )
+    assert run.returncode == 0, run.stderr
+    assert "scenario: default" in run.stdout
+    assert (tmp_path / "out" / "scenario.yaml").is_file()
+    listing = subprocess.run(
+        [str(env_dir / "bin" / "dcsim"), "plugins"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        env=environment,
+    )
+    assert "straight-line" in listing.stdout and listing.stderr == ""
