@@ -23,6 +23,8 @@ Motion models
     :class:`SphericalMotion`, :class:`ClohessyWiltshireMotion`, :func:`mean_motion`.
 Plan cost
     :func:`plan_delta_v`, :func:`legs_delta_v`.
+Kinematics
+    :func:`rest_to_rest_time`, :func:`cruise_speed`.
 Geometry
     :func:`spherical_to_cartesian`, :func:`quaternion_between`, :func:`rotate`, :func:`unit`.
 Registry and hooks
@@ -44,6 +46,7 @@ from dcsim.errors import (
 from dcsim.geometry import quaternion_between, rotate, spherical_to_cartesian, unit
 from dcsim.hookspecs import hookimpl
 from dcsim.interfaces import PLUGIN_KINDS, Controller, Localiser, PathPlanner, Plugin, TaskPlanner
+from dcsim.kinematics import cruise_speed, rest_to_rest_time
 from dcsim.messages import (
     BeaconRange,
     Bounds,
@@ -88,6 +91,7 @@ __all__ = [
     "ClohessyWiltshireMotion",
     "Command",
     "Controller",
+    "cruise_speed",
     "CostWeights",
     "DcsimError",
     "DropPoint",
@@ -132,6 +136,7 @@ __all__ = [
     "plan_delta_v",
     "quantity",
     "quaternion_between",
+    "rest_to_rest_time",
     "rotate",
     "spherical_to_cartesian",
     "unit",

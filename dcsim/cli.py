@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import sys
 import warnings
+from datetime import datetime
 from pathlib import Path
 
 import click
@@ -18,7 +19,7 @@ from dcsim.errors import DcsimError, PluginLoadWarning
 from dcsim.interfaces import PLUGIN_KINDS
 from dcsim.registry import PluginRegistry
 from dcsim.runsetup import prepare_run
-from dcsim.scenario import dump_scenario, load_scenario
+from dcsim.scenario import load_scenario
 
 EXIT_USER_ERROR = 2
 
@@ -120,7 +121,7 @@ def validate_command(files: tuple[Path, ...]) -> None:
 @click.option(
     "--out",
     type=click.Path(file_okay=False, path_type=Path),
-    help="Run directory to write results into (created if missing).",
+    help="Run directory to write (created if missing). Default: runs/NAME-YYYYmmdd-HHMMSS.",
 )
 @click.option("--seed", type=click.IntRange(min=0), help="Seed for this run; replaces world.seed.")
 @click.option(
@@ -134,31 +135,51 @@ def validate_command(files: tuple[Path, ...]) -> None:
 def run_command(
     scenario: Path | None, out: Path | None, seed: int | None, overrides: tuple[str, ...]
 ) -> None:
-    """Run SCENARIO (default: the scenario shipped with dcsim).
+    """Run SCENARIO (default: the scenario shipped with dcsim) and record it.
 
-    The scenario is validated, its overrides applied, and its plugins constructed with
-    their validated parameters. This version stops there: it prints the resolved
-    scenario and the plugins of each role, and writes the resolved scenario to
-    OUT/scenario.yaml when --out is given. Simulation arrives with the world engine.
+    The scenario is validated (overrides applied first), its plugins constructed with
+    their validated parameters, and the mission flown until every target is delivered,
+    world.duration is reached, or a stop rule ends it. The run directory receives
+    scenario.yaml (resolved, to repeat the run), telemetry.csv, events.jsonl,
+    summary.json and plots/. Exit status: 0 when the run completed or was stopped by a
+    stop rule, 1 when a plugin failed, 130 when interrupted with Ctrl-C.
     """
+    from dcsim.runner import Runner, terminal_progress  # the world engine loads PyBullet
+
     setup = prepare_run(scenario, overrides, seed, registry=_registry())
-    resolved = dump_scenario(setup.scenario)
-    label = str(scenario) if scenario is not None else "default (packaged)"
-    click.echo(f"scenario: {setup.scenario.name} from {label}, seed {setup.scenario.world.seed}")
-    _print_table(
-        ("ROLE", "PLUGIN", "ORIGIN"),
-        [
-            (role, entry.name, f"{entry.origin.distribution} {entry.origin.version}")
-            for role, entry in setup.sources.items()
-        ],
+    if out is None:
+        out = Path("runs") / f"{setup.scenario.name}-{datetime.now():%Y%m%d-%H%M%S}"
+    summary = Runner(setup, out, progress=terminal_progress()).run()
+    if sys.stderr.isatty():
+        click.echo("", err=True)
+    _print_summary(summary, out)
+    if summary["reason"] == "interrupted":
+        sys.exit(130)
+    if summary["status"] == "failed":
+        sys.exit(1)
+
+
+def _print_summary(summary: dict, out: Path) -> None:
+    def number(key: str, unit: str, digits: int = 3) -> str:
+        value = summary[key]
+        return "n/a" if value is None else f"{value:.{digits}g} {unit}".rstrip()
+
+    reason = f" ({summary['reason']})" if summary["reason"] else ""
+    click.echo(f"{summary['scenario']} seed {summary['seed']}: {summary['status']}{reason}")
+    click.echo(
+        f"  delivered {summary['delivered']}/{summary['targets']}, captured {summary['captured']}, "
+        f"collisions {summary['collisions']}"
     )
-    click.echo("--- resolved scenario ---")
-    click.echo(resolved, nl=False)
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "scenario.yaml").write_text(resolved, encoding="utf-8")
-        click.echo(f"wrote {out / 'scenario.yaml'}")
-    click.echo("not simulated: this dcsim version has no world engine yet")
+    click.echo(
+        f"  delta-v {number('delta_v_mps', 'm/s')}, propellant {number('fuel_used_kg', 'kg')}, "
+        f"localisation RMSE {number('localisation_rmse_m', 'm')}, "
+        f"closest obstacle {number('min_obstacle_distance_m', 'm')}"
+    )
+    click.echo(
+        f"  simulated {summary['sim_time_s']:.1f} s in {summary['wall_time_s']:.1f} s of wall time "
+        f"(x{summary['real_time_factor']:.0f} real time)"
+    )
+    click.echo(f"  results in {out}")
 
 
 def main() -> None:

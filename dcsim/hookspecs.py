@@ -2,7 +2,10 @@
 
 A plugin package exposes a module (or a plugin class) through the ``dcsim``
 entry-point group. Modules implement the hooks below, marked with
-:data:`hookimpl`::
+:data:`hookimpl`: :func:`dcsim_plugin_classes` provides plugin classes, and the
+lifecycle hooks :func:`dcsim_run_start`, :func:`dcsim_run_step`,
+:func:`dcsim_run_event` and :func:`dcsim_run_end` let a package observe runs (a
+telemetry writer, a live report)::
 
     from dcsim.api import hookimpl
 
@@ -13,9 +16,17 @@ entry-point group. Modules implement the hooks below, marked with
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
 import pluggy
 
 from dcsim.interfaces import Plugin
+
+if TYPE_CHECKING:
+    from dcsim.scenario.model import Scenario
 
 PROJECT_NAME = "dcsim"
 """The pluggy project name and the entry-point group plugins are found in."""
@@ -23,6 +34,25 @@ PROJECT_NAME = "dcsim"
 hookspec = pluggy.HookspecMarker(PROJECT_NAME)
 hookimpl = pluggy.HookimplMarker(PROJECT_NAME)
 """Decorator marking a function as an implementation of a dcsim hook."""
+
+
+@dataclass(frozen=True)
+class RunInfo:
+    """What lifecycle hooks are told about the run they observe.
+
+    Attributes
+    ----------
+    scenario : Scenario
+        The resolved scenario.
+    seed : int
+        The run's seed.
+    out_dir : Path or None
+        The run directory, or None when the run writes no files.
+    """
+
+    scenario: Scenario
+    seed: int
+    out_dir: Path | None
 
 
 @hookspec
@@ -38,4 +68,56 @@ def dcsim_plugin_classes() -> list[type[Plugin]]:
     -------
     list of type
         The plugin classes; their order does not matter.
+    """
+
+
+@hookspec
+def dcsim_run_start(run: RunInfo) -> None:
+    """Called once before the first control tick of a run.
+
+    Parameters
+    ----------
+    run : RunInfo
+        The run's resolved scenario, seed and output directory.
+    """
+
+
+@hookspec
+def dcsim_run_step(run: RunInfo, row: Mapping[str, Any]) -> None:
+    """Called after every control tick with that tick's telemetry row.
+
+    Parameters
+    ----------
+    run : RunInfo
+        The run.
+    row : mapping
+        Column name to value, as written to ``telemetry.csv`` (true and estimated
+        state, mode, fuel, delta-v, nearest-obstacle distance, command).
+    """
+
+
+@hookspec
+def dcsim_run_event(run: RunInfo, event: Mapping[str, Any]) -> None:
+    """Called for every event (mode change, plan, grab, release, collision...).
+
+    Parameters
+    ----------
+    run : RunInfo
+        The run.
+    event : mapping
+        The event as written to ``events.jsonl``: ``t`` (s), ``event`` (its name)
+        and the event's own fields.
+    """
+
+
+@hookspec
+def dcsim_run_end(run: RunInfo, summary: Mapping[str, Any]) -> None:
+    """Called once when a run ends, however it ends, with its summary.
+
+    Parameters
+    ----------
+    run : RunInfo
+        The run.
+    summary : mapping
+        The content of ``summary.json``.
     """

@@ -36,23 +36,32 @@ def array_field(shape: tuple[int, ...] = (3,), default: ArrayLike | None = None)
     return field(default_factory=lambda: np.array(frozen).reshape(shape), metadata=metadata)
 
 
+_ARRAY_FIELDS: dict[type, tuple[tuple[str, tuple[int, ...]], ...]] = {}
+
+
+def _array_fields(cls: type) -> tuple[tuple[str, tuple[int, ...]], ...]:
+    """Names and shapes of a message class's array fields (cached per class)."""
+    found = _ARRAY_FIELDS.get(cls)
+    if found is None:
+        found = tuple((f.name, f.metadata["shape"]) for f in fields(cls) if "shape" in f.metadata)
+        _ARRAY_FIELDS[cls] = found
+    return found
+
+
 class Message:
     """Base of every message: converts array fields and compares by value."""
 
     def __post_init__(self) -> None:
-        for f in fields(self):  # type: ignore[arg-type]
-            shape = f.metadata.get("shape")
-            if shape is None:
-                continue
-            value = np.array(getattr(self, f.name), dtype=float)
+        for name, shape in _array_fields(type(self)):
+            value = np.array(getattr(self, name), dtype=float)
             if value.ndim != len(shape) or any(
                 want not in (-1, got) for want, got in zip(shape, value.shape, strict=True)
             ):
                 raise ValueError(
-                    f"{type(self).__name__}.{f.name} must have shape {shape}, got {value.shape}"
+                    f"{type(self).__name__}.{name} must have shape {shape}, got {value.shape}"
                 )
             value.setflags(write=False)
-            object.__setattr__(self, f.name, value)
+            object.__setattr__(self, name, value)
 
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):
@@ -267,6 +276,8 @@ class TaskRequest(Message):
         Targets already on board.
     max_speed : float
         Speed limit of the collector, m/s.
+    max_acceleration : float
+        Acceleration the collector can count on, m/s² (``inf`` for impulsive burns).
     time_budget : float
         Wall time the planner may spend, s.
     """
@@ -278,6 +289,7 @@ class TaskRequest(Message):
     capacity: int
     carried: int = 0
     max_speed: float = 1.0
+    max_acceleration: float = float("inf")
     time_budget: float = 1.0
 
 
@@ -434,6 +446,8 @@ class PathProblem(Message):
         Radius of the collector's bounding sphere, m.
     max_speed : float
         Speed limit, m/s.
+    max_acceleration : float
+        Acceleration the collector can count on, m/s² (``inf`` for impulsive burns).
     max_delta_v : float
         Largest total delta-v the path may use, m/s (``inf`` for none).
     bounds : Bounds or None
@@ -449,6 +463,7 @@ class PathProblem(Message):
     obstacles: tuple[ObjectTrack, ...] = ()
     robot_radius: float = 0.0
     max_speed: float = 1.0
+    max_acceleration: float = float("inf")
     max_delta_v: float = float("inf")
     bounds: Bounds | None = None
     weights: CostWeights = field(default_factory=CostWeights)
@@ -457,7 +472,7 @@ class PathProblem(Message):
 
 @_message
 class Trajectory(Message):
-    """A time-stamped reference trajectory, linear between samples.
+    """A time-stamped reference trajectory, position and velocity linear between samples.
 
     Attributes
     ----------
@@ -484,8 +499,8 @@ class Trajectory(Message):
     def sample(self, t: float) -> tuple[Vector, Vector]:
         """Reference ``(position, velocity)`` at time ``t`` (s), held at the ends."""
         position = np.array([np.interp(t, self.times, self.positions[:, k]) for k in range(3)])
-        i = int(np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, len(self.times) - 1))
-        return position, self.velocities[i].copy()
+        velocity = np.array([np.interp(t, self.times, self.velocities[:, k]) for k in range(3)])
+        return position, velocity
 
 
 @_message

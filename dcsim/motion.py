@@ -12,12 +12,14 @@ shape ``(..., 3)``.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from dcsim.geometry import Vector, spherical_to_cartesian
+from dcsim.geometry import Vector
 
 STANDARD_GRAVITATIONAL_PARAMETER_EARTH = 3.986004418e14
 """Earth's gravitational parameter μ, m³/s²."""
@@ -58,6 +60,44 @@ class MotionModel(ABC):
         """Return the position (m) at time(s) ``t`` (s)."""
         return self.state_at(t)[0]
 
+    @classmethod
+    def batch_state(cls, models: Sequence[MotionModel], t: float) -> tuple[Vector, Vector]:
+        """Positions and velocities of many models of this class at one time ``t`` (s).
+
+        Subclasses vectorise this over their parameters; the default evaluates the
+        models one by one.
+
+        Returns
+        -------
+        positions, velocities : ndarray, shape (N, 3)
+        """
+        states = [m.state_at(t) for m in models]
+        return np.array([p for p, _ in states]), np.array([v for _, v in states])
+
+
+def batch_states(models: Sequence[MotionModel], t: float) -> tuple[Vector, Vector]:
+    """Positions and velocities of any mix of motion models at time ``t`` (s).
+
+    Models are grouped by class and each group is evaluated in one vectorised call.
+
+    Returns
+    -------
+    positions, velocities : ndarray, shape (N, 3)
+        In the order of ``models``.
+    """
+    positions = np.zeros((len(models), 3))
+    velocities = np.zeros((len(models), 3))
+    groups: dict[type[MotionModel], list[int]] = {}
+    for index, model in enumerate(models):
+        groups.setdefault(type(model), []).append(index)
+    for cls, indices in groups.items():
+        positions[indices], velocities[indices] = cls.batch_state([models[i] for i in indices], t)
+    return positions, velocities
+
+
+def _stack(models: Sequence[Any], name: str) -> np.ndarray:
+    return np.array([getattr(m, name) for m in models], dtype=float)
+
 
 def _vec3(values: ArrayLike) -> tuple[float, float, float]:
     x, y, z = (float(v) for v in np.asarray(values, dtype=float).reshape(3))
@@ -77,6 +117,12 @@ class StaticMotion(MotionModel):
         """Return the fixed position and zero velocity at time(s) ``t``."""
         shape = np.shape(t) + (3,)
         return np.broadcast_to(np.array(self.position), shape).copy(), np.zeros(shape)
+
+    @classmethod
+    def batch_state(cls, models: Sequence[MotionModel], t: float) -> tuple[Vector, Vector]:
+        """Fixed positions and zero velocities of ``models``."""
+        positions = _stack(models, "position")
+        return positions, np.zeros_like(positions)
 
 
 @dataclass(frozen=True)
@@ -103,9 +149,20 @@ class LinearMotion(MotionModel):
 
     def state_at(self, t: ArrayLike) -> tuple[Vector, Vector]:
         """Return position and velocity at time(s) ``t``."""
-        dt = np.asarray(t, dtype=float)[..., None] - self.epoch
-        v = np.array(self.velocity)
-        return np.array(self.position) + v * dt, np.broadcast_to(v, dt.shape[:-1] + (3,)).copy()
+        tau = np.asarray(t, dtype=float) - self.epoch
+        return _linear_state(np.array(self.position), np.array(self.velocity), tau)
+
+    @classmethod
+    def batch_state(cls, models: Sequence[MotionModel], t: float) -> tuple[Vector, Vector]:
+        """Vectorised :meth:`state_at` of many linear motions at time ``t``."""
+        tau = t - _stack(models, "epoch")
+        return _linear_state(_stack(models, "position"), _stack(models, "velocity"), tau)
+
+
+def _linear_state(p0: np.ndarray, v0: np.ndarray, tau: np.ndarray) -> tuple[Vector, Vector]:
+    """``p0 + v0 τ``; ``p0``, ``v0`` of shape (3,) or (N, 3), τ broadcastable to (...)."""
+    tau = np.asarray(tau)[..., None]
+    return p0 + v0 * tau, np.broadcast_to(v0, np.broadcast_shapes(np.shape(p0), tau.shape)).copy()
 
 
 @dataclass(frozen=True)
@@ -140,22 +197,42 @@ class SphericalMotion(MotionModel):
     def state_at(self, t: ArrayLike) -> tuple[Vector, Vector]:
         """Return position and velocity at time(s) ``t``, from the exact derivative."""
         tau = np.asarray(t, dtype=float) - self.epoch
-        r = self.r + self.v * tau
-        theta = np.radians(self.polar_deg + self.alpha_deg_s * tau)
-        phi = np.radians(self.azimuth_deg + self.beta_deg_s * tau)
-        position = spherical_to_cartesian(r, np.degrees(theta), np.degrees(phi))
-        st, ct, sp, cp = np.sin(theta), np.cos(theta), np.sin(phi), np.cos(phi)
-        e_r = np.stack([st * cp, st * sp, ct], axis=-1)
-        e_theta = np.stack([ct * cp, ct * sp, -st], axis=-1)
-        e_phi = np.stack([-sp, cp, np.zeros_like(sp)], axis=-1)
-        theta_dot = np.radians(self.alpha_deg_s)
-        phi_dot = np.radians(self.beta_deg_s)
-        velocity = (
-            self.v * e_r
-            + (r * theta_dot)[..., None] * e_theta
-            + (r * st * phi_dot)[..., None] * e_phi
-        )
-        return position, velocity
+        return _spherical_state(*(getattr(self, n) for n in _SPHERICAL_PARAMETERS), tau)
+
+    @classmethod
+    def batch_state(cls, models: Sequence[MotionModel], t: float) -> tuple[Vector, Vector]:
+        """Vectorised :meth:`state_at` of many spherical motions at time ``t``."""
+        tau = t - _stack(models, "epoch")
+        return _spherical_state(*(_stack(models, n) for n in _SPHERICAL_PARAMETERS), tau)
+
+
+_SPHERICAL_PARAMETERS = ("r", "polar_deg", "azimuth_deg", "v", "alpha_deg_s", "beta_deg_s")
+
+
+def _spherical_state(
+    r0: ArrayLike,
+    polar_deg: ArrayLike,
+    azimuth_deg: ArrayLike,
+    v: ArrayLike,
+    alpha_deg_s: ArrayLike,
+    beta_deg_s: ArrayLike,
+    tau: np.ndarray,
+) -> tuple[Vector, Vector]:
+    """Eq. 2.1 and its time derivative; parameters broadcast against ``tau``."""
+    r = r0 + np.multiply(v, tau)
+    theta = np.radians(polar_deg + np.multiply(alpha_deg_s, tau))
+    phi = np.radians(azimuth_deg + np.multiply(beta_deg_s, tau))
+    st, ct, sp, cp = np.sin(theta), np.cos(theta), np.sin(phi), np.cos(phi)
+    e_r = np.stack([st * cp, st * sp, ct], axis=-1)
+    e_theta = np.stack([ct * cp, ct * sp, -st], axis=-1)
+    e_phi = np.stack([-sp, cp, np.zeros_like(sp)], axis=-1)
+    speed_r = np.broadcast_to(v, np.shape(r))
+    speed_theta = r * np.radians(alpha_deg_s)
+    speed_phi = r * st * np.radians(beta_deg_s)
+    velocity = (
+        speed_r[..., None] * e_r + speed_theta[..., None] * e_theta + speed_phi[..., None] * e_phi
+    )
+    return r[..., None] * e_r, velocity
 
 
 @dataclass(frozen=True)
@@ -188,15 +265,27 @@ class ClohessyWiltshireMotion(MotionModel):
 
     def state_at(self, t: ArrayLike) -> tuple[Vector, Vector]:
         """Return the exact relative position and velocity at time(s) ``t``."""
-        n = self.mean_motion
-        nt = n * (np.asarray(t, dtype=float) - self.epoch)
-        s, c = np.sin(nt), np.cos(nt)
-        x0, y0, z0 = self.position
-        u0, v0, w0 = self.velocity
-        x = (4 - 3 * c) * x0 + s / n * u0 + 2 / n * (1 - c) * v0
-        y = 6 * (s - nt) * x0 + y0 - 2 / n * (1 - c) * u0 + (4 * s - 3 * nt) / n * v0
-        z = c * z0 + s / n * w0
-        vx = 3 * n * s * x0 + c * u0 + 2 * s * v0
-        vy = -6 * n * (1 - c) * x0 - 2 * s * u0 + (4 * c - 3) * v0
-        vz = -n * s * z0 + c * w0
-        return np.stack([x, y, z], axis=-1), np.stack([vx, vy, vz], axis=-1)
+        tau = np.asarray(t, dtype=float) - self.epoch
+        return _cw_state(self.position, self.velocity, self.mean_motion, tau)
+
+    @classmethod
+    def batch_state(cls, models: Sequence[MotionModel], t: float) -> tuple[Vector, Vector]:
+        """Vectorised :meth:`state_at` of many Clohessy–Wiltshire motions at time ``t``."""
+        tau = t - _stack(models, "epoch")
+        n = _stack(models, "mean_motion")
+        return _cw_state(_stack(models, "position").T, _stack(models, "velocity").T, n, tau)
+
+
+def _cw_state(p0: ArrayLike, v0: ArrayLike, n: ArrayLike, tau: np.ndarray) -> tuple[Vector, Vector]:
+    """The Clohessy–Wiltshire closed form; components of ``p0``, ``v0`` broadcast with τ."""
+    nt = np.multiply(n, tau)
+    s, c = np.sin(nt), np.cos(nt)
+    x0, y0, z0 = p0
+    u0, v0, w0 = v0
+    x = (4 - 3 * c) * x0 + s / n * u0 + 2 / n * (1 - c) * v0
+    y = 6 * (s - nt) * x0 + y0 - 2 / n * (1 - c) * u0 + (4 * s - 3 * nt) / n * v0
+    z = c * z0 + s / n * w0
+    vx = 3 * n * s * x0 + c * u0 + 2 * s * v0
+    vy = -6 * n * (1 - c) * x0 - 2 * s * u0 + (4 * c - 3) * v0
+    vz = -n * s * z0 + c * w0
+    return np.stack([x, y, z], axis=-1), np.stack([vx, vy, vz], axis=-1)

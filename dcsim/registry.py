@@ -242,6 +242,11 @@ class PluginRegistry:
         self.warnings.append(message)
         warnings.warn(message, PluginLoadWarning, stacklevel=3)
 
+    @property
+    def hook(self) -> pluggy.HookRelay:
+        """The pluggy hook relay: ``registry.hook.dcsim_run_event(run=..., event=...)``."""
+        return self._manager.hook
+
     def plugins(self, kind: str | None = None) -> list[RegisteredPlugin]:
         """All registered plugins (of ``kind``, if given), ordered by kind then name."""
         order = list(PLUGIN_KINDS)

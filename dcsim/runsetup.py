@@ -25,11 +25,14 @@ class RunSetup:
         ``path_planner``, ``controller``), each with its own random generator.
     sources : dict of str to RegisteredPlugin
         Where each role's plugin came from.
+    registry : PluginRegistry
+        The registry the plugins came from (its hooks observe the run).
     """
 
     scenario: Scenario
     plugins: dict[str, Plugin]
     sources: dict[str, RegisteredPlugin]
+    registry: PluginRegistry
 
     def plugin_versions(self) -> dict[str, dict[str, str]]:
         """Name, distribution and version of each role's plugin (for run summaries)."""
@@ -81,4 +84,4 @@ def prepare_run(
         role: entry.cls(getattr(scenario, role).params, component_rng(scenario.world.seed, role))
         for role, entry in sources.items()
     }
-    return RunSetup(scenario, plugins, sources)
+    return RunSetup(scenario, plugins, sources, registry)

@@ -1,9 +1,12 @@
 """``nearest`` task planner: greedily pick the target that can be reached soonest.
 
 From the collector's estimated position the planner computes, for every remaining
-target, the earliest time it can be intercepted flying a straight line at the planning
-speed, and takes the soonest. When the collector is full it first visits the drop point
-(also at its earliest reachable time). Pickup times are spaced by at least
+target, the earliest time it can be intercepted, and takes the soonest. Interception
+means flying straight at the target in the frame moving with the target's velocity at
+pickup, from rest to rest in that frame with the request's acceleration limit and a
+cruise speed of ``speed_fraction`` of the speed limit less the target's speed (the
+profile the ``straight-line`` path planner flies). When the collector is full it first
+visits the drop point (also at its earliest reachable time). Pickup times are spaced by at least
 ``min_time_step``. Targets that cannot be reached within ``horizon`` are left out.
 The plan's cost is its impulsive delta-v (:func:`dcsim.api.plan_delta_v`).
 """
@@ -24,6 +27,7 @@ from dcsim.api import (
     hookimpl,
     plan_delta_v,
     quantity,
+    rest_to_rest_time,
 )
 
 Predictor = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
@@ -50,15 +54,19 @@ def earliest_intercept(
     t0: float,
     p0: np.ndarray,
     speed: float,
+    acceleration: float,
     predict: Predictor,
     t_min: float,
     horizon: float,
     resolution: float,
 ) -> float | None:
-    """Earliest time ``t ≥ t_min`` at which a mover is reachable from ``p0`` at ``speed``.
+    """Earliest time ``t ≥ t_min`` at which a mover can be met from ``p0`` (at rest at ``t0``).
 
-    Reachable means ``|x(t) − p0| ≤ speed (t − t0)``. The condition is scanned on a
-    grid of step ``resolution`` up to ``t0 + horizon`` and refined by bisection.
+    The mover at ``x(t)`` with velocity ``u(t)`` can be met at ``t`` when the rest-to-rest
+    time over ``|x(t) − u(t)(t − t0) − p0|`` (the distance in its moving frame), at
+    cruise speed ``speed − |u(t)|`` and ``acceleration``, fits in ``t − t0``. The
+    condition is scanned on a grid of step ``resolution`` up to ``t0 + horizon`` and
+    refined by bisection.
 
     Returns
     -------
@@ -67,7 +75,14 @@ def earliest_intercept(
     """
 
     def slack(t: np.ndarray) -> np.ndarray:
-        return speed * (t - t0) - np.linalg.norm(predict(t)[0] - p0, axis=-1)
+        position, velocity = predict(t)
+        elapsed = t - t0
+        distance = np.linalg.norm(
+            position - velocity * np.asarray(elapsed)[..., None] - p0, axis=-1
+        )
+        cruise = speed - np.linalg.norm(velocity, axis=-1)
+        needed = rest_to_rest_time(distance, np.maximum(cruise, 1e-12), acceleration)
+        return elapsed - np.where(cruise > 0, needed, np.inf)
 
     grid = np.arange(t_min, t0 + horizon + resolution, resolution)
     ok = np.flatnonzero(slack(grid) >= 0)
@@ -104,7 +119,14 @@ class NearestTaskPlanner(TaskPlanner):
 
         def search(predict: Predictor, after: float) -> float | None:
             return earliest_intercept(
-                t, position, speed, predict, after, request.time + p.horizon - t, p.time_resolution
+                t,
+                position,
+                speed,
+                request.max_acceleration,
+                predict,
+                after,
+                request.time + p.horizon - t,
+                p.time_resolution,
             )
 
         def visit_drop() -> bool:

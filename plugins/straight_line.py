@@ -1,11 +1,14 @@
 """``straight-line`` path planner: the direct segment, if it is safe.
 
-The collector flies the segment from the start to the goal centre at constant velocity:
-at the goal's required time if one is given, otherwise at ``speed_fraction`` of the speed
-limit. The segment is checked against every obstacle's predicted motion at a spacing of
-``check_spacing``; if it passes closer than the two radii plus ``clearance`` the answer is
-"no path", naming the obstacle and the time. This is the yardstick the real planners are
-compared with.
+The collector flies straight at the goal in the frame that moves with the goal's
+velocity (for a goal at rest, a straight line in space), with a trapezoidal speed
+profile: it accelerates at ``max_acceleration``, cruises, and brakes to arrive at rest
+relative to the goal, that is, matching the goal's velocity. It arrives at the goal's
+required time if one is given, otherwise as soon as a cruise speed of
+``speed_fraction`` of the speed limit allows. The path is checked against every
+obstacle's predicted motion every ``check_spacing`` metres; if it passes closer than
+the two radii plus ``clearance`` the answer is "no path", naming the obstacle and the
+time. This is the yardstick the real planners are compared with.
 """
 
 from __future__ import annotations
@@ -18,11 +21,14 @@ from dcsim.api import (
     PathProblem,
     PluginParams,
     Trajectory,
+    cruise_speed,
     hookimpl,
     quantity,
+    rest_to_rest_time,
 )
 
 _MIN_DURATION = 1e-3  # s; a zero-length path still spans a positive time
+_RAMP_SAMPLES = 12  # trajectory samples per acceleration ramp
 
 
 class StraightLineParams(PluginParams):
@@ -38,78 +44,140 @@ class StraightLineParams(PluginParams):
         0.5, unit="m", ge=0, description="Margin kept beyond the sum of robot and obstacle radii."
     )
     check_spacing: float = quantity(
-        0.25, unit="m", gt=0, description="Distance between collision checks along the segment."
+        0.25, unit="m", gt=0, description="Distance between collision checks along the path."
     )
 
 
+class _Profile:
+    """Trapezoidal distance ``s(τ)`` over ``[0, T]``: ramps at ``a``, cruise at ``v``."""
+
+    def __init__(self, length: float, duration: float, speed: float, acceleration: float) -> None:
+        self.length, self.duration, self.speed = length, duration, speed
+        self.acceleration = acceleration
+        self.ramp = 0.0 if np.isinf(acceleration) else min(speed / acceleration, duration / 2)
+
+    def __call__(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Distance (m) and speed (m/s) along the path at times ``tau`` since the start."""
+        if self.ramp == 0.0:
+            return self.speed * tau, np.full_like(tau, self.speed)
+        a, r, T, v = self.acceleration, self.ramp, self.duration, self.speed
+        rising, falling = tau < r, tau > T - r
+        distance = np.where(
+            rising,
+            0.5 * a * tau**2,
+            np.where(
+                falling, self.length - 0.5 * a * (T - tau) ** 2, 0.5 * a * r**2 + v * (tau - r)
+            ),
+        )
+        speed = np.where(rising, a * tau, np.where(falling, a * (T - tau), v))
+        return distance, speed
+
+    def sample_times(self) -> np.ndarray:
+        """Times that resolve the ramps, for the trajectory's samples."""
+        ramps = [
+            np.linspace(0, self.ramp, _RAMP_SAMPLES),
+            np.linspace(self.duration - self.ramp, self.duration, _RAMP_SAMPLES),
+        ]
+        return np.unique(np.concatenate([[0.0, self.duration], *ramps]))
+
+
 class StraightLinePlanner(PathPlanner):
-    """Direct constant-velocity segment, rejected if it meets a predicted obstacle."""
+    """Straight at the goal (in the goal's moving frame), trapezoidal speed, obstacle-checked."""
 
     name = "straight-line"
     summary = (
-        "Direct segment at a speed limit; no path if it crosses a predicted obstacle (baseline)"
+        "Direct path with a trapezoidal speed profile; "
+        "no path if it meets a predicted obstacle (baseline)"
     )
     Params = StraightLineParams
     params: StraightLineParams
 
     def plan(self, problem: PathProblem) -> Trajectory | NoPath:
-        """Return the straight segment to the goal, or why it cannot be flown."""
+        """Return the straight path to the goal, or why it cannot be flown."""
         start, goal = problem.start, problem.goal
-        offset = goal.position - start.position
-        distance = float(np.linalg.norm(offset))
+        goal_speed = float(np.linalg.norm(goal.velocity))
+        headroom = problem.max_speed - goal_speed
+        if headroom <= 0:
+            return NoPath(
+                f"the goal moves at {goal_speed:.3g} m/s, "
+                f"at or above the {problem.max_speed:g} m/s limit"
+            )
+        profile = self._profile(problem, headroom)
+        if isinstance(profile, NoPath):
+            return profile
+        offset = goal.position - goal.velocity * profile.duration - start.position
+        direction = offset / profile.length if profile.length > 0 else np.zeros(3)
+
+        def states(tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            distance, speed = profile(tau)
+            positions = (
+                start.position + np.outer(tau, goal.velocity) + np.outer(distance, direction)
+            )
+            return positions, goal.velocity + np.outer(speed, direction)
+
+        spacing = self.params.check_spacing
+        count = int(np.ceil((profile.length + goal_speed * profile.duration) / spacing)) + 2
+        fine_tau = np.linspace(0.0, profile.duration, count)
+        fine_positions, _ = states(fine_tau)
+        if problem.bounds is not None and not problem.bounds.contains(fine_positions).all():
+            return NoPath("the path leaves the bounds")
+        delta_v = float(np.linalg.norm(goal.velocity - start.velocity)) + 2.0 * profile.speed
+        if delta_v > problem.max_delta_v:
+            return NoPath(
+                f"the path needs {delta_v:.3g} m/s of delta-v, above {problem.max_delta_v:g}"
+            )
+        blocked = self._first_conflict(problem, start.time + fine_tau, fine_positions)
+        if blocked is not None:
+            return blocked
+        tau = profile.sample_times()
+        positions, velocities = states(tau)
+        return Trajectory(
+            times=start.time + tau,
+            positions=positions,
+            velocities=velocities,
+            delta_v=delta_v,
+            length=float(np.linalg.norm(np.diff(fine_positions, axis=0), axis=1).sum()),
+            duration=profile.duration,
+        )
+
+    def _profile(self, problem: PathProblem, headroom: float) -> _Profile | NoPath:
+        """The speed profile in the goal's frame: length, duration, cruise speed."""
+        start, goal = problem.start, problem.goal
+        accel = problem.max_acceleration
         if goal.time is not None:
             duration = goal.time - start.time
             if duration <= 0:
                 return NoPath(
                     f"the goal time {goal.time:g} s is not after the start {start.time:g} s"
                 )
-        else:
-            duration = distance / (self.params.speed_fraction * problem.max_speed)
-        duration = max(duration, _MIN_DURATION)
-        velocity = offset / duration
-        speed = distance / duration
-        if speed > problem.max_speed * (1 + 1e-9):
-            return NoPath(
-                f"reaching the goal by t = {goal.time:g} s needs {speed:.3g} m/s, "
-                f"above the {problem.max_speed:g} m/s limit"
+            length = float(
+                np.linalg.norm(goal.position - goal.velocity * duration - start.position)
             )
-        if (
-            problem.bounds is not None
-            and not problem.bounds.contains([start.position, goal.position]).all()
-        ):
-            return NoPath("the start or the goal lies outside the bounds")
-        delta_v = float(
-            np.linalg.norm(velocity - start.velocity) + np.linalg.norm(goal.velocity - velocity)
-        )
-        if delta_v > problem.max_delta_v:
-            return NoPath(
-                f"the segment needs {delta_v:.3g} m/s of delta-v, above {problem.max_delta_v:g}"
+            speed = cruise_speed(length, duration, accel)
+            if not speed <= headroom * (1 + 1e-9):
+                needed = rest_to_rest_time(length, headroom, accel)
+                return NoPath(
+                    f"reaching the goal by t = {goal.time:g} s needs {float(needed):.4g} s at the "
+                    f"speed and acceleration limits, only {duration:.4g} s are left"
+                )
+            return _Profile(length, max(duration, _MIN_DURATION), speed, accel)
+        limit = self.params.speed_fraction * headroom
+        duration = 0.0
+        for _ in range(50):  # the goal's own motion during the flight moves the aim point
+            length = float(
+                np.linalg.norm(goal.position - goal.velocity * duration - start.position)
             )
-        t1 = start.time + duration
-        blocked = self._first_conflict(problem, start.time, t1, start.position, velocity, distance)
-        if blocked is not None:
-            return blocked
-        return Trajectory(
-            times=[start.time, t1],
-            positions=[start.position, start.position + velocity * duration],
-            velocities=[velocity, goal.velocity],
-            delta_v=delta_v,
-            length=distance,
-            duration=duration,
-        )
+            updated = float(rest_to_rest_time(length, limit, accel))
+            converged = abs(updated - duration) < 1e-9
+            duration = updated
+            if converged:
+                break
+        speed = limit if np.isinf(accel) else min(limit, float(np.sqrt(accel * length)))
+        return _Profile(length, max(duration, _MIN_DURATION), speed, accel)
 
     def _first_conflict(
-        self,
-        problem: PathProblem,
-        t0: float,
-        t1: float,
-        p0: np.ndarray,
-        velocity: np.ndarray,
-        distance: float,
+        self, problem: PathProblem, times: np.ndarray, path: np.ndarray
     ) -> NoPath | None:
-        samples = int(np.ceil(distance / self.params.check_spacing)) + 2
-        times = np.linspace(t0, t1, samples)
-        path = p0 + velocity * (times - t0)[:, None]
         for obstacle in problem.obstacles:
             gaps = np.linalg.norm(obstacle.predict(times)[0] - path, axis=1)
             needed = problem.robot_radius + obstacle.radius + self.params.clearance
@@ -117,7 +185,7 @@ class StraightLinePlanner(PathPlanner):
             if hits.size:
                 k = int(hits[0])
                 return NoPath(
-                    f"the straight segment passes {gaps[k]:.2f} m from obstacle {obstacle.id} "
+                    f"the straight path passes {gaps[k]:.2f} m from obstacle {obstacle.id} "
                     f"at t = {times[k]:.1f} s (needs {needed:.2f} m)"
                 )
         return None

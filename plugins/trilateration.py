@@ -1,10 +1,12 @@
-"""``trilateration`` localiser: a nonlinear least-squares fix on beacon ranges.
+"""``trilateration`` localiser: least-squares fixes on beacon ranges, smoothed by an α-β filter.
 
 Each update solves ``min_p Σ_i (|p − b_i| − ρ_i)²`` with scipy's ``least_squares``,
 started from the predicted position, so that of the two mirror solutions three beacons
-allow, the one nearer the current belief is chosen. Between fixes the estimate is
-dead-reckoned with the commanded acceleration. The velocity is smoothed from
-successive fixes. This is the yardstick the filters are compared with.
+allow, the one nearer the current belief is chosen. The first fix is taken as it is;
+later fixes correct the dead-reckoned prediction (commanded acceleration included) by
+fixed gains: ``p += α r`` and ``v += β r / Δt`` with ``r`` the fix minus the prediction
+(an α-β tracker). The reported covariance is the filter's steady-state covariance for
+the fix's own covariance. This is the yardstick the filters are compared with.
 """
 
 from __future__ import annotations
@@ -31,8 +33,14 @@ class TrilaterationParams(PluginParams):
     """Parameters of :class:`TrilaterationLocaliser`."""
 
     min_beacons: int = quantity(3, ge=3, description="Fewest ranges a fix is computed from.")
+    position_gain: float = quantity(
+        0.2, gt=0, le=1, description="Fraction α of the fix-minus-prediction added to the position."
+    )
     velocity_gain: float = quantity(
-        0.5, gt=0, le=1, description="Weight of a new fix-to-fix velocity against the prediction."
+        0.02,
+        gt=0,
+        lt=1,
+        description="Fraction β of the fix-minus-prediction rate added to the velocity.",
     )
     max_residual: float = quantity(
         5.0, unit="m", gt=0, description="RMS range residual above which a fix is rejected."
@@ -40,10 +48,10 @@ class TrilaterationParams(PluginParams):
 
 
 class TrilaterationLocaliser(Localiser):
-    """Position fixes from beacon ranges by nonlinear least squares (scipy)."""
+    """Position fixes from beacon ranges by nonlinear least squares (scipy), α-β smoothed."""
 
     name = "trilateration"
-    summary = "Nonlinear least-squares position fix on beacon ranges (baseline)"
+    summary = "Least-squares position fixes on beacon ranges, alpha-beta smoothed (baseline)"
     Params = TrilaterationParams
     params: TrilaterationParams
 
@@ -52,64 +60,82 @@ class TrilaterationLocaliser(Localiser):
         self._time = time
         self._position = np.array(prior.position, dtype=float)
         self._velocity = np.array(prior.velocity, dtype=float)
-        self._position_var = np.full(3, prior.position_sigma**2)
-        self._velocity_var = np.full(3, prior.velocity_sigma**2)
+        self._variance = np.concatenate(
+            [np.full(3, prior.position_sigma**2), np.full(3, prior.velocity_sigma**2)]
+        )
         self._heading = unit(self._velocity)
-        self._converged = False
-        self._last_fix: tuple[float, np.ndarray] | None = None
+        self._last_fix_time: float | None = None
 
     def predict(self, motion: MotionInput, dt: float) -> None:
         """Dead-reckon with the commanded acceleration over ``dt`` seconds."""
         a = np.asarray(motion.acceleration)
         self._position = self._position + self._velocity * dt + 0.5 * a * dt**2
         self._velocity = self._velocity + a * dt
-        self._position_var = self._position_var + self._velocity_var * dt**2
+        if self._last_fix_time is None:
+            self._variance[:3] += self._variance[3:] * dt**2
         self._time += dt
 
     def update(self, ranges: Sequence[BeaconRange]) -> None:
-        """Fix the position when at least ``min_beacons`` ranges are in view."""
-        if len(ranges) < self.params.min_beacons:
+        """Correct with a fix when at least ``min_beacons`` ranges are in view."""
+        fix = self._fix(ranges)
+        if fix is None:
             return
+        position, fix_variance = fix
+        if self._last_fix_time is None:
+            self._position = position
+            self._variance[:3] = fix_variance
+        elif self._time > self._last_fix_time:
+            elapsed = self._time - self._last_fix_time
+            residual = position - self._position
+            alpha, beta = self.params.position_gain, self.params.velocity_gain
+            self._position = self._position + alpha * residual
+            self._velocity = self._velocity + beta * residual / elapsed
+            self._variance = _steady_state_variance(fix_variance, alpha, beta, elapsed)
+        self._last_fix_time = self._time
+        self._heading = unit(self._velocity, fallback=self._heading)
+
+    def _fix(self, ranges: Sequence[BeaconRange]) -> tuple[np.ndarray, np.ndarray] | None:
+        """Least-squares position and its per-axis variance, or None if not trustworthy."""
+        if len(ranges) < self.params.min_beacons:
+            return None
         beacons = np.array([r.beacon_position for r in ranges])
         measured = np.array([r.range for r in ranges])
         sigma = max(max(r.sigma for r in ranges), 1e-6)
         fit = least_squares(
-            lambda p: np.linalg.norm(beacons - p, axis=1) - measured, self._position, method="lm"
+            lambda p: np.linalg.norm(beacons - p, axis=1) - measured,
+            self._position,
+            jac=lambda p: (p - beacons) / np.linalg.norm(beacons - p, axis=1)[:, None],
+            method="lm",
         )
         rms = float(np.sqrt(np.mean(fit.fun**2)))
         if not fit.success or rms > self.params.max_residual:
-            return
-        fix = fit.x
-        if self._last_fix is not None and self._time > self._last_fix[0]:
-            fix_velocity = (fix - self._last_fix[1]) / (self._time - self._last_fix[0])
-            g = self.params.velocity_gain
-            self._velocity = (1 - g) * self._velocity + g * fix_velocity
-        self._last_fix = (self._time, fix)
-        self._position = fix
-        self._position_var = self._fix_variance(fit.jac, sigma)
-        self._heading = unit(self._velocity, fallback=self._heading)
-        self._converged = True
-
-    @staticmethod
-    def _fix_variance(jacobian: np.ndarray, sigma: float) -> np.ndarray:
-        information = jacobian.T @ jacobian
+            return None
         try:
-            return np.diag(np.linalg.inv(information)) * sigma**2
+            variance = np.diag(np.linalg.inv(fit.jac.T @ fit.jac)) * sigma**2
         except np.linalg.LinAlgError:
-            return np.full(3, np.inf)
+            return None
+        return fit.x, variance
 
     def estimate(self) -> LocationEstimate:
-        """The latest fix (or dead-reckoned position) with a diagonal covariance."""
-        variances = np.concatenate([self._position_var, self._velocity_var])
-        covariance = np.diag(np.minimum(variances, 1e12))
+        """The filtered position and velocity with a diagonal covariance."""
         return LocationEstimate(
             time=self._time,
             position=self._position,
             velocity=self._velocity,
             heading=self._heading,
-            covariance=covariance,
-            converged=self._converged,
+            covariance=np.diag(np.minimum(self._variance, 1e12)),
+            converged=self._last_fix_time is not None,
         )
+
+
+def _steady_state_variance(
+    fix_variance: np.ndarray, alpha: float, beta: float, dt: float
+) -> np.ndarray:
+    """Steady-state position and velocity variances of an α-β tracker on noisy fixes."""
+    denominator = alpha * (4.0 - 2.0 * alpha - beta)
+    position = fix_variance * (2.0 * alpha**2 + beta * (2.0 - 3.0 * alpha)) / denominator
+    velocity = fix_variance * 2.0 * beta**2 / (denominator * dt**2)
+    return np.concatenate([position, velocity])
 
 
 @hookimpl

@@ -93,16 +93,20 @@ def test_validate_reports_each_problem_with_line_and_path(dcsim_cli, tmp_path):
     assert "Traceback" not in result.stderr
 
 
-def test_run_default_prints_resolved_scenario_and_plugins(dcsim_cli):
-    result = dcsim_cli("run")
+def test_run_default_writes_a_run_directory_and_prints_a_summary(dcsim_cli, tmp_path):
+    result = dcsim_cli("run", "--set", "world.duration=3")
     assert result.returncode == 0, result.stderr
-    assert "scenario: default" in result.stdout
-    for role, plugin in [("localiser", "trilateration"), ("controller", "pd")]:
-        assert any(line.split()[:2] == [role, plugin] for line in result.stdout.splitlines())
-    resolved = yaml.safe_load(
-        result.stdout.split("--- resolved scenario ---\n", 1)[1].rsplit("not simulated", 1)[0]
-    )
+    assert result.stdout.startswith("default seed 0: completed (duration reached)")
+    (run_dir,) = (tmp_path / "runs").glob("default-*")
+    assert f"results in runs/{run_dir.name}" in result.stdout
+    names = {p.name for p in run_dir.iterdir()}
+    assert {"scenario.yaml", "telemetry.csv", "events.jsonl", "summary.json", "plots"} <= names
+    resolved = yaml.safe_load((run_dir / "scenario.yaml").read_text())
     assert resolved["controller"]["params"]["bandwidth"] > 0  # defaults filled in
+    summary = json.loads((run_dir / "summary.json").read_text())
+    assert summary["plugins"]["localiser"]["name"] == "trilateration"
+    assert summary["sim_time_s"] == pytest.approx(3.0)
+    assert result.stderr == ""  # no progress bar when piped, no PyBullet banner
 
 
 def test_run_writes_resolved_scenario_with_seed_and_overrides(dcsim_cli, tmp_path):
@@ -118,6 +122,8 @@ def test_run_writes_resolved_scenario_with_seed_and_overrides(dcsim_cli, tmp_pat
         "robot.max_force=123.5",
         "--set",
         "controller.params.damping=1.2",
+        "--set",
+        "world.duration=2",
     )
     assert result.returncode == 0, result.stderr
     written = yaml.safe_load((out / "scenario.yaml").read_text())

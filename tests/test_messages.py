@@ -83,11 +83,11 @@ def test_move_command_converts_to_a_force_within_the_limit():
 
 def test_trajectory_samples_linearly_and_holds_at_the_ends():
     trajectory = Trajectory(
-        times=[0, 10], positions=[[0, 0, 0], [10, 0, 0]], velocities=[[1, 0, 0], [0, 0, 0]]
+        times=[0, 10], positions=[[0, 0, 0], [10, 0, 0]], velocities=[[2, 0, 0], [0, 0, 0]]
     )
     position, velocity = trajectory.sample(2.5)
     np.testing.assert_allclose(position, [2.5, 0, 0])
-    np.testing.assert_allclose(velocity, [1, 0, 0])
+    np.testing.assert_allclose(velocity, [1.5, 0, 0])
     position, velocity = trajectory.sample(20.0)
     np.testing.assert_allclose(position, [10, 0, 0])
     np.testing.assert_allclose(velocity, [0, 0, 0])

@@ -68,3 +68,21 @@ def test_linear_and_static_models_vectorise_over_time():
     assert velocity.shape == (3, 3)
     position, velocity = StaticMotion((4.0, 5.0, 6.0)).state_at(times)
     assert position.shape == (3, 3) and not velocity.any()
+
+
+def test_batch_evaluation_matches_one_by_one():
+    from dcsim.motion import batch_states
+
+    models = [
+        ClohessyWiltshireMotion((1.0, 2.0, 3.0), (0.01, 0.0, -0.02), N),
+        SphericalMotion(150_000.0, 45.0, 0.0, v=1.0, alpha_deg_s=0.002, beta_deg_s=0.001),
+        StaticMotion((7.0, 8.0, 9.0)),
+        ClohessyWiltshireMotion((-4.0, 0.0, 1.0), (0.0, 0.03, 0.0), N, epoch=5.0),
+        LinearMotion((0.0, 0.0, 0.0), (1.0, 1.0, 0.0), epoch=2.0),
+        SphericalMotion(149_000.0, 44.0, 359.0, beta_deg_s=-0.003, epoch=1.0),
+    ]
+    positions, velocities = batch_states(models, 123.4)
+    for model, position, velocity in zip(models, positions, velocities, strict=True):
+        expected_position, expected_velocity = model.state_at(123.4)
+        np.testing.assert_allclose(position, expected_position, rtol=1e-13, atol=1e-12)
+        np.testing.assert_allclose(velocity, expected_velocity, rtol=1e-13, atol=1e-12)

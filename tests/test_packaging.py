@@ -65,7 +65,7 @@ def test_wheel_installs_into_a_fresh_environment_and_runs(wheel, tmp_path):
     )
     environment = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
     run = subprocess.run(
-        [str(env_dir / "bin" / "dcsim"), "run", "--out", "out"],
+        [str(env_dir / "bin" / "dcsim"), "run", "--out", "out", "--set", "world.duration=5"],
         cwd=tmp_path,
         capture_output=True,
         text=True,
@@ -73,8 +73,9 @@ def test_wheel_installs_into_a_fresh_environment_and_runs(wheel, tmp_path):
         timeout=120,
     )
     assert run.returncode == 0, run.stderr
-    assert "scenario: default" in run.stdout
+    assert run.stdout.startswith("default seed 0: completed (duration reached)")
     assert (tmp_path / "out" / "scenario.yaml").is_file()
+    assert (tmp_path / "out" / "plots" / "trajectory.png").is_file()
     listing = subprocess.run(
         [str(env_dir / "bin" / "dcsim"), "plugins"],
         cwd=tmp_path,

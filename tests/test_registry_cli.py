@@ -31,13 +31,24 @@ def test_external_plugin_is_listed_with_its_distribution(dcsim_cli, good_plugin_
     )
 
 
-def test_external_plugin_runs_in_a_scenario(dcsim_cli, good_plugin_dist):
-    result = dcsim_cli("run", "--set", "controller.plugin=hold", extra_path=[good_plugin_dist])
-    assert result.returncode == 0, result.stderr
-    assert any(
-        line.split()[:3] == ["controller", "hold", "dcsim-hold"]
-        for line in result.stdout.splitlines()
+def test_external_plugin_runs_in_a_scenario(dcsim_cli, good_plugin_dist, tmp_path):
+    result = dcsim_cli(
+        "run",
+        "--out",
+        str(tmp_path / "hold"),
+        "--set",
+        "controller.plugin=hold",
+        "--set",
+        "world.duration=2",
+        extra_path=[good_plugin_dist],
     )
+    assert result.returncode == 0, result.stderr
+    summary = json.loads((tmp_path / "hold" / "summary.json").read_text())
+    assert summary["plugins"]["controller"] == {
+        "name": "hold",
+        "distribution": "dcsim-hold",
+        "version": "1.2.3",
+    }
 
 
 def test_load_plugins_env_restricts_external_plugins(dcsim_cli, good_plugin_dist):

@@ -143,6 +143,14 @@ def _rule_violations(scenario: Scenario) -> list[tuple[KeyPath, str]]:
                 f"{robot.propellant_mass:g} kg must be less than robot.mass ({robot.mass:g} kg)",
             )
         )
+    if scenario.mission.reach > robot.grab_distance:
+        found.append(
+            (
+                ("mission", "reach"),
+                f"{scenario.mission.reach:g} m is beyond robot.grab_distance "
+                f"({robot.grab_distance:g} m)",
+            )
+        )
     if sum(q * q for q in robot.initial.attitude) < 1e-12:
         found.append((("robot", "initial", "attitude"), "the quaternion must not be zero"))
     owners: dict[int, str] = {}

@@ -167,6 +167,18 @@ class InitialStateSpec(Section):
     angular_velocity: Vec3 = quantity(
         (0.0, 0.0, 0.0), unit="rad/s", description="Angular velocity."
     )
+    position_sigma: float = quantity(
+        1.0,
+        unit="m",
+        gt=0,
+        description="Uncertainty of the position the localiser is told at start (per axis).",
+    )
+    velocity_sigma: float = quantity(
+        0.05,
+        unit="m/s",
+        gt=0,
+        description="Uncertainty of the velocity the localiser is told at start (per axis).",
+    )
 
 
 class RobotSection(Section):
@@ -252,6 +264,43 @@ class PluginChoice(Section):
     )
 
 
+class MissionSection(Section):
+    """How the executer flies the debris-collection mission (the thesis's §5.2 and §5.4)."""
+
+    reach: float = quantity(
+        0.5,
+        unit="m",
+        gt=0,
+        description="Surface gap to a target at which GRAB is entered (REACH); "
+        "at most robot.grab_distance.",
+    )
+    pickup_slack: float = quantity(
+        30.0, unit="s", ge=0, description="How late a pickup may be before the plan is remade."
+    )
+    acceleration_fraction: float = quantity(
+        0.5,
+        gt=0,
+        le=1,
+        description="Fraction of the thrust-limited acceleration that plans may use; "
+        "the rest is left to the controller.",
+    )
+    planning_budget: float = quantity(
+        1.0, unit="s", gt=0, description="Wall time given to a planner call."
+    )
+    path_retry: float = quantity(
+        5.0,
+        unit="s",
+        gt=0,
+        description="Wait before asking again after the path planner found no path.",
+    )
+    release_fraction: float = quantity(
+        0.5,
+        gt=0,
+        le=1,
+        description="Fraction of the drop tolerance within which the collector releases its cargo.",
+    )
+
+
 class StopSection(Section):
     """When a run ends before ``world.duration``."""
 
@@ -293,6 +342,9 @@ class Scenario(Section):
     )
     controller: PluginChoice = Field(
         default_factory=lambda: PluginChoice(plugin="pd"), description="Controller plugin."
+    )
+    mission: MissionSection = Field(
+        default_factory=MissionSection, description="Executer settings."
     )
     stop: StopSection = Field(default_factory=StopSection, description="Stop rules.")
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from dcsim_plugins.nearest import NearestTaskPlanner
@@ -67,8 +69,16 @@ def test_moving_target_is_intercepted_at_the_earliest_reachable_time():
     point, velocity = moving.predict(task.pickup_time)
     np.testing.assert_allclose(task.pickup_point, point)
     np.testing.assert_allclose(task.pickup_velocity, velocity)
-    # |p(t)| = t at interception: 400 + 0.25 t² = t²  ->  t = 20 / sqrt(0.75)
-    assert task.pickup_time == pytest.approx(20 / np.sqrt(0.75), abs=1e-6)
+    # In the target's moving frame the aim point stays 20 m away and the cruise speed
+    # there is 1 - 0.5 m/s (impulsive burns): 40 s.
+    assert task.pickup_time == pytest.approx(40.0, abs=1e-6)
+
+
+def test_finite_acceleration_delays_pickups_by_the_ramps():
+    slow = request([track(1, (10, 0, 0))], speed=1.0)
+    slow = dataclasses.replace(slow, max_acceleration=0.1)
+    # Rest to rest over 10 m at 1 m/s and 0.1 m/s²: 10 s cruising plus 10 s of ramps.
+    assert planner().plan(slow).tasks[0].pickup_time == pytest.approx(20.0, abs=1e-6)
 
 
 def test_unreachable_targets_are_left_out_and_times_follow_now():

@@ -78,7 +78,7 @@ def test_reported_variance_matches_the_scatter_of_noisy_fixes():
 def test_velocity_follows_a_coasting_collector():
     loc = localiser()
     velocity = np.array([0.3, -0.2, 0.1])
-    for k in range(30):
+    for k in range(400):
         loc.predict(MotionInput(), dt=1.0)
         loc.update(ranges(velocity * (k + 1)))
     np.testing.assert_allclose(loc.estimate().velocity, velocity, atol=1e-6)

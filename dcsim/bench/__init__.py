@@ -1,0 +1,1 @@
+"""Benchmarks run by ``dcsim bench KIND``: harnesses, and reference solvers that score plugins."""

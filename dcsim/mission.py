@@ -1,0 +1,356 @@
+"""The debris-collection mission: the executer state machine of the source thesis.
+
+Modes (the thesis's §2.2.1 and §5.2)::
+
+    LOCALIZE ──converged──► DEVISE_PLAN ──plan──► SELECT_NEXT ──pickup──► MOVE_TO_NEXT
+        ▲                        ▲                 │   ▲   drop              │ in reach
+        │                        │ replan          ▼   │                     ▼
+        └──── nothing left ──────┴──────────── MOVE_TO_DROP ◄──full/last── GRAB
+                                  IDLE: converged, no target known
+
+Replanning happens when a new target enters sensor range, a grab fails, or a pickup
+can no longer be met. Every mode change, plan, grab, release and path failure is
+reported through the ``emit`` callback as an event.
+"""
+
+from __future__ import annotations
+
+import enum
+from collections import deque
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from dcsim.geometry import unit
+from dcsim.interfaces import Plugin
+from dcsim.messages import (
+    DropVisit,
+    GoalRegion,
+    LocationEstimate,
+    NoPath,
+    ObjectKind,
+    ObjectTrack,
+    PathProblem,
+    PathState,
+    Plan,
+    PlanTask,
+    Reference,
+    TaskRequest,
+    Trajectory,
+)
+from dcsim.scenario.model import Scenario
+from dcsim.world import World
+
+Emit = Callable[..., None]
+
+
+class Mode(enum.IntEnum):
+    """Mission modes, with the integer each is reported as."""
+
+    LOCALIZE = 0
+    DEVISE_PLAN = 1
+    SELECT_NEXT = 2
+    MOVE_TO_NEXT = 3
+    GRAB = 4
+    MOVE_TO_DROP = 5
+    IDLE = 6
+
+
+_INSTANT = {Mode.DEVISE_PLAN, Mode.SELECT_NEXT, Mode.GRAB}
+
+
+class PluginFailure(Exception):
+    """A plugin raised during a run.
+
+    Attributes
+    ----------
+    role : str
+        The role of the plugin (``localiser``, ``controller``...).
+    plugin : str
+        The plugin's name.
+    method : str
+        The method that raised.
+    """
+
+    def __init__(self, role: str, plugin: str, method: str, error: BaseException) -> None:
+        self.role, self.plugin, self.method, self.error = role, plugin, method, error
+        super().__init__(
+            f"{role} plugin '{plugin}' raised in {method}(): {type(error).__name__}: {error}"
+        )
+
+
+def call_plugin(plugins: dict[str, Plugin], role: str, method: str, *args: Any) -> Any:
+    """Call ``plugins[role].method(*args)``, wrapping any exception in :class:`PluginFailure`."""
+    plugin = plugins[role]
+    try:
+        return getattr(plugin, method)(*args)
+    except Exception as error:  # a plugin's own bug ends the run, recorded
+        raise PluginFailure(role, plugin.name, method, error) from error
+
+
+class Mission:
+    """The executer: turns estimates and tracks into references and world service calls.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The resolved scenario (mission settings, robot limits).
+    world : World
+        Provides the grab and release services and the drop point.
+    plugins : dict
+        The task planner and path planner under their roles.
+    emit : callable
+        ``emit(event_name, **data)`` records an event.
+    """
+
+    def __init__(
+        self, scenario: Scenario, world: World, plugins: dict[str, Plugin], emit: Emit
+    ) -> None:
+        self.settings = scenario.mission
+        self.robot = scenario.robot
+        self.world = world
+        self.plugins = plugins
+        self.emit = emit
+        self.mode = Mode.LOCALIZE
+        self.known: dict[int, ObjectTrack] = {}
+        self.planned: set[int] = set()
+        self.steps: deque[PlanTask | DropVisit] = deque()
+        self.task: PlanTask | None = None
+        self.trajectory: Trajectory | None = None
+        self.approach = np.zeros(3)
+        self.hold: np.ndarray | None = None
+        self.retry_at = -np.inf
+        self.release_refused = False
+        self.time = 0.0
+
+    # ------------------------------------------------------------------ tick
+    def tick(
+        self, time: float, estimate: LocationEstimate, tracks: Sequence[ObjectTrack]
+    ) -> Reference:
+        """Advance the state machine at ``time`` and return the reference to track."""
+        self.time = time
+        self.estimate = estimate
+        self.visible = {t.id: t for t in tracks}
+        self.known.update(self.visible)
+        for _ in range(len(Mode) + 2):
+            before = self.mode
+            reference = self._step()
+            if self.mode is before or self.mode not in _INSTANT:
+                return reference
+        return reference
+
+    def _go(self, mode: Mode, reason: str) -> None:
+        if mode is not self.mode:
+            self.emit("mode", previous=self.mode.name, mode=mode.name, reason=reason)
+            self.mode = mode
+            self.hold = None
+
+    def _step(self) -> Reference:
+        handler = {
+            Mode.LOCALIZE: self._localize,
+            Mode.IDLE: self._idle,
+            Mode.DEVISE_PLAN: self._devise_plan,
+            Mode.SELECT_NEXT: self._select_next,
+            Mode.MOVE_TO_NEXT: self._move_to_next,
+            Mode.GRAB: self._grab,
+            Mode.MOVE_TO_DROP: self._move_to_drop,
+        }[self.mode]
+        return handler()
+
+    # ------------------------------------------------------------------ helpers
+    def _free_targets(self) -> list[ObjectTrack]:
+        return [t for t in self.visible.values() if t.kind is ObjectKind.TARGET]
+
+    def _obstacles(self) -> tuple[ObjectTrack, ...]:
+        return tuple(t for t in self.visible.values() if t.kind is ObjectKind.OBSTACLE)
+
+    def _max_acceleration(self) -> float:
+        """Acceleration plans may count on, m/s²: a share of thrust over current mass."""
+        return (
+            self.settings.acceleration_fraction * self.robot.max_force / self.world.assembly_mass()
+        )
+
+    def _holding(self) -> Reference:
+        if self.hold is None:
+            self.hold = np.array(self.estimate.position)
+        return Reference(time=self.time, position=self.hold)
+
+    def _new_target(self) -> ObjectTrack | None:
+        return next((t for t in self._free_targets() if t.id not in self.planned), None)
+
+    def _plan_path(self, goal: GoalRegion) -> Trajectory | None:
+        problem = PathProblem(
+            start=PathState(self.time, self.estimate.position, self.estimate.velocity),
+            goal=goal,
+            obstacles=self._obstacles(),
+            robot_radius=self.robot.radius,
+            max_speed=self.robot.max_speed,
+            max_acceleration=self._max_acceleration(),
+            time_budget=self.settings.planning_budget,
+        )
+        result = call_plugin(self.plugins, "path_planner", "plan", problem)
+        if isinstance(result, NoPath):
+            self.emit("no_path", reason=result.reason)
+            self.retry_at = self.time + self.settings.path_retry
+            return None
+        self.emit("path", duration=result.duration, length=result.length, delta_v=result.delta_v)
+        return result
+
+    def _follow(self, live: Callable[[], tuple[np.ndarray, np.ndarray]]) -> Reference:
+        """Track the trajectory while it lasts, then the live goal state."""
+        if self.trajectory is not None and self.time < self.trajectory.times[-1]:
+            position, velocity = self.trajectory.sample(self.time)
+        else:
+            position, velocity = live()
+        return Reference(time=self.time, position=position, velocity=velocity)
+
+    # ------------------------------------------------------------------ modes
+    def _localize(self) -> Reference:
+        if self.estimate.converged:
+            if self.world.carried_ids() or self._free_targets():
+                self._go(Mode.DEVISE_PLAN, "localised")
+            else:
+                self._go(Mode.IDLE, "localised, no target in sight")
+        return self._holding()
+
+    def _idle(self) -> Reference:
+        if self._free_targets() or self.world.carried_ids():
+            self._go(Mode.DEVISE_PLAN, "target in sight")
+        return self._holding()
+
+    def _devise_plan(self) -> Reference:
+        targets = tuple(self._free_targets())
+        request = TaskRequest(
+            time=self.time,
+            robot=self.estimate,
+            targets=targets,
+            drop_point=self.world.drop_point,
+            capacity=self.robot.capacity,
+            carried=len(self.world.carried_ids()),
+            max_speed=self.robot.max_speed,
+            max_acceleration=self._max_acceleration(),
+            time_budget=self.settings.planning_budget,
+        )
+        plan: Plan = call_plugin(self.plugins, "task_planner", "plan", request)
+        self.planned = {t.id for t in targets}
+        self.steps = deque(_ordered_steps(plan))
+        self.emit(
+            "plan",
+            tasks=[[t.target_id, t.pickup_time] for t in plan.tasks],
+            drops=[[v.after_task, v.time] for v in plan.drop_visits],
+            cost=plan.cost,
+        )
+        if self.steps:
+            self._go(Mode.SELECT_NEXT, "plan ready")
+        else:
+            self._go(Mode.IDLE, "nothing to plan")
+        return self._holding()
+
+    def _select_next(self) -> Reference:
+        if not self.steps:
+            self._go(Mode.LOCALIZE, "plan done")
+            return self._holding()
+        step = self.steps.popleft()
+        self.trajectory = None
+        if isinstance(step, DropVisit):
+            self._go(Mode.MOVE_TO_DROP, "drop visit")
+        else:
+            self.task = step
+            track = self.known[step.target_id]
+            target_at_pickup = track.predict(step.pickup_time)[0]
+            self.approach = unit(self.estimate.position - target_at_pickup)
+            self.retry_at = -np.inf
+            self._go(Mode.MOVE_TO_NEXT, f"pickup of target {step.target_id}")
+        return self._holding()
+
+    def _standoff(self, track: ObjectTrack, time: float) -> tuple[np.ndarray, np.ndarray]:
+        position, velocity = track.predict(time)
+        distance = self.robot.radius + track.radius + 0.5 * self.settings.reach
+        return position + self.approach * distance, velocity
+
+    def _move_to_next(self) -> Reference:
+        task = self.task
+        track = self.known[task.target_id]
+        if self._new_target() is not None:
+            self._go(Mode.DEVISE_PLAN, f"new target {self._new_target().id} in sight")
+            return self._holding()
+        if self.trajectory is None and self.time >= self.retry_at:
+            goal_position, goal_velocity = self._standoff(track, task.pickup_time)
+            arrive = task.pickup_time if task.pickup_time > self.time else None
+            self.trajectory = self._plan_path(
+                GoalRegion(goal_position, 0.5 * self.settings.reach, goal_velocity, arrive)
+            )
+        if self.trajectory is None:
+            if self.world.carried_ids():
+                self._go(Mode.MOVE_TO_DROP, "no path to the target")
+            elif self.time > task.pickup_time + self.settings.pickup_slack:
+                self._go(Mode.DEVISE_PLAN, "pickup missed")
+            return self._holding()
+        target_position = track.predict(self.time)[0]
+        gap = (
+            np.linalg.norm(self.estimate.position - target_position)
+            - self.robot.radius
+            - track.radius
+        )
+        if gap <= self.settings.reach:
+            self._go(Mode.GRAB, f"target {task.target_id} in reach")
+        elif self.time > task.pickup_time + self.settings.pickup_slack:
+            self.emit("pickup_missed", target=task.target_id, planned=task.pickup_time)
+            self._go(Mode.DEVISE_PLAN, "pickup missed")
+        return self._follow(lambda: self._standoff(track, self.time))
+
+    def _grab(self) -> Reference:
+        result = self.world.grab(self.task.target_id)
+        self.emit(
+            "grab",
+            target=result.target_id,
+            success=result.success,
+            reason=result.reason,
+            gap=result.gap,
+        )
+        track = self.known[self.task.target_id]
+        reference = Reference(self.time, *self._standoff(track, self.time))
+        if not result.success:
+            self._go(Mode.DEVISE_PLAN, "grab failed")
+            return reference
+        self.known.pop(self.task.target_id, None)
+        full = len(self.world.carried_ids()) >= self.robot.capacity
+        if self.steps and isinstance(self.steps[0], DropVisit):
+            self.steps.popleft()
+            self._go(Mode.MOVE_TO_DROP, "drop visit")
+        elif full or not self.steps:
+            self._go(Mode.MOVE_TO_DROP, "full" if full else "last pickup")
+        else:
+            self._go(Mode.SELECT_NEXT, "grabbed")
+        return reference
+
+    def _move_to_drop(self) -> Reference:
+        drop = self.world.drop_point
+        if self.trajectory is None and self.time >= self.retry_at:
+            position, velocity = drop.state_at(self.time)
+            self.trajectory = self._plan_path(GoalRegion(position, 0.5 * drop.tolerance, velocity))
+            self.release_refused = False
+        reference = self._follow(lambda: drop.state_at(self.time))
+        distance = np.linalg.norm(self.estimate.position - drop.state_at(self.time)[0])
+        if distance <= self.settings.release_fraction * drop.tolerance:
+            result = self.world.release()
+            if result.delivered or not self.world.carried_ids():
+                self.emit("release", delivered=list(result.delivered), reason=result.reason)
+                self.trajectory = None
+                self._go(Mode.SELECT_NEXT if self.steps else Mode.LOCALIZE, "delivered")
+            elif not self.release_refused:
+                self.emit("release", delivered=[], reason=result.reason)
+                self.release_refused = True
+        return reference
+
+
+def _ordered_steps(plan: Plan) -> list[PlanTask | DropVisit]:
+    """A plan as the sequence of pickups and drop visits the collector flies."""
+    drops = {visit.after_task: visit for visit in plan.drop_visits}
+    steps: list[PlanTask | DropVisit] = [drops[-1]] if -1 in drops else []
+    for index, task in enumerate(plan.tasks):
+        steps.append(task)
+        if index in drops:
+            steps.append(drops[index])
+    return steps

@@ -1,0 +1,290 @@
+"""The run loop: world, localiser, mission, controller, recorded tick by tick.
+
+One control tick (``docs/architecture.md``)::
+
+    observe (beacon ranges, object tracks, last motion)
+    localiser.predict(motion, dt); localiser.update(ranges); estimate = localiser.estimate()
+    reference = mission.tick(t, estimate, tracks)          # may plan, grab, release
+    command = controller.command(t, estimate, reference, surroundings)
+    record telemetry; fire dcsim_run_step
+    world.step(command)                                     # fixed physics sub-steps
+
+Plots are drawn into ``plots/`` of the run directory at the end. A run ends
+``completed`` (every target delivered, or ``world.duration`` reached), ``stopped``
+(a collision with ``stop.on_collision``, ``stop.max_wall_time``, or an interrupt with
+Ctrl-C) or ``failed`` (a plugin or hook raised). Whatever the ending,
+the telemetry, events and summary recorded so far are written.
+"""
+
+from __future__ import annotations
+
+import sys
+import time as wallclock
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from dcsim.hookspecs import RunInfo
+from dcsim.messages import LocationEstimate, Prior, Surroundings
+from dcsim.mission import Mission, PluginFailure, call_plugin
+from dcsim.plots import write_plots
+from dcsim.recording import Recorder
+from dcsim.runsetup import RunSetup
+from dcsim.scenario import dump_scenario
+from dcsim.scenario.model import point_to_cartesian
+from dcsim.seeding import component_rng
+from dcsim.world import World, WorldInputs
+from dcsim.world.objects import ObjectStatus
+
+
+class HookFailure(Exception):
+    """A lifecycle hook implementation raised during a run."""
+
+
+class _RunEnded(Exception):
+    """Internal: a stop rule ended the run."""
+
+    def __init__(self, status: str, reason: str) -> None:
+        super().__init__(reason)
+        self.status, self.reason = status, reason
+
+
+class Runner:
+    """Runs one scenario to its end and records it.
+
+    Parameters
+    ----------
+    setup : RunSetup
+        The resolved scenario and its constructed plugins.
+    out_dir : Path, optional
+        Run directory to write; None records in memory only.
+    progress : callable, optional
+        ``progress(sim_time, duration, mode, delivered, targets)``, called about four
+        times a second of wall time.
+    """
+
+    def __init__(
+        self,
+        setup: RunSetup,
+        out_dir: Path | None = None,
+        progress: Callable[[float, float, str, int, int], None] | None = None,
+    ) -> None:
+        self.setup = setup
+        self.scenario = setup.scenario
+        self.plugins = setup.plugins
+        self.recorder = Recorder(out_dir)
+        self.info = RunInfo(self.scenario, self.scenario.world.seed, out_dir)
+        self.progress = progress
+        self.world: World | None = None
+        self.summary: dict[str, Any] = {}
+
+    # ------------------------------------------------------------------ public
+    def run(self) -> dict[str, Any]:
+        """Run to the end; return the summary (also written to ``summary.json``)."""
+        started = wallclock.perf_counter()
+        status, reason = "completed", ""
+        self.world = World(self.scenario, component_rng(self.scenario.world.seed, "world"))
+        try:
+            self._hook("dcsim_run_start", run=self.info)
+            self._loop(started)
+        except _RunEnded as end:
+            status, reason = end.status, end.reason
+        except PluginFailure as failure:
+            status, reason = "failed", str(failure)
+            self._event(
+                "plugin_failed", role=failure.role, plugin=failure.plugin, error=str(failure.error)
+            )
+        except HookFailure as failure:
+            status, reason = "failed", str(failure)
+        except KeyboardInterrupt:
+            status, reason = "stopped", "interrupted"
+            self._event("interrupted")
+        finally:
+            wall = wallclock.perf_counter() - started
+            self.summary = self._summary(status, reason, wall)
+            self.world.close()
+            self.recorder.write(self.summary, dump_scenario(self.scenario))
+            if self.info.out_dir is not None:
+                write_plots(
+                    self.info.out_dir,
+                    self.scenario,
+                    self.recorder.telemetry(),
+                    self.recorder.events,
+                )
+        self._hook("dcsim_run_end", run=self.info, summary=self.summary)
+        return self.summary
+
+    # ------------------------------------------------------------------ loop
+    def _loop(self, started: float) -> None:
+        world, scenario = self.world, self.scenario
+        period = world.control_period
+        mission = Mission(scenario, world, self.plugins, self._event)
+        call_plugin(self.plugins, "localiser", "reset", self._prior(), 0.0)
+        call_plugin(self.plugins, "controller", "reset", world.robot_spec())
+        cargo = world.carried_ids()
+        targets = int(world.field.is_target.sum())
+        last_progress = -np.inf
+        first = True
+        while True:
+            t = world.time
+            tracks = world.object_tracks()
+            if not first:
+                call_plugin(self.plugins, "localiser", "predict", world.motion_input(), period)
+            call_plugin(self.plugins, "localiser", "update", world.beacon_ranges())
+            estimate: LocationEstimate = call_plugin(self.plugins, "localiser", "estimate")
+            previous_mode = mission.mode
+            reference = mission.tick(t, estimate, tracks)
+            if world.carried_ids() != cargo:  # a grab or a release changed the mass
+                cargo = world.carried_ids()
+                call_plugin(self.plugins, "controller", "reset", world.robot_spec())
+            obstacles = tuple(tr for tr in tracks if tr.kind.value == "obstacle")
+            command = call_plugin(
+                self.plugins,
+                "controller",
+                "command",
+                t,
+                estimate,
+                reference,
+                Surroundings(obstacles),
+            )
+            self._record(t, estimate, mission.mode.name, command.force)
+            delivered = world.field.count(ObjectStatus.DELIVERED)
+            self._check_stop(t, delivered, targets, started, previous_mode is not mission.mode)
+            for collision in world.step(WorldInputs(force=command.force, torque=command.torque)):
+                self._event(
+                    "collision",
+                    object=collision.object_id,
+                    body=collision.body,
+                    penetration=collision.penetration,
+                )
+                if scenario.stop.on_collision:
+                    self._record_final(mission.mode.name)
+                    raise _RunEnded("stopped", f"collision with object {collision.object_id}")
+            first = False
+            wall = wallclock.perf_counter()
+            if self.progress is not None and wall - last_progress > 0.25:
+                last_progress = wall
+                self.progress(
+                    world.time, scenario.world.duration, mission.mode.name, delivered, targets
+                )
+
+    def _check_stop(
+        self, t: float, delivered: int, targets: int, started: float, changed: bool
+    ) -> None:
+        stop = self.scenario.stop
+        if stop.on_all_delivered and targets and delivered == targets:
+            raise _RunEnded("completed", "all targets delivered")
+        if t >= self.scenario.world.duration - 1e-9:
+            raise _RunEnded("completed", "duration reached")
+        if (
+            stop.max_wall_time is not None
+            and wallclock.perf_counter() - started > stop.max_wall_time
+        ):
+            raise _RunEnded("stopped", f"wall-time limit of {stop.max_wall_time:g} s reached")
+
+    def _prior(self) -> Prior:
+        """The localiser's initial belief: the true start, blurred by the stated sigmas."""
+        initial = self.scenario.robot.initial
+        rng = component_rng(self.scenario.world.seed, "prior")
+        position = point_to_cartesian(initial.position) + rng.normal(0, initial.position_sigma, 3)
+        velocity = np.asarray(initial.velocity) + rng.normal(0, initial.velocity_sigma, 3)
+        return Prior(position, initial.position_sigma, velocity, initial.velocity_sigma)
+
+    # ------------------------------------------------------------------ records
+    def _record(self, t: float, estimate: LocationEstimate, mode: str, force: np.ndarray) -> None:
+        out = self.world.outputs()
+        row: dict[str, Any] = {"time": t}
+        row.update(zip(("x", "y", "z"), out["position"], strict=True))
+        row.update(zip(("vx", "vy", "vz"), out["velocity"], strict=True))
+        row.update(zip(("est_x", "est_y", "est_z"), estimate.position, strict=True))
+        row.update(zip(("est_vx", "est_vy", "est_vz"), estimate.velocity, strict=True))
+        row.update(zip(("qx", "qy", "qz", "qw"), out["attitude"], strict=True))
+        row.update(
+            mode=mode,
+            converged=int(estimate.converged),
+            carried=out["carried"],
+            delivered=out["delivered"],
+            fuel_used=out["fuel_used"],
+            delta_v=out["delta_v"],
+            nearest_obstacle=out["nearest_obstacle_distance"],
+        )
+        row.update(zip(("fx", "fy", "fz"), force, strict=True))
+        self.recorder.row(row)
+        self._hook("dcsim_run_step", run=self.info, row=row)
+
+    def _record_final(self, mode: str) -> None:
+        """Record the state reached by the last step (the run ends after it)."""
+        last = self.recorder.rows[-1]
+        estimate = LocationEstimate(
+            time=self.world.time,
+            position=[last["est_x"], last["est_y"], last["est_z"]],
+            velocity=[last["est_vx"], last["est_vy"], last["est_vz"]],
+            converged=bool(last["converged"]),
+        )
+        self._record(self.world.time, estimate, mode, np.zeros(3))
+
+    def _event(self, name: str, **data: Any) -> None:
+        event = {"t": self.world.time, "event": name, **data}
+        self.recorder.event(event)
+        self._hook("dcsim_run_event", run=self.info, event=event)
+
+    def _hook(self, name: str, **kwargs: Any) -> None:
+        try:
+            getattr(self.setup.registry.hook, name)(**kwargs)
+        except KeyboardInterrupt:
+            raise
+        except Exception as error:  # a hook implementation's own bug
+            raise HookFailure(f"hook {name} raised: {type(error).__name__}: {error}") from error
+
+    def _summary(self, status: str, reason: str, wall: float) -> dict[str, Any]:
+        world = self.world
+        telemetry = self.recorder.telemetry()
+        converged = (
+            telemetry["converged"].astype(bool) if len(self.recorder.rows) else np.zeros(0, bool)
+        )
+        errors = np.zeros(0)
+        if converged.any():
+            true = np.column_stack([telemetry[c] for c in ("x", "y", "z")])[converged]
+            est = np.column_stack([telemetry[c] for c in ("est_x", "est_y", "est_z")])[converged]
+            errors = np.linalg.norm(true - est, axis=1)
+        gaps = telemetry["nearest_obstacle"] if len(self.recorder.rows) else np.zeros(0)
+        sim_time = world.time
+        return {
+            "status": status,
+            "reason": reason,
+            "scenario": self.scenario.name,
+            "seed": self.scenario.world.seed,
+            "sim_time_s": sim_time,
+            "wall_time_s": wall,
+            "real_time_factor": sim_time / wall if wall > 0 else None,
+            "targets": int(world.field.is_target.sum()),
+            "captured": world.field.count(ObjectStatus.CARRIED)
+            + world.field.count(ObjectStatus.DELIVERED),
+            "delivered": world.field.count(ObjectStatus.DELIVERED),
+            "collisions": len(world.collisions),
+            "fuel_used_kg": world.fuel_used,
+            "delta_v_mps": world.delta_v,
+            "localisation_rmse_m": float(np.sqrt(np.mean(errors**2))) if errors.size else None,
+            "min_obstacle_distance_m": float(gaps.min()) if gaps.size else None,
+            "plugins": self.setup.plugin_versions(),
+        }
+
+
+def terminal_progress(stream: Any = None) -> Callable[[float, float, str, int, int], None] | None:
+    """A progress line for an interactive terminal, or None when output is piped."""
+    stream = stream or sys.stderr
+    if not stream.isatty():
+        return None
+
+    def show(sim_time: float, duration: float, mode: str, delivered: int, targets: int) -> None:
+        fraction = min(sim_time / duration, 1.0)
+        bar = "#" * int(30 * fraction)
+        stream.write(
+            f"\r[{bar:<30}] {100 * fraction:5.1f}%  t = {sim_time:7.1f} s  "
+            f"{mode:<12}  delivered {delivered}/{targets} "
+        )
+        stream.flush()
+
+    return show

@@ -1,0 +1,95 @@
+"""Space objects (targets and obstacles) as the world keeps them."""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from dcsim.messages import ObjectKind
+from dcsim.motion import MotionModel, batch_states
+
+
+class ObjectStatus(enum.IntEnum):
+    """Where an object is in its life: free in space, carried, or delivered."""
+
+    FREE = 0
+    CARRIED = 1
+    DELIVERED = 2
+
+
+@dataclass(frozen=True)
+class SpaceObject:
+    """A target or an obstacle.
+
+    Attributes
+    ----------
+    id : int
+        Unique id.
+    kind : ObjectKind
+        Target or obstacle.
+    radius : float
+        Bounding-sphere radius, m.
+    mass : float
+        Mass, kg.
+    motion : MotionModel
+        Motion followed exactly while the object is free.
+    """
+
+    id: int
+    kind: ObjectKind
+    radius: float
+    mass: float
+    motion: MotionModel
+
+
+class ObjectField:
+    """All space objects of a world, with vectorised access to their free motion.
+
+    Attributes
+    ----------
+    objects : tuple of SpaceObject
+        The objects, in scenario order (targets first).
+    radii : ndarray (N,)
+        Radii, m.
+    is_target : ndarray (N,) of bool
+        Which objects are targets.
+    status : ndarray (N,) of int
+        :class:`ObjectStatus` of each object.
+    """
+
+    def __init__(self, objects: Sequence[SpaceObject]) -> None:
+        self.objects = tuple(objects)
+        self.radii = np.array([o.radius for o in self.objects], dtype=float)
+        self.is_target = np.array([o.kind is ObjectKind.TARGET for o in self.objects], dtype=bool)
+        self.status = np.full(len(self.objects), ObjectStatus.FREE, dtype=int)
+        self.index = {o.id: i for i, o in enumerate(self.objects)}
+        self._models = [o.motion for o in self.objects]
+        self._cache: tuple[float, np.ndarray, np.ndarray] | None = None
+
+    def __len__(self) -> int:
+        return len(self.objects)
+
+    def free_states(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Positions and velocities (N, 3) of every object as its motion model gives them.
+
+        Only the rows of free objects describe where the objects are; carried objects
+        move with the collector. Results are cached for the latest ``t``.
+        """
+        if self._cache is None or self._cache[0] != t:
+            positions, velocities = (
+                batch_states(self._models, t) if self._models else (np.zeros((0, 3)),) * 2
+            )
+            self._cache = (t, positions, velocities)
+        return self._cache[1], self._cache[2]
+
+    def free_mask(self) -> np.ndarray:
+        """Boolean mask of the objects that are free."""
+        return self.status == ObjectStatus.FREE
+
+    def count(self, status: ObjectStatus, targets_only: bool = True) -> int:
+        """Number of objects (targets only, by default) with ``status``."""
+        mask = self.status == status
+        return int(np.count_nonzero(mask & self.is_target if targets_only else mask))

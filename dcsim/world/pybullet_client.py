@@ -1,0 +1,39 @@
+"""PyBullet, imported without its banner, and DIRECT clients.
+
+PyBullet prints ``pybullet build time: ...`` from C on standard error when it is
+imported, which would clutter every command's output; the import here sends it to a
+discarded file descriptor. Import ``pb`` from this module, never ``pybullet`` itself.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import sys
+from types import ModuleType
+
+
+def _import_quietly() -> ModuleType:
+    sys.stderr.flush()
+    saved = os.dup(2)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 2)
+        import pybullet
+
+        ctypes.CDLL(None).fflush(None)
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(devnull)
+    return pybullet
+
+
+pb = _import_quietly()
+
+
+def connect_direct() -> int:
+    """Connect a new PyBullet DIRECT client (no GUI), zero gravity, and return its id."""
+    client = pb.connect(pb.DIRECT)
+    pb.setGravity(0, 0, 0, physicsClientId=client)
+    return client
