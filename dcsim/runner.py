@@ -155,6 +155,7 @@ class Runner:
             for collision in world.step(WorldInputs(force=command.force, torque=command.torque)):
                 self._event(
                     "collision",
+                    at=collision.time,
                     object=collision.object_id,
                     body=collision.body,
                     penetration=collision.penetration,
@@ -225,8 +226,8 @@ class Runner:
         )
         self._record(self.world.time, estimate, mode, np.zeros(3))
 
-    def _event(self, name: str, **data: Any) -> None:
-        event = {"t": self.world.time, "event": name, **data}
+    def _event(self, name: str, at: float | None = None, **data: Any) -> None:
+        event = {"t": self.world.time if at is None else at, "event": name, **data}
         self.recorder.event(event)
         self._hook("dcsim_run_event", run=self.info, event=event)
 

@@ -1,0 +1,306 @@
+"""Runs end to end: the mission state machine, outputs, determinism, failures, hooks."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import textwrap
+import time
+import types
+
+import numpy as np
+import pytest
+from dcsim_plugins.trilateration import TrilaterationLocaliser
+
+from dcsim.api import Command, Controller, PluginParams, PluginRegistry, hookimpl, quantity
+from dcsim.registry import PluginOrigin
+from dcsim.runner import Runner
+from dcsim.runsetup import prepare_run
+from tests.conftest import DCSIM, REPO
+
+TEST_ORIGIN = PluginOrigin("tests", "0", "tests")
+
+# Mode changes the thesis's executer allows (§2.2.1, §5.2), plus replanning.
+ALLOWED = {
+    ("LOCALIZE", "DEVISE_PLAN"),
+    ("LOCALIZE", "IDLE"),
+    ("IDLE", "DEVISE_PLAN"),
+    ("DEVISE_PLAN", "SELECT_NEXT"),
+    ("DEVISE_PLAN", "IDLE"),
+    ("SELECT_NEXT", "MOVE_TO_NEXT"),
+    ("SELECT_NEXT", "MOVE_TO_DROP"),
+    ("SELECT_NEXT", "LOCALIZE"),
+    ("MOVE_TO_NEXT", "GRAB"),
+    ("MOVE_TO_NEXT", "MOVE_TO_DROP"),
+    ("MOVE_TO_NEXT", "DEVISE_PLAN"),
+    ("GRAB", "SELECT_NEXT"),
+    ("GRAB", "MOVE_TO_DROP"),
+    ("GRAB", "DEVISE_PLAN"),
+    ("MOVE_TO_DROP", "SELECT_NEXT"),
+    ("MOVE_TO_DROP", "LOCALIZE"),
+}
+
+
+class BiasedLocaliser(TrilaterationLocaliser):
+    """Believes it is 0.8 m further along -x than it is."""
+
+    name = "biased"
+    summary = "Trilateration with a constant bias (test)"
+
+    def estimate(self):
+        estimate = super().estimate()
+        return type(estimate)(**{**estimate.__dict__, "position": estimate.position - [0.8, 0, 0]})
+
+
+class ExplodingParams(PluginParams):
+    after: float = quantity(2.0, unit="s", ge=0, description="When to raise.")
+
+
+class ExplodingController(Controller):
+    name = "explodes"
+    summary = "Raises after a while (test)"
+    Params = ExplodingParams
+
+    def reset(self, robot):
+        pass
+
+    def command(self, time, estimate, reference, surroundings):
+        if time >= self.params.after:
+            raise RuntimeError("boom")
+        return Command()
+
+
+def registry_with(*classes: type) -> PluginRegistry:
+    registry = PluginRegistry.discover()
+    for cls in classes:
+        registry.register_class(cls, TEST_ORIGIN)
+    return registry
+
+
+def scenario_file(tmp_path, text: str):
+    path = tmp_path / "scenario.yaml"
+    path.write_text(textwrap.dedent(text))
+    return path
+
+
+def run(path=None, overrides=(), out=None, registry=None, seed=None):
+    setup = prepare_run(path, overrides, seed, registry=registry or PluginRegistry.discover())
+    runner = Runner(setup, out)
+    return runner, runner.run()
+
+
+def modes(events):
+    return [(e["previous"], e["mode"]) for e in events if e["event"] == "mode"]
+
+
+@pytest.fixture(scope="module")
+def default_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("default")
+    runner, summary = run(out=out)
+    return runner, summary, out
+
+
+def test_default_run_delivers_every_target_without_collision(default_run):
+    _, summary, out = default_run
+    assert summary["status"] == "completed" and summary["reason"] == "all targets delivered"
+    assert summary["delivered"] == summary["targets"] == 4
+    assert summary["collisions"] == 0
+    assert summary["min_obstacle_distance_m"] > 0
+    assert summary["localisation_rmse_m"] < 0.1
+    assert 0 < summary["fuel_used_kg"] < 10 and summary["delta_v_mps"] > 0
+    assert json.loads((out / "summary.json").read_text()) == json.loads(json.dumps(summary))
+    assert (out / "plots" / "trajectory.png").stat().st_size > 10_000
+    assert (out / "plots" / "timeline.png").stat().st_size > 10_000
+
+
+def test_default_run_follows_the_executer_state_machine(default_run):
+    runner, _, _ = default_run
+    events = runner.recorder.events
+    transitions = modes(events)
+    assert transitions[0] == ("LOCALIZE", "DEVISE_PLAN")
+    assert set(transitions) <= ALLOWED, set(transitions) - ALLOWED
+    grabs = [e for e in events if e["event"] == "grab"]
+    assert len(grabs) == 4 and all(g["success"] for g in grabs)
+    releases = [e["delivered"] for e in events if e["event"] == "release"]
+    assert sorted(sum(releases, [])) == [1, 2, 3, 4]
+    assert all(len(r) <= 2 for r in releases)  # capacity 2
+    telemetry = runner.recorder.telemetry()
+    assert telemetry["carried"].max() == 2
+    assert np.all(np.diff(telemetry["delivered"]) >= 0)
+    # Every plan's pickups are viable: strictly increasing times after the plan was made.
+    for plan in (e for e in events if e["event"] == "plan"):
+        times = [t for _, t in plan["tasks"]]
+        assert all(t > plan["t"] for t in times) and np.all(np.diff(times) > 0)
+
+
+def test_a_failed_grab_makes_a_new_plan(tmp_path):
+    path = scenario_file(
+        tmp_path,
+        """\
+        world: {frame: geocentric, duration: 120}
+        robot: {max_force: 5, max_speed: 0.5, grab_distance: 0.6, capacity: 1}
+        mission: {reach: 0.5}
+        targets:
+          - {id: 1, radius: 0.3, motion: {type: static, position: [-8, 0, 0]}}
+        beacons: {positions: [[50, 50, 50], [50, -50, -50], [-50, 50, -50], [-50, -50, 50]], noise_sigma: 0.01}
+        drop_point: {position: [0, 0, 0]}
+        localiser: {plugin: biased}
+        """,
+    )
+    runner, summary = run(path, registry=registry_with(BiasedLocaliser))
+    events = runner.recorder.events
+    failed = next(e for e in events if e["event"] == "grab")
+    assert not failed["success"] and "out of reach" in failed["reason"]
+    after = events[events.index(failed) + 1 :]
+    assert after[0]["event"] == "mode" and (after[0]["mode"], after[0]["reason"]) == (
+        "DEVISE_PLAN",
+        "grab failed",
+    )
+    assert after[1]["event"] == "plan" and after[1]["tasks"][0][0] == 1
+    assert summary["delivered"] == 0 and summary["reason"] == "duration reached"
+
+
+def test_a_target_entering_sensor_range_triggers_a_replan(tmp_path):
+    path = scenario_file(
+        tmp_path,
+        """\
+        world: {frame: geocentric, duration: 400}
+        robot: {max_force: 5, max_speed: 0.5, sensor_range: 20, capacity: 2}
+        targets:
+          - {id: 1, radius: 0.3, motion: {type: static, position: [8, 0, 0]}}
+          - {id: 2, radius: 0.3, motion: {type: cartesian, position: [30, 6, 0], velocity: [-0.3, 0, 0]}}
+        beacons: {positions: [[50, 50, 50], [50, -50, -50], [-50, 50, -50], [-50, -50, 50]]}
+        drop_point: {position: [0, -3, 0]}
+        """,
+    )
+    runner, summary = run(path)
+    events = runner.recorder.events
+    plans = [e for e in events if e["event"] == "plan"]
+    assert [t for t, _ in plans[0]["tasks"]] == [1]
+    replan = next(
+        e for e in events if e["event"] == "mode" and e["reason"].startswith("new target")
+    )
+    assert replan["reason"] == "new target 2 in sight" and replan["mode"] == "DEVISE_PLAN"
+    row = next(r for r in runner.recorder.rows if r["time"] == replan["t"])
+    gap = np.hypot(30 - 0.3 * replan["t"] - row["x"], 6 - row["y"])
+    assert 19.9 < gap <= 20.0  # seen the first tick it was within sensor range
+    assert 2 in [t for p in plans[1:] for t, _ in p["tasks"]]
+    assert summary["delivered"] == 2 and summary["status"] == "completed"
+
+
+def test_same_scenario_and_seed_give_identical_files(tmp_path):
+    for name in ("a", "b"):
+        run(overrides=["world.duration=150"], out=tmp_path / name, seed=5)
+    for file in ("telemetry.csv", "events.jsonl", "scenario.yaml"):
+        assert (tmp_path / "a" / file).read_bytes() == (tmp_path / "b" / file).read_bytes()
+    run(overrides=["world.duration=150"], out=tmp_path / "c", seed=6)
+    seed_5 = (tmp_path / "a" / "telemetry.csv").read_text().splitlines()
+    seed_6 = (tmp_path / "c" / "telemetry.csv").read_text().splitlines()
+    assert len(seed_5) == len(seed_6) > 1000 and seed_5[-1] != seed_6[-1]  # the seed matters
+
+
+def test_a_raising_plugin_fails_the_run_and_keeps_what_was_recorded(tmp_path):
+    out = tmp_path / "run"
+    runner, summary = run(
+        overrides=["controller.plugin=explodes"],
+        out=out,
+        registry=registry_with(ExplodingController),
+    )
+    assert summary["status"] == "failed"
+    assert (
+        summary["reason"] == "controller plugin 'explodes' raised in command(): RuntimeError: boom"
+    )
+    last = json.loads((out / "events.jsonl").read_text().splitlines()[-1])
+    assert (
+        last["event"] == "plugin_failed"
+        and last["plugin"] == "explodes"
+        and last["error"] == "boom"
+    )
+    rows = (out / "telemetry.csv").read_text().splitlines()
+    assert len(rows) == 1 + 20  # header, then ticks at 0.0 ... 1.9 s
+    assert json.loads((out / "summary.json").read_text())["status"] == "failed"
+
+
+def test_hooks_observe_the_whole_run_and_an_interrupt_keeps_the_record(tmp_path):
+    seen = {"start": 0, "step": 0, "event": 0, "end": []}
+
+    def on_step(run, row):
+        seen["step"] += 1
+        if row["time"] >= 1.0:
+            raise KeyboardInterrupt
+
+    observer = types.ModuleType("observer")
+    observer.dcsim_run_start = hookimpl(lambda run: seen.__setitem__("start", seen["start"] + 1))
+    observer.dcsim_run_step = hookimpl(on_step)
+    observer.dcsim_run_event = hookimpl(
+        lambda run, event: seen.__setitem__("event", seen["event"] + 1)
+    )
+    observer.dcsim_run_end = hookimpl(lambda run, summary: seen["end"].append(summary))
+    registry = PluginRegistry.discover()
+    registry.register_module(observer, TEST_ORIGIN)
+    out = tmp_path / "run"
+    runner, summary = run(out=out, registry=registry)
+    assert summary["status"] == "stopped" and summary["reason"] == "interrupted"
+    assert seen["start"] == 1 and seen["end"] == [summary]
+    assert seen["step"] == len(runner.recorder.rows) == 11
+    assert seen["event"] == len(runner.recorder.events)
+    assert len((out / "telemetry.csv").read_text().splitlines()) == 12
+    assert json.loads((out / "events.jsonl").read_text().splitlines()[-1])["event"] == "interrupted"
+
+
+def test_ctrl_c_on_the_command_line_stops_the_run_and_writes_the_summary(tmp_path):
+    out = tmp_path / "run"
+    process = subprocess.Popen(
+        [
+            str(DCSIM),
+            "run",
+            str(REPO / "scenarios" / "thesis_debris_field.yaml"),
+            "--out",
+            str(out),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONPATH": ""},
+    )
+    deadline = time.monotonic() + 60
+    while not (out / "events.jsonl").exists() and time.monotonic() < deadline:
+        time.sleep(0.1)
+    time.sleep(1.0)
+    process.send_signal(signal.SIGINT)
+    stdout, stderr = process.communicate(timeout=60)
+    assert process.returncode == 130, stderr
+    assert "stopped (interrupted)" in stdout and "Traceback" not in stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["reason"] == "interrupted" and summary["sim_time_s"] > 0
+    assert len((out / "telemetry.csv").read_text().splitlines()) > 2
+
+
+def test_collisions_stop_the_run_or_are_counted(tmp_path):
+    text = """\
+        world: {frame: geocentric, duration: 30}
+        robot: {radius: 0.5, initial: {position: [0, 0, 0], velocity: [0.5, 0, 0]}}
+        obstacles:
+          - {id: 3, radius: 1.0, motion: {type: static, position: [6, 0, 0]}}
+        beacons: {positions: [[50, 50, 50], [50, -50, -50], [-50, 50, -50], [-50, -50, 50]]}
+        controller: {plugin: explodes, params: {after: 1000}}
+        """
+    registry = registry_with(ExplodingController)
+    runner, summary = run(scenario_file(tmp_path, text), registry=registry)
+    assert summary["status"] == "stopped" and summary["reason"] == "collision with object 3"
+    collision = next(e for e in runner.recorder.events if e["event"] == "collision")
+    assert collision["t"] == pytest.approx(9.01) and collision["body"] == "collector"
+    assert runner.recorder.rows[-1]["nearest_obstacle"] < 0
+    _, going_on = run(
+        scenario_file(tmp_path, text + "stop: {on_collision: false}\n"), registry=registry
+    )
+    assert going_on["status"] == "completed" and going_on["collisions"] == 1
+
+
+def test_thesis_debris_field_runs_to_completion():
+    runner, summary = run(REPO / "scenarios" / "thesis_debris_field.yaml")
+    assert summary["status"] == "completed" and summary["reason"] == "all targets delivered"
+    assert summary["delivered"] == 4 and summary["collisions"] == 0
+    assert set(modes(runner.recorder.events)) <= ALLOWED

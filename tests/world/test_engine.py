@@ -1,0 +1,213 @@
+"""The PyBullet world engine against closed forms and the thesis's §6.2 checks."""
+
+from __future__ import annotations
+
+import textwrap
+
+import numpy as np
+import pytest
+
+from dcsim.api import ClohessyWiltshireMotion, SphericalMotion, mean_motion
+from dcsim.scenario import ScenarioDocument, validate
+from dcsim.world import World, WorldInputs
+from dcsim.world.engine import STANDARD_GRAVITY
+from dcsim.world.pybullet_client import pb
+
+N = mean_motion(6_778_137.0)
+
+
+def world_from(text: str, seed: int = 0) -> World:
+    scenario = validate(ScenarioDocument.from_text(textwrap.dedent(text), "test.yaml"))
+    return World(scenario, np.random.default_rng(seed))
+
+
+FIELD = """\
+    world: {frame: lvlh, physics_step: 0.01, control_period: 0.1}
+    robot: {mass: 100, propellant_mass: 10, radius: 0.5, max_force: 5, sensor_range: 30,
+            grab_distance: 1.0, capacity: 1, specific_impulse: 200}
+    targets:
+      - {id: 1, radius: 0.5, mass: 5, motion: {type: cw, position: [2.5, 0, 0], velocity: [0, -0.005657, 0]}}
+      - {id: 2, radius: 0.5, mass: 5, motion: {type: cw, position: [0, 2.2, 0], velocity: [0, 0, 0]}}
+      - {id: 3, radius: 0.5, mass: 5, motion: {type: cw, position: [0, -25, 0], velocity: [0, 0, 0.01]}}
+      - {id: 4, radius: 0.5, mass: 5, motion: {type: cw, position: [0, 0, 40], velocity: [0, 0, 0]}}
+    obstacles:
+      - {id: 9, radius: 1.0, motion: {type: cw, position: [-20, 5, 0], velocity: [0, 0.04525, 0]}}
+    beacons:
+      positions: [[100, 0, 0], [0, 100, 0], [0, 0, 100], [-100, -100, -100], [500, 500, 500]]
+      max_range: 300
+      noise_sigma: 0.1
+      report_nearest: 3
+    """
+
+
+def test_free_objects_follow_their_closed_forms():
+    world = world_from(FIELD)
+    for _ in range(300):
+        world.step()
+    positions, velocities = world.object_states()
+    for obj, position, velocity in zip(world.field.objects, positions, velocities, strict=True):
+        expected = obj.motion.state_at(30.0)
+        np.testing.assert_allclose(position, expected[0], atol=1e-12)
+        np.testing.assert_allclose(velocity, expected[1], atol=1e-12)
+    assert isinstance(world.field.objects[0].motion, ClohessyWiltshireMotion)
+    assert world.time == pytest.approx(30.0)
+
+
+def test_geocentric_objects_follow_the_thesis_model():
+    world = world_from("""\
+        world: {frame: geocentric, physics_step: 0.05, control_period: 0.5}
+        robot: {initial: {position: {r: 150000, polar_deg: 45, azimuth_deg: 0}}}
+        obstacles:
+          - {id: 5, motion: {type: spherical, r: 155000, polar_deg: 89.05, azimuth_deg: 0.19, alpha_deg_s: -0.005}}
+        """)
+    for _ in range(20):
+        world.step()
+    expected = SphericalMotion(155000, 89.05, 0.19, alpha_deg_s=-0.005).state_at(10.0)[0]
+    np.testing.assert_allclose(world.object_states()[0][0], expected, rtol=1e-15)
+
+
+def test_tracks_only_within_sensor_range():
+    world = world_from(FIELD)
+    assert sorted(t.id for t in world.object_tracks()) == [1, 2, 3, 9]  # target 4 is 40 m away
+    track = next(t for t in world.object_tracks() if t.id == 1)
+    np.testing.assert_allclose(track.position, [2.5, 0, 0])
+    assert track.kind.value == "target" and track.radius == 0.5 and track.motion is not None
+
+
+def test_beacons_report_the_nearest_within_range_with_noise():
+    world = world_from(FIELD)
+    ranges = world.beacon_ranges()
+    assert [r.beacon_id for r in ranges] == [0, 1, 2]  # 100 m each; the far two are not nearest
+    errors = []
+    for _ in range(200):
+        world.step()
+        for r in world.beacon_ranges():
+            errors.append(
+                r.range - np.linalg.norm(world.beacons[r.beacon_id] - world.collector_state()[0])
+            )
+    assert np.std(errors) == pytest.approx(0.1, rel=0.15)
+    assert abs(np.mean(errors)) < 0.02
+
+
+def test_grab_within_reach_fails_beyond_and_beyond_capacity():
+    world = world_from(FIELD)
+    far = world.grab(3)
+    assert not far.success and "out of reach" in far.reason
+    near = world.grab(1)  # 2.5 m between centres: a 1.5 m gap... too far
+    assert not near.success
+    world_close = world_from(
+        FIELD.replace(
+            "position: [2.5, 0, 0], velocity: [0, -0.005657, 0]",
+            "position: [1.8, 0, 0], velocity: [0, -0.004073, 0]",
+        )
+    )
+    grabbed = world_close.grab(1)
+    assert grabbed.success and grabbed.gap == pytest.approx(0.8, abs=1e-6)
+    full = world_close.grab(2)  # 2.2 m: a 1.2 m gap would be out of reach anyway; capacity first
+    assert not full.success and "capacity 1 reached" in full.reason
+    assert not world_close.grab(9).success  # an obstacle is no target
+    assert world_close.grab(1).reason == "target is not free"
+
+
+def test_grabbed_target_leaves_the_field_and_rides_with_the_collector():
+    world = world_from(FIELD.replace("position: [0, 2.2, 0]", "position: [0, 1.9, 0]"))
+    assert world.grab(2).success
+    assert 2 not in [t.id for t in world.object_tracks()]
+
+    def offset_in_collector_frame() -> np.ndarray:
+        position, _, attitude, _ = world.collector_state()
+        rotation = np.array(pb.getMatrixFromQuaternion(attitude)).reshape(3, 3)
+        return rotation.T @ (world.object_states()[0][1] - position)
+
+    before = offset_in_collector_frame()
+    for _ in range(200):
+        world.step(WorldInputs(force=np.array([5.0, 0.0, 0.0])))
+    np.testing.assert_allclose(offset_in_collector_frame(), before, atol=1e-4)
+    assert world.collector_state()[1][0] > 0.05  # the assembly moved
+    # Thrust through the collector's centre, off the assembly's centre of mass, turns it.
+    assert abs(world.collector_state()[3][2]) > 1e-3
+    assert world.assembly_mass() == pytest.approx(world.collector_mass() + 5.0)
+
+
+def test_release_only_at_the_drop_point():
+    world = world_from(
+        FIELD.replace("position: [0, 2.2, 0]", "position: [0, 1.9, 0]").rstrip(" ")
+        + "    drop_point: {position: [0, 0, 0], tolerance: 0.5}\n"
+    )
+    assert world.release().reason == "nothing carried"
+    assert world.grab(2).success
+    assert world.release().delivered == (2,)
+    assert world.outputs()["delivered"] == 1 and world.outputs()["carried"] == 0
+    away = world_from(
+        FIELD.replace("position: [0, 2.2, 0]", "position: [0, 1.9, 0]").rstrip(" ")
+        + "    drop_point: {position: [9, 0, 0], tolerance: 0.5}\n"
+    )
+    assert away.grab(2).success
+    refused = away.release()
+    assert refused.delivered == () and "from the drop point" in refused.reason
+
+
+def test_thrust_bookkeeping_matches_impulse_over_mass():
+    world = world_from("""\
+        world: {frame: geocentric, physics_step: 0.01, control_period: 0.1}
+        robot: {mass: 100, propellant_mass: 10, max_force: 4, specific_impulse: 250}
+        """)
+    force = np.array([3.0, 4.0, 0.0])  # 5 N, clipped to 4 N along the same direction
+    masses = []
+    for _ in range(500):
+        masses.append(world.assembly_mass())
+        world.step(WorldInputs(force=force))
+    applied = 4.0 * force / 5.0
+    expected_velocity = sum(applied * 0.1 / m for m in masses)
+    np.testing.assert_allclose(world.collector_state()[1], expected_velocity, rtol=1e-9)
+    assert world.delta_v == pytest.approx(sum(4.0 * 0.1 / m for m in masses), rel=1e-12)
+    assert world.fuel_used == pytest.approx(4.0 * 50.0 / (250 * STANDARD_GRAVITY), rel=1e-12)
+    assert world.collector_mass() == pytest.approx(100 - world.fuel_used)
+
+
+def test_thrust_stops_when_the_propellant_runs_out():
+    world = world_from("""\
+        world: {frame: geocentric}
+        robot: {mass: 10, propellant_mass: 0.001, max_force: 10, specific_impulse: 100}
+        """)
+    for _ in range(20):
+        world.step(WorldInputs(force=np.array([10.0, 0, 0])))
+    burn_time = 0.001 * 100 * STANDARD_GRAVITY / 10.0  # 0.098 s of full thrust
+    assert world.propellant == 0.0
+    assert world.fuel_used == pytest.approx(0.001)
+    assert world.collector_state()[1][0] == pytest.approx(10.0 * burn_time / 10.0, rel=1e-3)
+
+
+def test_free_collector_drifts_as_clohessy_wiltshire_says():
+    world = world_from("""\
+        world: {frame: lvlh, physics_step: 0.01, control_period: 0.1}
+        robot: {initial: {position: [10, -5, 3], velocity: [0.01, 0.02, -0.005]}}
+        """)
+    for _ in range(6000):  # 600 s, a tenth of an orbit
+        world.step()
+    expected = ClohessyWiltshireMotion((10, -5, 3), (0.01, 0.02, -0.005), N).state_at(600.0)
+    position, velocity, _, _ = world.collector_state()
+    drift = np.linalg.norm(expected[0] - np.array([10, -5, 3]))
+    assert drift > 10.0  # the check would be empty if nothing moved
+    np.testing.assert_allclose(position, expected[0], atol=2e-3)
+    np.testing.assert_allclose(velocity, expected[1], atol=1e-5)
+
+
+def test_collision_is_detected_once_when_contact_starts():
+    world = world_from("""\
+        world: {frame: geocentric, physics_step: 0.01, control_period: 0.1}
+        robot: {radius: 0.5, initial: {position: [0, 0, 0], velocity: [1.0, 0, 0]}}
+        obstacles:
+          - {id: 7, radius: 0.5, motion: {type: static, position: [5, 0, 0]}}
+          - {id: 8, radius: 0.5, motion: {type: cartesian, position: [2.5, 2, 0], velocity: [0, -1, 0]}}
+        """)
+    events = []
+    for _ in range(60):
+        events += world.step()
+    assert [e.object_id for e in events] == [8, 7]
+    first = events[0]
+    # Contact starts when (t - 2.5)² + (2 - t)² = 1, at t = (9 - 7 ** 0.5) / 4.
+    assert first.time == pytest.approx((9 - 7**0.5) / 4, abs=0.011)
+    assert first.body == "collector" and 0 < first.penetration < 0.02
+    assert events[1].time == pytest.approx(4.0, abs=0.011)
+    assert world.nearest_obstacle_distance() < 0
