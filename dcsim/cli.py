@@ -182,6 +182,50 @@ def _print_summary(summary: dict, out: Path) -> None:
     click.echo(f"  results in {out}")
 
 
+@cli.group("bench")
+def bench_group() -> None:
+    """Measure dcsim and its plugins; results go into docs/benchmarks.md."""
+
+
+@bench_group.command("world")
+@click.option(
+    "--objects",
+    default="10,100,1000",
+    show_default=True,
+    help="Comma-separated field sizes (targets and obstacles in all).",
+)
+@click.option(
+    "--duration",
+    type=click.FloatRange(min=1.0),
+    default=60.0,
+    show_default=True,
+    help="Simulated seconds per measurement.",
+)
+def bench_world_command(objects: str, duration: float) -> None:
+    """Closed-loop wall time per simulated second against PyBullet stepping alone.
+
+    For each field size, one synthetic LVLH scenario is stepped bare (stepSimulation
+    only) and flown by the full runner; the closed loop is split by phase of the run
+    loop. Then the default scenario is flown once for its real-time factor. Prints a
+    Markdown table for docs/benchmarks.md.
+    """
+    from dcsim.bench.world import bench_world, markdown_table
+    from dcsim.runner import Runner
+
+    try:
+        sizes = [int(n) for n in objects.split(",")]
+    except ValueError:
+        raise click.BadParameter(f"expected integers like 10,100,1000, got {objects!r}") from None
+    rows = bench_world(sizes, duration, progress=lambda line: click.echo(line, err=True))
+    click.echo(markdown_table(rows))
+    summary = Runner(prepare_run(registry=_registry())).run()
+    click.echo(
+        f"\ndefault scenario: {summary['status']} ({summary['reason']}), "
+        f"{summary['sim_time_s']:.1f} s simulated in {summary['wall_time_s']:.2f} s, "
+        f"real-time factor {summary['real_time_factor']:.0f}"
+    )
+
+
 def main() -> None:
     """Entry point of the ``dcsim`` console script."""
     cli(prog_name="dcsim")

@@ -61,38 +61,55 @@ class MotionModel(ABC):
         return self.state_at(t)[0]
 
     @classmethod
-    def batch_state(cls, models: Sequence[MotionModel], t: float) -> tuple[Vector, Vector]:
-        """Positions and velocities of many models of this class at one time ``t`` (s).
+    def stack(cls, models: Sequence[MotionModel]) -> Any:
+        """Gather the parameters of many models of this class for :meth:`stacked_state`.
 
-        Subclasses vectorise this over their parameters; the default evaluates the
-        models one by one.
-
-        Returns
-        -------
-        positions, velocities : ndarray, shape (N, 3)
+        Subclasses stack their parameters into arrays once, so that evaluating the
+        whole group at any time is one vectorised call; the default keeps the models.
         """
-        states = [m.state_at(t) for m in models]
+        return list(models)
+
+    @classmethod
+    def stacked_state(cls, stacked: Any, t: float) -> tuple[Vector, Vector]:
+        """Positions and velocities (N, 3) at time ``t`` (s) of models gathered by :meth:`stack`."""
+        states = [m.state_at(t) for m in stacked]
         return np.array([p for p, _ in states]), np.array([v for _, v in states])
 
 
-def batch_states(models: Sequence[MotionModel], t: float) -> tuple[Vector, Vector]:
-    """Positions and velocities of any mix of motion models at time ``t`` (s).
+class MotionSet:
+    """Many motion models of any classes, evaluated together.
 
-    Models are grouped by class and each group is evaluated in one vectorised call.
+    Models are grouped by class and each group's parameters are stacked once; each
+    :meth:`state_at` is then one vectorised call per class.
 
-    Returns
-    -------
-    positions, velocities : ndarray, shape (N, 3)
-        In the order of ``models``.
+    Parameters
+    ----------
+    models : sequence of MotionModel
+        The models, in the order results are returned.
     """
-    positions = np.zeros((len(models), 3))
-    velocities = np.zeros((len(models), 3))
-    groups: dict[type[MotionModel], list[int]] = {}
-    for index, model in enumerate(models):
-        groups.setdefault(type(model), []).append(index)
-    for cls, indices in groups.items():
-        positions[indices], velocities[indices] = cls.batch_state([models[i] for i in indices], t)
-    return positions, velocities
+
+    def __init__(self, models: Sequence[MotionModel]) -> None:
+        self.size = len(models)
+        indices: dict[type[MotionModel], list[int]] = {}
+        for index, model in enumerate(models):
+            indices.setdefault(type(model), []).append(index)
+        self._groups = [
+            (cls, np.array(group), cls.stack([models[i] for i in group]))
+            for cls, group in indices.items()
+        ]
+
+    def state_at(self, t: float) -> tuple[Vector, Vector]:
+        """Positions and velocities (N, 3) of all models at time ``t`` (s)."""
+        positions = np.zeros((self.size, 3))
+        velocities = np.zeros((self.size, 3))
+        for cls, group, stacked in self._groups:
+            positions[group], velocities[group] = cls.stacked_state(stacked, t)
+        return positions, velocities
+
+
+def batch_states(models: Sequence[MotionModel], t: float) -> tuple[Vector, Vector]:
+    """Positions and velocities (N, 3) of any mix of motion models at time ``t`` (s)."""
+    return MotionSet(models).state_at(t)
 
 
 def _stack(models: Sequence[Any], name: str) -> np.ndarray:
@@ -119,10 +136,14 @@ class StaticMotion(MotionModel):
         return np.broadcast_to(np.array(self.position), shape).copy(), np.zeros(shape)
 
     @classmethod
-    def batch_state(cls, models: Sequence[MotionModel], t: float) -> tuple[Vector, Vector]:
-        """Fixed positions and zero velocities of ``models``."""
-        positions = _stack(models, "position")
-        return positions, np.zeros_like(positions)
+    def stack(cls, models: Sequence[MotionModel]) -> Any:
+        """The fixed positions, (N, 3)."""
+        return _stack(models, "position")
+
+    @classmethod
+    def stacked_state(cls, stacked: Any, t: float) -> tuple[Vector, Vector]:
+        """Fixed positions and zero velocities."""
+        return stacked.copy(), np.zeros_like(stacked)
 
 
 @dataclass(frozen=True)
@@ -153,10 +174,15 @@ class LinearMotion(MotionModel):
         return _linear_state(np.array(self.position), np.array(self.velocity), tau)
 
     @classmethod
-    def batch_state(cls, models: Sequence[MotionModel], t: float) -> tuple[Vector, Vector]:
+    def stack(cls, models: Sequence[MotionModel]) -> Any:
+        """Positions, velocities and epochs as arrays."""
+        return tuple(_stack(models, name) for name in ("position", "velocity", "epoch"))
+
+    @classmethod
+    def stacked_state(cls, stacked: Any, t: float) -> tuple[Vector, Vector]:
         """Vectorised :meth:`state_at` of many linear motions at time ``t``."""
-        tau = t - _stack(models, "epoch")
-        return _linear_state(_stack(models, "position"), _stack(models, "velocity"), tau)
+        position, velocity, epoch = stacked
+        return _linear_state(position, velocity, t - epoch)
 
 
 def _linear_state(p0: np.ndarray, v0: np.ndarray, tau: np.ndarray) -> tuple[Vector, Vector]:
@@ -200,10 +226,15 @@ class SphericalMotion(MotionModel):
         return _spherical_state(*(getattr(self, n) for n in _SPHERICAL_PARAMETERS), tau)
 
     @classmethod
-    def batch_state(cls, models: Sequence[MotionModel], t: float) -> tuple[Vector, Vector]:
+    def stack(cls, models: Sequence[MotionModel]) -> Any:
+        """The six parameters and the epochs as arrays."""
+        return tuple(_stack(models, name) for name in (*_SPHERICAL_PARAMETERS, "epoch"))
+
+    @classmethod
+    def stacked_state(cls, stacked: Any, t: float) -> tuple[Vector, Vector]:
         """Vectorised :meth:`state_at` of many spherical motions at time ``t``."""
-        tau = t - _stack(models, "epoch")
-        return _spherical_state(*(_stack(models, n) for n in _SPHERICAL_PARAMETERS), tau)
+        *parameters, epoch = stacked
+        return _spherical_state(*parameters, t - epoch)
 
 
 _SPHERICAL_PARAMETERS = ("r", "polar_deg", "azimuth_deg", "v", "alpha_deg_s", "beta_deg_s")
@@ -269,11 +300,20 @@ class ClohessyWiltshireMotion(MotionModel):
         return _cw_state(self.position, self.velocity, self.mean_motion, tau)
 
     @classmethod
-    def batch_state(cls, models: Sequence[MotionModel], t: float) -> tuple[Vector, Vector]:
+    def stack(cls, models: Sequence[MotionModel]) -> Any:
+        """Initial states (transposed), mean motions and epochs as arrays."""
+        return (
+            _stack(models, "position").T,
+            _stack(models, "velocity").T,
+            _stack(models, "mean_motion"),
+            _stack(models, "epoch"),
+        )
+
+    @classmethod
+    def stacked_state(cls, stacked: Any, t: float) -> tuple[Vector, Vector]:
         """Vectorised :meth:`state_at` of many Clohessy–Wiltshire motions at time ``t``."""
-        tau = t - _stack(models, "epoch")
-        n = _stack(models, "mean_motion")
-        return _cw_state(_stack(models, "position").T, _stack(models, "velocity").T, n, tau)
+        position, velocity, n, epoch = stacked
+        return _cw_state(position, velocity, n, t - epoch)
 
 
 def _cw_state(p0: ArrayLike, v0: ArrayLike, n: ArrayLike, tau: np.ndarray) -> tuple[Vector, Vector]:

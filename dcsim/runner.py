@@ -39,6 +39,32 @@ from dcsim.world import World, WorldInputs
 from dcsim.world.objects import ObjectStatus
 
 
+class LapTimer:
+    """Wall time spent in each phase of the run loop, s.
+
+    Attributes
+    ----------
+    totals : dict of str to float
+        Seconds per phase: ``sensors``, ``localiser``, ``mission`` (planners included),
+        ``controller``, ``recording`` (telemetry, hooks, progress) and ``world``
+        (the physics steps of each control period).
+    """
+
+    def __init__(self) -> None:
+        self.totals: dict[str, float] = {}
+        self._last = wallclock.perf_counter()
+
+    def start(self) -> None:
+        """Start timing from now."""
+        self._last = wallclock.perf_counter()
+
+    def lap(self, phase: str) -> None:
+        """Charge the time since the previous lap to ``phase``."""
+        now = wallclock.perf_counter()
+        self.totals[phase] = self.totals.get(phase, 0.0) + now - self._last
+        self._last = now
+
+
 class HookFailure(Exception):
     """A lifecycle hook implementation raised during a run."""
 
@@ -79,6 +105,7 @@ class Runner:
         self.progress = progress
         self.world: World | None = None
         self.summary: dict[str, Any] = {}
+        self.laps = LapTimer()
 
     # ------------------------------------------------------------------ public
     def run(self) -> dict[str, Any]:
@@ -105,8 +132,8 @@ class Runner:
             wall = wallclock.perf_counter() - started
             self.summary = self._summary(status, reason, wall)
             self.world.close()
-            self.recorder.write(self.summary, dump_scenario(self.scenario))
             if self.info.out_dir is not None:
+                self.recorder.write(self.summary, dump_scenario(self.scenario))
                 write_plots(
                     self.info.out_dir,
                     self.scenario,
@@ -118,7 +145,7 @@ class Runner:
 
     # ------------------------------------------------------------------ loop
     def _loop(self, started: float) -> None:
-        world, scenario = self.world, self.scenario
+        world, scenario, laps = self.world, self.scenario, self.laps
         period = world.control_period
         mission = Mission(scenario, world, self.plugins, self._event)
         call_plugin(self.plugins, "localiser", "reset", self._prior(), 0.0)
@@ -126,33 +153,34 @@ class Runner:
         cargo = world.carried_ids()
         targets = int(world.field.is_target.sum())
         last_progress = -np.inf
-        first = True
+        laps.start()
         while True:
             t = world.time
-            tracks = world.object_tracks()
-            if not first:
+            tracks, ranges = world.object_tracks(), world.beacon_ranges()
+            laps.lap("sensors")
+            if t > 0:
                 call_plugin(self.plugins, "localiser", "predict", world.motion_input(), period)
-            call_plugin(self.plugins, "localiser", "update", world.beacon_ranges())
+            call_plugin(self.plugins, "localiser", "update", ranges)
             estimate: LocationEstimate = call_plugin(self.plugins, "localiser", "estimate")
-            previous_mode = mission.mode
+            laps.lap("localiser")
             reference = mission.tick(t, estimate, tracks)
+            laps.lap("mission")
             if world.carried_ids() != cargo:  # a grab or a release changed the mass
                 cargo = world.carried_ids()
                 call_plugin(self.plugins, "controller", "reset", world.robot_spec())
             obstacles = tuple(tr for tr in tracks if tr.kind.value == "obstacle")
+            surroundings = Surroundings(obstacles)
             command = call_plugin(
-                self.plugins,
-                "controller",
-                "command",
-                t,
-                estimate,
-                reference,
-                Surroundings(obstacles),
+                self.plugins, "controller", "command", t, estimate, reference, surroundings
             )
+            laps.lap("controller")
             self._record(t, estimate, mission.mode.name, command.force)
             delivered = world.field.count(ObjectStatus.DELIVERED)
-            self._check_stop(t, delivered, targets, started, previous_mode is not mission.mode)
-            for collision in world.step(WorldInputs(force=command.force, torque=command.torque)):
+            self._check_stop(t, delivered, targets, started)
+            laps.lap("recording")
+            collisions = world.step(WorldInputs(force=command.force, torque=command.torque))
+            laps.lap("world")
+            for collision in collisions:
                 self._event(
                     "collision",
                     at=collision.time,
@@ -163,17 +191,15 @@ class Runner:
                 if scenario.stop.on_collision:
                     self._record_final(mission.mode.name)
                     raise _RunEnded("stopped", f"collision with object {collision.object_id}")
-            first = False
             wall = wallclock.perf_counter()
             if self.progress is not None and wall - last_progress > 0.25:
                 last_progress = wall
                 self.progress(
                     world.time, scenario.world.duration, mission.mode.name, delivered, targets
                 )
+            laps.lap("recording")
 
-    def _check_stop(
-        self, t: float, delivered: int, targets: int, started: float, changed: bool
-    ) -> None:
+    def _check_stop(self, t: float, delivered: int, targets: int, started: float) -> None:
         stop = self.scenario.stop
         if stop.on_all_delivered and targets and delivered == targets:
             raise _RunEnded("completed", "all targets delivered")
@@ -270,6 +296,7 @@ class Runner:
             "localisation_rmse_m": float(np.sqrt(np.mean(errors**2))) if errors.size else None,
             "min_obstacle_distance_m": float(gaps.min()) if gaps.size else None,
             "plugins": self.setup.plugin_versions(),
+            "wall_time_by_phase_s": dict(sorted(self.laps.totals.items())),
         }
 
 

@@ -78,7 +78,17 @@ def prepare_run(
     registry = registry if registry is not None else PluginRegistry.discover()
     if seed is not None:
         overrides = [*overrides, f"world.seed={seed}"]
-    scenario = load_scenario(path, overrides, registry)
+    return build_run(load_scenario(path, overrides, registry), registry)
+
+
+def build_run(scenario: Scenario, registry: PluginRegistry) -> RunSetup:
+    """Construct the plugins of a validated scenario, each with its own generator.
+
+    Raises
+    ------
+    PluginError
+        If a plugin is unknown or its parameters are invalid.
+    """
     sources = {role: registry.get(role, getattr(scenario, role).plugin) for role in PLUGIN_KINDS}
     plugins = {
         role: entry.cls(getattr(scenario, role).params, component_rng(scenario.world.seed, role))

@@ -172,3 +172,14 @@ def test_debug_shows_the_traceback(dcsim_cli):
     assert result.returncode != 0
     assert "Traceback" in result.stderr
     assert "ScenarioError" in result.stderr
+
+
+def test_bench_world_prints_a_table_for_each_size(dcsim_cli):
+    result = dcsim_cli("bench", "world", "--objects", "5,20", "--duration", "2")
+    assert result.returncode == 0, result.stderr
+    rows = [
+        line for line in result.stdout.splitlines() if line.startswith("| ") and line[2].isdigit()
+    ]
+    assert [row.split("|")[1].strip() for row in rows] == ["5", "20"]
+    assert "default scenario: completed (all targets delivered)" in result.stdout
+    assert "5 objects: bare stepping" in result.stderr

@@ -117,6 +117,11 @@ def build_objects(scenario: Scenario) -> list[SpaceObject]:
 class World:
     """A steppable PyBullet world built from a scenario.
 
+    As a system it has named inputs (:class:`WorldInputs`: force, torque and the
+    disturbance force and torque, set before each :meth:`step` of one control period),
+    named outputs (:meth:`outputs`) and parameters (:meth:`parameters`); it is usable
+    without the runner.
+
     Parameters
     ----------
     scenario : Scenario
@@ -221,6 +226,11 @@ class World:
 
     # ------------------------------------------------------------------ state
     @property
+    def client(self) -> int:
+        """The PyBullet client id, for tools that query PyBullet directly."""
+        return self._client
+
+    @property
     def time(self) -> float:
         """Simulated time, s."""
         return self._steps * self.physics_step
@@ -279,6 +289,24 @@ class World:
             p, _ = pb.getBasePositionAndOrientation(body, physicsClientId=self._client)
             spheres.append((np.array(p), self.field.objects[index].radius))
         return spheres
+
+    def parameters(self) -> dict[str, float]:
+        """Named scalar parameters of the world as a system (fixed for its lifetime)."""
+        r = self.robot
+        return {
+            "physics_step": self.physics_step,
+            "control_period": self.control_period,
+            "robot.mass": r.mass,
+            "robot.propellant_mass": r.propellant_mass,
+            "robot.radius": r.radius,
+            "robot.max_force": r.max_force,
+            "robot.max_torque": r.max_torque,
+            "robot.specific_impulse": r.specific_impulse,
+            "robot.sensor_range": r.sensor_range,
+            "robot.grab_distance": r.grab_distance,
+            "robot.capacity": float(r.capacity),
+            "mean_motion": self._mean_motion or 0.0,
+        }
 
     def outputs(self) -> dict[str, object]:
         """Named outputs of the world as a system (true state and bookkeeping)."""
@@ -413,7 +441,9 @@ class World:
             accel += 2 * float(np.linalg.norm(self._cw_acceleration(position, velocity)))
         sweep = np.linalg.norm(velocity) * period + accel * period**2
         now = self.field.free_states(self.time)[0][free]
-        later = self.field.free_states(self.time + period)[0][free]
+        later = self.field.free_states((self._steps + self.steps_per_control) * self.physics_step)[
+            0
+        ][free]
         moves = np.linalg.norm(later - now, axis=1)
         gaps = np.linalg.norm(now - position, axis=1) - reach - self.field.radii[free]
         self._candidates = free[gaps <= 1.5 * (moves + sweep) + _BROAD_PHASE_SLACK]

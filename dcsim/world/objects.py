@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dcsim.messages import ObjectKind
-from dcsim.motion import MotionModel, batch_states
+from dcsim.motion import MotionModel, MotionSet
 
 
 class ObjectStatus(enum.IntEnum):
@@ -66,8 +66,8 @@ class ObjectField:
         self.is_target = np.array([o.kind is ObjectKind.TARGET for o in self.objects], dtype=bool)
         self.status = np.full(len(self.objects), ObjectStatus.FREE, dtype=int)
         self.index = {o.id: i for i, o in enumerate(self.objects)}
-        self._models = [o.motion for o in self.objects]
-        self._cache: tuple[float, np.ndarray, np.ndarray] | None = None
+        self._motions = MotionSet([o.motion for o in self.objects])
+        self._cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
 
     def __len__(self) -> int:
         return len(self.objects)
@@ -76,14 +76,14 @@ class ObjectField:
         """Positions and velocities (N, 3) of every object as its motion model gives them.
 
         Only the rows of free objects describe where the objects are; carried objects
-        move with the collector. Results are cached for the latest ``t``.
+        move with the collector. The two latest times are cached (the world asks for
+        the start and the end of each control period).
         """
-        if self._cache is None or self._cache[0] != t:
-            positions, velocities = (
-                batch_states(self._models, t) if self._models else (np.zeros((0, 3)),) * 2
-            )
-            self._cache = (t, positions, velocities)
-        return self._cache[1], self._cache[2]
+        if t not in self._cache:
+            if len(self._cache) >= 2:
+                self._cache.pop(min(self._cache))
+            self._cache[t] = self._motions.state_at(t)
+        return self._cache[t]
 
     def free_mask(self) -> np.ndarray:
         """Boolean mask of the objects that are free."""

@@ -211,3 +211,25 @@ def test_collision_is_detected_once_when_contact_starts():
     assert first.body == "collector" and 0 < first.penetration < 0.02
     assert events[1].time == pytest.approx(4.0, abs=0.011)
     assert world.nearest_obstacle_distance() < 0
+
+
+def test_the_world_is_a_system_with_named_inputs_outputs_and_parameters():
+    world = world_from(FIELD)
+    assert world.parameters()["robot.max_force"] == 5.0
+    assert world.parameters()["mean_motion"] == pytest.approx(N)
+    outputs = world.outputs()
+    assert {
+        "position",
+        "velocity",
+        "attitude",
+        "angular_velocity",
+        "fuel_used",
+        "delta_v",
+        "carried",
+        "delivered",
+        "collisions",
+        "nearest_obstacle_distance",
+    } <= set(outputs)
+    world.inputs = WorldInputs(disturbance_force=np.array([0.0, 0.0, 2.0]))
+    world.step()
+    assert world.outputs()["velocity"][2] > 0 and world.outputs()["fuel_used"] == 0.0

@@ -1,0 +1,156 @@
+"""``dcsim bench world``: the closed loop's cost against PyBullet stepping alone.
+
+For each field size the benchmark builds one synthetic LVLH scenario (four targets near
+the collector, the rest obstacles on bounded Clohessy–Wiltshire orbits 60–500 m away)
+and measures, on that same world:
+
+- **bare stepping**: ``stepSimulation`` alone for the simulated time;
+- **closed loop**: the full runner (sensors, localiser, mission, planners, controller,
+  forces, collision checks, telemetry), recording in memory.
+
+Both are reported as wall time per simulated second, and the closed loop is split by
+phase of the run loop (the runner's lap timer): the world's control-period step
+(physics included), sensors, localiser, mission (planners included), controller and
+recording.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from dcsim.motion import mean_motion
+from dcsim.registry import PluginRegistry
+from dcsim.runner import Runner
+from dcsim.runsetup import build_run
+from dcsim.scenario.model import Scenario
+from dcsim.seeding import component_rng
+from dcsim.world import World
+from dcsim.world.pybullet_client import pb
+
+ORBIT_RADIUS = 6_778_137.0
+_TARGETS = ([15.0, 30.0, 5.0], [-10.0, 45.0, -5.0], [20.0, -35.0, 0.0], [-15.0, -25.0, 8.0])
+_BEACONS = [[100, 100, 100], [100, -100, -100], [-100, 100, -100], [-100, -100, 100]]
+
+
+PHASES = ("world", "sensors", "localiser", "mission", "controller", "recording")
+"""Phases of the run loop the closed-loop time is split into (see ``LapTimer``)."""
+
+
+@dataclass(frozen=True)
+class WorldBenchRow:
+    """One field size's measurements, in seconds of wall time per simulated second.
+
+    Attributes
+    ----------
+    objects : int
+        Targets and obstacles in the field.
+    bare : float
+        ``stepSimulation`` alone.
+    closed_loop : float
+        The full runner.
+    phases : dict of str to float
+        The closed loop split by phase of the run loop.
+    """
+
+    objects: int
+    bare: float
+    closed_loop: float
+    phases: dict[str, float]
+
+    @property
+    def overhead(self) -> float:
+        """Closed-loop time over bare stepping, minus one (0.5 is 50 % more)."""
+        return self.closed_loop / self.bare - 1.0
+
+
+def field_scenario(objects: int, duration: float, seed: int = 0) -> Scenario:
+    """The synthetic benchmark scenario with ``objects`` targets and obstacles in all."""
+    rng = np.random.default_rng(seed)
+    n = mean_motion(ORBIT_RADIUS)
+
+    def cw(position: list[float], vz: float = 0.0) -> dict:
+        return {"type": "cw", "position": position, "velocity": [0.0, -2 * n * position[0], vz]}
+
+    targets = [
+        {"id": i, "radius": 0.3, "mass": 5.0, "motion": cw(p)}
+        for i, p in enumerate(_TARGETS[: min(4, objects)])
+    ]
+    obstacles = []
+    for i in range(len(targets), objects):
+        direction = rng.normal(size=3)
+        position = direction / np.linalg.norm(direction) * rng.uniform(60.0, 500.0)
+        obstacles.append(
+            {"id": i, "radius": 1.0, "motion": cw(position.tolist(), rng.normal(0, 0.01))}
+        )
+    return Scenario.model_validate(
+        {
+            "name": f"bench-{objects}",
+            "world": {"frame": "lvlh", "orbit": {"radius": ORBIT_RADIUS}, "duration": duration},
+            "robot": {"radius": 0.5, "max_force": 5.0, "max_speed": 0.5, "sensor_range": 120.0},
+            "targets": targets,
+            "obstacles": obstacles,
+            "beacons": {"positions": _BEACONS, "noise_sigma": 0.05, "report_nearest": 4},
+            "drop_point": {"position": [-5.0, 0.0, 0.0], "tolerance": 1.5},
+            "stop": {"on_collision": False, "on_all_delivered": False},
+        }
+    )
+
+
+def bare_stepping(scenario: Scenario) -> float:
+    """Wall seconds per simulated second of ``stepSimulation`` alone on the scenario's world."""
+    with World(scenario, component_rng(0, "world")) as world:
+        steps = round(scenario.world.duration / world.physics_step)
+        start = time.perf_counter()
+        for _ in range(steps):
+            pb.stepSimulation(physicsClientId=world.client)
+        return (time.perf_counter() - start) / scenario.world.duration
+
+
+def closed_loop(scenario: Scenario, registry: PluginRegistry) -> tuple[float, dict[str, float]]:
+    """Wall seconds per simulated second of the full runner, in all and by phase."""
+    runner = Runner(build_run(scenario, registry))
+    start = time.perf_counter()
+    runner.run()
+    elapsed = time.perf_counter() - start
+    duration = scenario.world.duration
+    return elapsed / duration, {p: runner.laps.totals.get(p, 0.0) / duration for p in PHASES}
+
+
+def bench_world(
+    sizes: list[int], duration: float, progress: Callable[[str], None] = print
+) -> list[WorldBenchRow]:
+    """Measure every field size; ``progress`` receives a line per finished size."""
+    registry = PluginRegistry.discover()
+    closed_loop(field_scenario(4, 5.0), registry)  # warm up: imports, caches
+    rows = []
+    for objects in sizes:
+        scenario = field_scenario(objects, duration)
+        bare = bare_stepping(scenario)
+        loop, phases = closed_loop(scenario, registry)
+        rows.append(WorldBenchRow(objects, bare, loop, phases))
+        progress(
+            f"{objects} objects: bare stepping {1e3 * bare:.1f} ms, "
+            f"closed loop {1e3 * loop:.1f} ms per simulated second"
+        )
+    return rows
+
+
+def markdown_table(rows: list[WorldBenchRow]) -> str:
+    """The measurements as a Markdown table (milliseconds of wall time per simulated second)."""
+    head = (
+        "| objects | bare stepping | closed loop | overhead | real-time factor | "
+        + " | ".join(PHASES)
+        + " |"
+    )
+    lines = [head, "|" + "---:|" * (5 + len(PHASES))]
+    for r in rows:
+        phases = " | ".join(f"{1e3 * r.phases[p]:.2f}" for p in PHASES)
+        lines.append(
+            f"| {r.objects} | {1e3 * r.bare:.2f} | {1e3 * r.closed_loop:.2f} | "
+            f"{100 * r.overhead:.0f} % | {1 / r.closed_loop:.0f} | {phases} |"
+        )
+    return "\n".join(lines)
