@@ -22,6 +22,7 @@ run: $(STAMP)
 # Regenerate the generated parts of docs/ (a test fails while they are stale).
 docs: $(STAMP)
 	$(BIN)/python -m dcsim.scenario.reference docs/scenarios.md
+	$(BIN)/python -m dcsim.testing.reference docs/plugins.md
 
 clean:
 	rm -rf $(VENV) build *.egg-info

@@ -182,6 +182,32 @@ def _print_summary(summary: dict, out: Path) -> None:
     click.echo(f"  results in {out}")
 
 
+@cli.command("new-plugin")
+@click.argument("kind", type=click.Choice(list(PLUGIN_KINDS)))
+@click.argument("name")
+@click.option(
+    "--dir",
+    "directory",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=Path("."),
+    show_default=True,
+    help="Folder to create the package in.",
+)
+def new_plugin_command(kind: str, name: str, directory: Path) -> None:
+    """Write an out-of-tree plugin package of KIND called NAME.
+
+    The package (DIR/dcsim-NAME) has a pyproject.toml with the dcsim entry point, the
+    plugin class with its parameter model and a simple working algorithm, a test file
+    that runs the conformance suite, and a README. Install it with
+    `pip install -e DIR/dcsim-NAME` and run `pytest` inside it.
+    """
+    from dcsim.scaffold import new_plugin
+
+    root = new_plugin(kind, name, directory)
+    click.echo(f"wrote {root}")
+    click.echo(f"next: pip install -e '{root}[test]' && (cd {root} && pytest)")
+
+
 @cli.group("bench")
 def bench_group() -> None:
     """Measure dcsim and its plugins; results go into docs/benchmarks.md."""

@@ -6,6 +6,7 @@ import os
 import subprocess
 import sys
 import textwrap
+import venv
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -100,3 +101,53 @@ def good_plugin_dist(tmp_path) -> Path:
         {"dcsim_hold": GOOD_PLUGIN},
         {"hold": "dcsim_hold"},
     )
+
+
+@dataclass
+class FreshEnvironment:
+    """A new virtual environment with dcsim installed from its wheel (and pytest)."""
+
+    root: Path
+    wheel: Path
+
+    def run(
+        self, program: str, *args: str, cwd: Path, timeout: float = 600
+    ) -> subprocess.CompletedProcess:
+        """Run one of the environment's programs (``dcsim``, ``python``, ``pip``)."""
+        environment = {
+            k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")
+        }
+        return subprocess.run(
+            [str(self.root / "bin" / program), *args],
+            cwd=cwd,
+            capture_output=True,
+            text=True,
+            env=environment,
+            timeout=timeout,
+        )
+
+
+@pytest.fixture(scope="session")
+def wheel(tmp_path_factory) -> Path:
+    """dcsim built as a wheel from this checkout."""
+    out = tmp_path_factory.mktemp("wheel")
+    subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "--quiet", "--no-deps", "-w", str(out), str(REPO)],
+        check=True,
+        capture_output=True,
+        timeout=300,
+    )
+    return next(out.glob("dcsim-*.whl"))
+
+
+@pytest.fixture(scope="session")
+def fresh_env(wheel, tmp_path_factory) -> FreshEnvironment:
+    """A fresh environment where dcsim was installed as a user would: from the wheel."""
+    root = tmp_path_factory.mktemp("fresh") / "env"
+    venv.create(root, with_pip=True)
+    env = FreshEnvironment(root, wheel)
+    installed = env.run(
+        "python", "-m", "pip", "install", "--quiet", str(wheel), "pytest", cwd=root.parent
+    )
+    assert installed.returncode == 0, installed.stderr
+    return env

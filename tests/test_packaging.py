@@ -2,14 +2,8 @@
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
 import tomllib
-import venv
 import zipfile
-
-import pytest
 
 from tests.conftest import REPO
 
@@ -29,18 +23,6 @@ def test_every_package_directory_is_listed_in_pyproject():
     assert set(config["packages"]) == _source_packages()
 
 
-@pytest.fixture(scope="module")
-def wheel(tmp_path_factory):
-    out = tmp_path_factory.mktemp("wheel")
-    subprocess.run(
-        [sys.executable, "-m", "pip", "wheel", "--quiet", "--no-deps", "-w", str(out), str(REPO)],
-        check=True,
-        capture_output=True,
-        timeout=300,
-    )
-    return next(out.glob("dcsim-*.whl"))
-
-
 def test_wheel_carries_the_default_scenario_plugins_and_entry_points(wheel):
     with zipfile.ZipFile(wheel) as archive:
         names = set(archive.namelist())
@@ -53,34 +35,11 @@ def test_wheel_carries_the_default_scenario_plugins_and_entry_points(wheel):
     assert "pd = dcsim_plugins.pd" in entry_points and "dcsim = dcsim.cli:main" in entry_points
 
 
-def test_wheel_installs_into_a_fresh_environment_and_runs(wheel, tmp_path):
-    env_dir = tmp_path / "env"
-    venv.create(env_dir, with_pip=True)
-    python = env_dir / "bin" / "python"
-    subprocess.run(
-        [str(python), "-m", "pip", "install", "--quiet", str(wheel)],
-        check=True,
-        capture_output=True,
-        timeout=600,
-    )
-    environment = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
-    run = subprocess.run(
-        [str(env_dir / "bin" / "dcsim"), "run", "--out", "out", "--set", "world.duration=5"],
-        cwd=tmp_path,
-        capture_output=True,
-        text=True,
-        env=environment,
-        timeout=120,
-    )
+def test_wheel_installs_into_a_fresh_environment_and_runs(fresh_env, tmp_path):
+    run = fresh_env.run("dcsim", "run", "--out", "out", "--set", "world.duration=5", cwd=tmp_path)
     assert run.returncode == 0, run.stderr
     assert run.stdout.startswith("default seed 0: completed (duration reached)")
     assert (tmp_path / "out" / "scenario.yaml").is_file()
     assert (tmp_path / "out" / "plots" / "trajectory.png").is_file()
-    listing = subprocess.run(
-        [str(env_dir / "bin" / "dcsim"), "plugins"],
-        cwd=tmp_path,
-        capture_output=True,
-        text=True,
-        env=environment,
-    )
+    listing = fresh_env.run("dcsim", "plugins", cwd=tmp_path)
     assert "straight-line" in listing.stdout and listing.stderr == ""

@@ -227,8 +227,10 @@ def test_spherical_points_convert_to_cartesian(tmp_path):
 
 
 def test_docs_key_reference_matches_the_schema():
+    from dcsim.docgen import block
     from dcsim.scenario.reference import BEGIN, END, render_reference
 
     text = (REPO / "docs" / "scenarios.md").read_text()
-    block = text.split(BEGIN, 1)[1].split(END, 1)[0]
-    assert block == "\n" + render_reference(), "docs/scenarios.md is stale: run `make docs`"
+    assert block(text, BEGIN, END) == render_reference(), (
+        "docs/scenarios.md is stale: run `make docs`"
+    )

@@ -16,6 +16,7 @@ from typing import Annotated, Any, Literal, Union, get_args, get_origin
 from pydantic import BaseModel
 from pydantic_core import PydanticUndefined
 
+from dcsim.docgen import update_block
 from dcsim.params import field_bounds, field_unit
 from dcsim.scenario.model import MotionSpec, PluginChoice, Scenario, SphericalPoint, Vec3
 
@@ -119,16 +120,7 @@ def render_reference() -> str:
     return "\n\n".join(blocks) + "\n"
 
 
-def update_file(path: Path) -> bool:
-    """Rewrite the generated block of ``path``; return True if it changed."""
-    text = path.read_text(encoding="utf-8")
-    head, _, rest = text.partition(BEGIN)
-    _, _, tail = rest.partition(END)
-    new = f"{head}{BEGIN}\n{render_reference()}{END}{tail}"
-    path.write_text(new, encoding="utf-8")
-    return new != text
-
-
 if __name__ == "__main__":
     target = Path(sys.argv[1] if len(sys.argv) > 1 else "docs/scenarios.md")
-    print(f"{target}: {'updated' if update_file(target) else 'already up to date'}")
+    changed = update_block(target, BEGIN, END, render_reference())
+    print(f"{target}: {'updated' if changed else 'already up to date'}")

@@ -1,0 +1,408 @@
+"""The plugin contracts, one check each.
+
+A check is a function taking the plugin class and raising :class:`ContractViolation`
+with a message that says what the plugin did and what the contract expects. Checks are
+registered per kind with :func:`contract`; :func:`checks_for` lists those that apply to
+a kind, in a stable order.
+"""
+
+from __future__ import annotations
+
+import ast
+import copy
+import dataclasses
+import inspect
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from dcsim.errors import PluginInterfaceError, PluginParameterError
+from dcsim.interfaces import PLUGIN_KINDS, Controller, Localiser, Plugin
+from dcsim.messages import (
+    Command,
+    LocationEstimate,
+    NoPath,
+    Plan,
+    Reference,
+    Surroundings,
+    Trajectory,
+)
+from dcsim.registry import check_plugin_class
+from dcsim.testing import problems
+
+SEED = 1234
+"""Seed of the generator every plugin under test is constructed with."""
+
+LOCALISER_ERROR_BOUND = 1.0
+"""Largest position error (m) a localiser may have at the end of the standard problem."""
+
+TIME_SLACK = 0.2
+"""Wall time (s) allowed beyond a time budget (and 20 % of it) for returning."""
+
+
+class ContractViolation(AssertionError):
+    """A plugin broke a contract; the message says how and what was expected."""
+
+
+@dataclass(frozen=True)
+class Check:
+    """One contract check.
+
+    Attributes
+    ----------
+    name : str
+        Identifier, used as the test name (``deterministic``, ``converges``...).
+    kinds : tuple of str
+        Plugin kinds it applies to.
+    contract : str
+        The contract in words.
+    function : callable
+        ``function(plugin_class)``; raises :class:`ContractViolation`.
+    """
+
+    name: str
+    kinds: tuple[str, ...]
+    contract: str
+    function: Callable[[type[Plugin]], None]
+
+    def run(self, plugin_class: type[Plugin]) -> None:
+        """Run the check, prefixing any violation with the plugin and the contract."""
+        try:
+            self.function(plugin_class)
+        except ContractViolation as violation:
+            raise ContractViolation(
+                f"{_label(plugin_class)} breaks '{self.name}': {violation}\n"
+                f"  contract: {self.contract}"
+            ) from None
+
+
+_CHECKS: list[Check] = []
+
+
+def contract(name: str, text: str, kinds: tuple[str, ...] = tuple(PLUGIN_KINDS)) -> Callable:
+    """Register the decorated function as the check ``name`` for ``kinds``."""
+
+    def register(function: Callable[[type[Plugin]], None]) -> Callable[[type[Plugin]], None]:
+        _CHECKS.append(Check(name, kinds, text, function))
+        return function
+
+    return register
+
+
+def checks_for(kind: str) -> list[Check]:
+    """Every check that applies to plugins of ``kind``."""
+    return [c for c in _CHECKS if kind in c.kinds]
+
+
+def _label(plugin_class: type) -> str:
+    kind = getattr(plugin_class, "kind", "?")
+    return f"{kind} plugin '{getattr(plugin_class, 'name', plugin_class.__name__)}'"
+
+
+def make(plugin_class: type[Plugin], params: Any = None, seed: int = SEED) -> Plugin:
+    """A plugin instance with ``params`` (defaults if None) and a generator seeded with ``seed``."""
+    return plugin_class(params, np.random.default_rng(seed))
+
+
+def _fail(message: str) -> None:
+    raise ContractViolation(message)
+
+
+# --------------------------------------------------------------------- exercises
+# For each kind: the standard inputs, and how to feed them to a plugin.
+
+
+def _localiser_inputs(empty: bool) -> list:
+    problem = problems.beacon_problem(steps=40)
+    steps = [(s.motion, s.dt, [] if empty else list(s.ranges)) for s in problem.steps]
+    return [problem.prior, problem.start_time, steps]
+
+
+def _feed_localiser(plugin: Localiser, inputs: list) -> list:
+    prior, start, steps = inputs
+    plugin.reset(prior, start)
+    outputs = []
+    for motion, dt, ranges in steps:
+        plugin.predict(motion, dt)
+        plugin.update(ranges)
+        outputs.append(plugin.estimate())
+    return outputs
+
+
+def _controller_inputs(empty: bool) -> list:
+    rng = np.random.default_rng(3)
+    obstacles = () if empty else problems.path_problem().obstacles
+    ticks = []
+    for k in range(20):
+        t = 0.1 * k
+        estimate = LocationEstimate(
+            time=t, position=rng.normal(0, 10, 3), velocity=rng.normal(0, 0.2, 3), converged=True
+        )
+        reference = Reference(time=t, position=rng.normal(0, 10, 3), velocity=rng.normal(0, 0.1, 3))
+        ticks.append((t, estimate, reference, Surroundings(obstacles)))
+    return [problems.ROBOT, ticks]
+
+
+def _feed_controller(plugin: Controller, inputs: list) -> list:
+    robot, ticks = inputs
+    plugin.reset(robot)
+    return [plugin.command(*tick) for tick in ticks]
+
+
+def _path_inputs(empty: bool) -> list:
+    problem = problems.path_problem()
+    if empty:
+        problem = dataclasses.replace(problem, obstacles=(), bounds=None)
+    return [problem]
+
+
+_INPUTS: dict[str, Callable[[bool], list]] = {
+    "localiser": _localiser_inputs,
+    "task_planner": lambda empty: [problems.task_request(targets=0 if empty else 6)],
+    "path_planner": _path_inputs,
+    "controller": _controller_inputs,
+}
+_FEEDS: dict[str, Callable[[Any, list], list]] = {
+    "localiser": _feed_localiser,
+    "task_planner": lambda plugin, inputs: [plugin.plan(request) for request in inputs],
+    "path_planner": lambda plugin, inputs: [plugin.plan(problem) for problem in inputs],
+    "controller": _feed_controller,
+}
+
+
+def standard_inputs(kind: str, empty: bool = False) -> list:
+    """The standard inputs of a kind (``empty``: no beacons, targets or obstacles)."""
+    return _INPUTS[kind](empty)
+
+
+def feed(plugin: Plugin, inputs: list) -> list:
+    """Feed standard inputs to a plugin; return its outputs in order."""
+    return _FEEDS[plugin.kind](plugin, inputs)
+
+
+def _same(a: Any, b: Any) -> bool:
+    """Deep equality of messages, arrays, tuples, lists and floats (NaN equal to NaN)."""
+    if isinstance(a, (list, tuple)):
+        return (
+            type(a) is type(b)
+            and len(a) == len(b)
+            and all(_same(x, y) for x, y in zip(a, b, strict=True))
+        )
+    if isinstance(a, np.ndarray):
+        return (
+            isinstance(b, np.ndarray)
+            and a.shape == b.shape
+            and np.array_equal(a, b, equal_nan=True)
+        )
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    if dataclasses.is_dataclass(a) and type(a) is type(b):
+        return all(_same(getattr(a, f.name), getattr(b, f.name)) for f in dataclasses.fields(a))
+    return bool(a == b)
+
+
+def _flatten(items: list) -> list:
+    """The leaves of nested input lists, for pointing at the one that differs."""
+    out = []
+    for item in items:
+        out.extend(_flatten(item) if isinstance(item, list) else [item])
+    return out
+
+
+def _first_difference(first: list, second: list) -> int:
+    return next(i for i, (x, y) in enumerate(zip(first, second, strict=True)) if not _same(x, y))
+
+
+def _run(plugin_class: type[Plugin], inputs: list, what: str) -> list:
+    try:
+        return feed(make(plugin_class), inputs)
+    except Exception as error:  # a plugin's own failure: name it, with the problem posed
+        raise ContractViolation(f"raised {type(error).__name__}: {error} on {what}") from error
+
+
+# --------------------------------------------------------------------- every kind
+
+
+@contract(
+    "declares_metadata",
+    "the class derives from its kind, sets `name` and a one-line `summary`, "
+    "and has a `Params` model",
+)
+def check_metadata(plugin_class: type[Plugin]) -> None:
+    try:
+        check_plugin_class(plugin_class)
+    except PluginInterfaceError as error:
+        _fail(str(error))
+
+
+METADATA_CHECK = _CHECKS[-1]
+"""The check every other check relies on."""
+
+
+@contract(
+    "parameters_round_trip",
+    "the default parameters dumped to plain data validate back to an equal model",
+)
+def check_round_trip(plugin_class: type[Plugin]) -> None:
+    defaults = plugin_class.Params.parse(plugin_class.name, None)
+    dumped = defaults.model_dump(mode="json")
+    again = plugin_class.Params.parse(plugin_class.name, dumped)
+    if again != defaults:
+        _fail(f"{dumped} validated to {again.model_dump()}, not to the defaults it came from")
+
+
+@contract(
+    "constructs_with_defaults",
+    "the class constructs with no parameters (all defaults) and a seeded generator",
+)
+def check_construction(plugin_class: type[Plugin]) -> None:
+    try:
+        make(plugin_class)
+    except Exception as error:  # a plugin's own constructor failing
+        _fail(f"construction with defaults raised {type(error).__name__}: {error}")
+
+
+def _invalid_parameter_sets(plugin_class: type[Plugin]) -> list[dict[str, Any]]:
+    """An unknown parameter, and each bounded parameter just outside its bound."""
+    cases: list[dict[str, Any]] = [{"no_such_parameter_xyz": 1}]
+    outside = {"gt": 0.0, "ge": -1.0, "lt": 0.0, "le": 1.0}
+    for name, info in plugin_class.Params.model_fields.items():
+        for meta in info.metadata:
+            for attr, offset in outside.items():
+                bound = getattr(meta, attr, None)
+                if bound is not None:
+                    cases.append({name: bound + offset})
+    return cases
+
+
+@contract(
+    "rejects_invalid_parameters",
+    "unknown parameters and values outside their declared bounds raise PluginParameterError",
+)
+def check_invalid_parameters(plugin_class: type[Plugin]) -> None:
+    for values in _invalid_parameter_sets(plugin_class):
+        try:
+            plugin_class(values, np.random.default_rng(0))
+        except PluginParameterError:
+            continue
+        except Exception as error:  # anything else is the wrong way to refuse
+            name = type(error).__name__
+            _fail(f"parameters {values} raised {name}: {error}, not PluginParameterError")
+        _fail(f"parameters {values} were accepted")
+
+
+@contract(
+    "deterministic",
+    "two instances with the same seed, given the same inputs, give identical outputs",
+)
+def check_determinism(plugin_class: type[Plugin]) -> None:
+    first = _run(plugin_class, standard_inputs(plugin_class.kind), "the standard problem")
+    second = _run(plugin_class, standard_inputs(plugin_class.kind), "the standard problem")
+    if not _same(first, second):
+        i = _first_difference(first, second)
+        _fail(
+            f"output {i} differs between two identically seeded runs: {first[i]!r} vs {second[i]!r}"
+        )
+
+
+@contract(
+    "does_not_mutate_inputs",
+    "every input (lists, messages and their arrays) is unchanged after the plugin used it",
+)
+def check_no_mutation(plugin_class: type[Plugin]) -> None:
+    inputs = standard_inputs(plugin_class.kind)
+    pristine = copy.deepcopy(inputs)
+    _run(plugin_class, inputs, "the standard problem")
+    given, kept = _flatten(inputs), _flatten(pristine)
+    if not _same(given, kept):
+        i = _first_difference(given, kept)
+        _fail(f"an input was changed: it is now {given[i]!r}, it was given as {kept[i]!r}")
+
+
+def _check_output(kind: str, output: Any) -> str | None:
+    """Why an output is not of the documented type, shape and finiteness (None if fine)."""
+    expected = {
+        "localiser": (LocationEstimate,),
+        "task_planner": (Plan,),
+        "path_planner": (Trajectory, NoPath),
+        "controller": (Command,),
+    }[kind]
+    if not isinstance(output, expected):
+        wanted = " or ".join(t.__name__ for t in expected)
+        return f"returned {type(output).__name__}, expected {wanted}"
+    if isinstance(output, NoPath):
+        return None if output.reason.strip() else "returned NoPath without a reason"
+    arrays = [getattr(output, f.name) for f in dataclasses.fields(output)]
+    if isinstance(output, Plan):
+        arrays += [
+            x
+            for task in output.tasks
+            for x in (task.pickup_time, task.pickup_point, task.pickup_velocity)
+        ]
+        arrays += [x for visit in output.drop_visits for x in (visit.time, visit.point)]
+    numbers = [
+        np.asarray(a, dtype=float)
+        for a in arrays
+        if isinstance(a, (float, int, np.ndarray)) and not isinstance(a, bool)
+    ]
+    if not all(np.all(np.isfinite(n)) for n in numbers):
+        return f"returned non-finite values: {output!r}"
+    if isinstance(output, LocationEstimate) and abs(np.linalg.norm(output.heading) - 1.0) > 1e-6:
+        return f"heading {output.heading} is not a unit vector"
+    if isinstance(output, Trajectory) and (
+        len(output.times) < 2 or np.any(np.diff(output.times) <= 0)
+    ):
+        return "trajectory times are not strictly increasing over at least two samples"
+    return None
+
+
+@contract(
+    "outputs_well_formed",
+    "outputs are of the documented types, with finite values and valid shapes",
+)
+def check_outputs(plugin_class: type[Plugin]) -> None:
+    for output in _run(plugin_class, standard_inputs(plugin_class.kind), "the standard problem"):
+        problem = _check_output(plugin_class.kind, output)
+        if problem:
+            _fail(problem)
+
+
+@contract(
+    "uses_only_the_public_api",
+    "the plugin's module imports nothing of dcsim but dcsim.api, so it cannot reach ground "
+    "truth: it works from its inputs alone",
+)
+def check_public_api(plugin_class: type[Plugin]) -> None:
+    try:
+        source = inspect.getsource(inspect.getmodule(plugin_class))
+    except (OSError, TypeError):
+        return  # classes defined interactively have no source to read
+    for node in ast.walk(ast.parse(source)):
+        names = []
+        if isinstance(node, ast.Import):
+            names = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            names = [node.module]
+        for name in names:
+            if name.split(".")[0] == "dcsim" and name not in ("dcsim.api", "dcsim.testing"):
+                _fail(f"imports {name}; plugins may use dcsim.api only")
+
+
+@contract(
+    "handles_empty_inputs",
+    "with no beacons in view, no targets or no obstacles the plugin returns its documented "
+    "empty answer (an unconverged estimate, an empty plan, a path, a command) instead of raising",
+)
+def check_empty_inputs(plugin_class: type[Plugin]) -> None:
+    outputs = _run(plugin_class, standard_inputs(plugin_class.kind, empty=True), "empty inputs")
+    for output in outputs:
+        problem = _check_output(plugin_class.kind, output)
+        if problem:
+            _fail(f"on empty inputs {problem}")
+    if plugin_class.kind == "task_planner" and (outputs[0].tasks or outputs[0].drop_visits):
+        _fail(f"with no targets and nothing carried the plan should be empty, got {outputs[0]!r}")
+    if plugin_class.kind == "path_planner" and not isinstance(outputs[0], Trajectory):
+        _fail(f"with no obstacles and no bounds there is a path, got {outputs[0]!r}")

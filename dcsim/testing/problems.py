@@ -1,0 +1,202 @@
+"""Standard problems the conformance suite poses to each plugin kind.
+
+Each problem is built from a fixed seed, so every plugin is measured on exactly the same
+inputs. They are small enough to run in well under a second per check.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from dcsim.messages import (
+    BeaconRange,
+    Bounds,
+    DropPoint,
+    GoalRegion,
+    LocationEstimate,
+    MotionInput,
+    ObjectKind,
+    ObjectTrack,
+    PathProblem,
+    PathState,
+    Prior,
+    RobotSpec,
+    TaskRequest,
+)
+from dcsim.motion import LinearMotion, StaticMotion
+
+BEACONS = np.array(
+    [
+        [150.0, 150.0, 150.0],
+        [150.0, -150.0, -150.0],
+        [-150.0, 150.0, -150.0],
+        [-150.0, -150.0, 150.0],
+        [0.0, 0.0, -200.0],
+    ]
+)
+"""Beacon positions of the standard beacon problem, m."""
+
+ROBOT = RobotSpec(mass=100.0, radius=0.5, max_force=5.0, max_torque=0.5, max_speed=0.5)
+"""The collector of the controller and planner problems."""
+
+
+@dataclass(frozen=True)
+class BeaconStep:
+    """One step of the standard beacon problem.
+
+    Attributes
+    ----------
+    motion : MotionInput
+        Commanded acceleration over the step.
+    dt : float
+        Step length, s.
+    ranges : list of BeaconRange
+        Ranges measured at the end of the step.
+    truth : ndarray (3,)
+        True position at the end of the step (for scoring only; never given to the plugin).
+    """
+
+    motion: MotionInput
+    dt: float
+    ranges: list[BeaconRange]
+    truth: np.ndarray
+
+
+@dataclass(frozen=True)
+class BeaconProblem:
+    """A manoeuvring collector ranging to fixed beacons, from a wide prior.
+
+    Attributes
+    ----------
+    prior : Prior
+        The initial belief: 40 m off the truth, with a 50 m standard deviation.
+    start_time : float
+        Time of the prior, s.
+    steps : list of BeaconStep
+        The measurements, in order.
+    """
+
+    prior: Prior
+    start_time: float
+    steps: list[BeaconStep]
+
+
+def beacon_problem(
+    seed: int = 0, steps: int = 240, sigma: float = 0.1, nearest: int = 4
+) -> BeaconProblem:
+    """The standard localisation problem: 120 s at 2 Hz, ranges to the nearest beacons.
+
+    Parameters
+    ----------
+    seed : int
+        Seed of the range noise.
+    steps : int
+        Number of predict/update steps (0.5 s each).
+    sigma : float
+        Range noise standard deviation, m.
+    nearest : int
+        Beacons reported per step.
+    """
+    rng = np.random.default_rng(seed)
+    dt = 0.5
+    position = np.array([10.0, -20.0, 5.0])
+    velocity = np.array([0.2, 0.1, 0.0])
+    prior = Prior(
+        position=position + [30.0, -20.0, 20.0],
+        position_sigma=50.0,
+        velocity=[0, 0, 0],
+        velocity_sigma=0.5,
+    )
+    out = []
+    for k in range(steps):
+        acceleration = 0.01 * np.array([np.sin(0.05 * k), np.cos(0.03 * k), -np.sin(0.02 * k)])
+        position = position + velocity * dt + 0.5 * acceleration * dt**2
+        velocity = velocity + acceleration * dt
+        distances = np.linalg.norm(BEACONS - position, axis=1)
+        order = np.argsort(distances)[:nearest]
+        measured = distances[order] + rng.normal(0.0, sigma, len(order))
+        ranges = [
+            BeaconRange(int(i), BEACONS[i], float(r), sigma)
+            for i, r in zip(order, measured, strict=True)
+        ]
+        out.append(BeaconStep(MotionInput(acceleration), dt, ranges, position.copy()))
+    return BeaconProblem(prior, 0.0, out)
+
+
+def target_track(
+    target_id: int, position, velocity=(0.0, 0.0, 0.0), time: float = 100.0
+) -> ObjectTrack:
+    """A target observed at ``time`` moving in a straight line."""
+    motion = LinearMotion(position, velocity, epoch=time)
+    return ObjectTrack(
+        target_id, ObjectKind.TARGET, time, position, velocity, mass=5.0, radius=0.3, motion=motion
+    )
+
+
+def obstacle_track(
+    obstacle_id: int, position, velocity=(0.0, 0.0, 0.0), radius: float = 1.0, time: float = 0.0
+) -> ObjectTrack:
+    """An obstacle observed at ``time`` moving in a straight line."""
+    motion = LinearMotion(position, velocity, epoch=time)
+    return ObjectTrack(
+        obstacle_id,
+        ObjectKind.OBSTACLE,
+        time,
+        position,
+        velocity,
+        mass=50.0,
+        radius=radius,
+        motion=motion,
+    )
+
+
+def task_request(targets: int = 6, time_budget: float = 1.0, capacity: int = 2) -> TaskRequest:
+    """The standard task-planning request: slow targets within 40 m, capacity 2.
+
+    Every target is reachable well within an hour at the request's limits.
+    """
+    rng = np.random.default_rng(7)
+    tracks = tuple(
+        target_track(i + 1, rng.uniform(-40.0, 40.0, 3), rng.normal(0.0, 0.01, 3))
+        for i in range(targets)
+    )
+    return TaskRequest(
+        time=100.0,
+        robot=LocationEstimate(time=100.0, position=[0.0, 0.0, 0.0], converged=True),
+        targets=tracks,
+        drop_point=DropPoint(StaticMotion((-5.0, 0.0, 0.0)), tolerance=1.5),
+        capacity=capacity,
+        carried=0,
+        max_speed=ROBOT.max_speed,
+        max_acceleration=0.025,
+        time_budget=time_budget,
+    )
+
+
+def path_problem(time_budget: float = 1.0) -> PathProblem:
+    """The standard path problem: 40 m across a box, obstacles near but off the direct line."""
+    return PathProblem(
+        start=PathState(time=0.0, position=[0.0, 0.0, 0.0]),
+        goal=GoalRegion(position=[40.0, 5.0, 0.0], tolerance=1.0),
+        obstacles=(
+            obstacle_track(1, (20.0, 12.0, 0.0), radius=2.0),
+            obstacle_track(2, (10.0, -8.0, 3.0), velocity=(0.0, -0.05, 0.0)),
+            obstacle_track(3, (30.0, 3.0, 12.0), velocity=(0.0, 0.0, 0.1), radius=1.5),
+        ),
+        robot_radius=ROBOT.radius,
+        max_speed=ROBOT.max_speed,
+        max_acceleration=0.025,
+        max_delta_v=5.0,
+        bounds=Bounds(lower=[-10.0, -30.0, -30.0], upper=[60.0, 30.0, 30.0]),
+        time_budget=time_budget,
+    )
+
+
+def impossible_path_problem(time_budget: float = 1.0) -> PathProblem:
+    """The standard path problem with the goal inside a static obstacle."""
+    problem = path_problem(time_budget)
+    blocker = obstacle_track(9, (40.0, 5.0, 0.0), radius=3.0)
+    return dataclasses.replace(problem, obstacles=(*problem.obstacles, blocker))

@@ -1,0 +1,182 @@
+"""The conformance suite: every built-in plugin passes it, and broken plugins are caught."""
+
+from __future__ import annotations
+
+import dataclasses
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+from dcsim_plugins.nearest import NearestTaskPlanner
+from dcsim_plugins.pd import PDController
+from dcsim_plugins.straight_line import StraightLinePlanner
+from dcsim_plugins.trilateration import TrilaterationLocaliser
+
+from dcsim.api import Command, PluginRegistry
+from dcsim.testing import ControllerContract, check_plugin, checks_for
+from tests.testing.peeking_plugin import PeekingController
+
+BUILTINS = [p for p in PluginRegistry.discover().plugins() if p.origin.distribution == "dcsim"]
+
+
+@pytest.mark.parametrize(
+    "plugin, check",
+    [(p.cls, c) for p in BUILTINS for c in checks_for(p.kind)],
+    ids=[f"{p.kind}:{p.name}::{c.name}" for p in BUILTINS for c in checks_for(p.kind)],
+)
+def test_builtin_plugins_keep_every_contract(plugin, check):
+    check.run(plugin)
+
+
+def test_every_kind_has_builtins_under_test():
+    assert {p.kind for p in BUILTINS} == {"localiser", "task_planner", "path_planner", "controller"}
+
+
+# ----------------------------------------------------------------- broken plugins
+
+
+class MutatingLocaliser(TrilaterationLocaliser):
+    name = "mutating"
+    summary = "Drops the farthest range from the list it is given (test)"
+
+    def update(self, ranges):
+        if ranges:
+            ranges.pop()
+        super().update(ranges)
+
+
+class NondeterministicPlanner(NearestTaskPlanner):
+    name = "nondeterministic"
+    summary = "Perturbs its plan with an unseeded generator (test)"
+
+    def plan(self, request):
+        plan = super().plan(request)
+        return type(plan)(
+            plan.tasks, plan.drop_visits, plan.cost + np.random.default_rng().random()
+        )
+
+
+class OverreachingController(PDController):
+    name = "overreaching"
+    summary = "Asks twice the force limit (test)"
+
+    def command(self, time, estimate, reference, surroundings):
+        force = super().command(time, estimate, reference, surroundings).force
+        norm = np.linalg.norm(force)
+        return Command(force=force / norm * 2 * self.robot.max_force if norm else force)
+
+
+class SlowPlanner(NearestTaskPlanner):
+    name = "slow"
+    summary = "Ignores its time budget (test)"
+
+    def plan(self, request):
+        time.sleep(request.time_budget + 0.5)
+        return super().plan(request)
+
+
+class FragilePathPlanner(StraightLinePlanner):
+    name = "fragile"
+    summary = "Raises when there are no obstacles (test)"
+
+    def plan(self, problem):
+        if not problem.obstacles:
+            raise IndexError("no obstacles to avoid")
+        return super().plan(problem)
+
+
+class LostLocaliser(TrilaterationLocaliser):
+    name = "lost"
+    summary = "Ignores every range (test)"
+
+    def update(self, ranges):
+        return None
+
+
+class CarelessPathPlanner(StraightLinePlanner):
+    name = "careless"
+    summary = "Flies straight even through obstacles (test)"
+
+    def plan(self, problem):
+        return super().plan(dataclasses.replace(problem, obstacles=()))
+
+
+@pytest.mark.parametrize(
+    "plugin, failing",
+    [
+        (MutatingLocaliser, {"does_not_mutate_inputs"}),
+        (NondeterministicPlanner, {"deterministic"}),
+        (OverreachingController, {"commands_within_limits"}),
+        (SlowPlanner, {"honours_time_budget"}),
+        (FragilePathPlanner, {"handles_empty_inputs"}),
+        (LostLocaliser, {"converges"}),
+        (CarelessPathPlanner, {"answers_no_path"}),
+        (PeekingController, {"uses_only_the_public_api"}),
+    ],
+    ids=lambda value: getattr(value, "name", None) or "-".join(sorted(value)),
+)
+def test_broken_plugins_are_reported_by_the_right_check(plugin, failing):
+    results = {r.check: r for r in check_plugin(plugin)}
+    failed = {name for name, r in results.items() if not r.passed}
+    assert failing <= failed, results
+    for name in failing:
+        message = results[name].message
+        assert f"plugin '{plugin.name}' breaks '{name}'" in message and "contract: " in message
+
+
+def test_messages_say_what_the_plugin_did():
+    results = {r.check: r for r in check_plugin(OverreachingController)}
+    assert "asks 10.000 N" in results["commands_within_limits"].message
+    assert "the limits are 5.0 N" in results["commands_within_limits"].message
+    slow = {r.check: r for r in check_plugin(SlowPlanner)}["honours_time_budget"].message
+    assert "with a budget of 0.3 s" in slow
+
+
+def test_a_class_that_is_no_plugin_fails_only_the_metadata_check():
+    (result,) = check_plugin(int)
+    assert result.check == "declares_metadata" and not result.passed
+    assert "is not a plugin class" in result.message
+
+
+class TestSubclassingTheContractRunsEveryCheck(ControllerContract):
+    plugin = PDController
+
+
+def test_contract_classes_get_one_test_per_check():
+    names = {n for n in dir(TestSubclassingTheContractRunsEveryCheck) if n.startswith("test_")}
+    assert names == {f"test_{c.name}" for c in checks_for("controller")}
+
+
+def test_pytest_option_runs_the_suite_against_an_installed_plugin(tmp_path):
+    command = [sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-q", "--dcsim-plugin"]
+    passing = subprocess.run(
+        [*command, "controller:pd"], cwd=tmp_path, capture_output=True, text=True
+    )
+    assert passing.returncode == 0, passing.stdout
+    assert f"{len(checks_for('controller'))} passed" in passing.stdout
+    unknown = subprocess.run(
+        [*command, "controller:nope"], cwd=tmp_path, capture_output=True, text=True
+    )
+    assert unknown.returncode != 0 and "no controller plugin named 'nope'" in unknown.stdout
+
+
+def test_docs_list_every_check_and_every_hook():
+    import inspect
+
+    from dcsim import hookspecs
+    from dcsim.docgen import block
+    from dcsim.testing.reference import BEGIN, END, render_checks
+    from tests.conftest import REPO
+
+    text = (REPO / "docs" / "plugins.md").read_text()
+    assert block(text, BEGIN, END) == render_checks(), "docs/plugins.md is stale: run `make docs`"
+    specs = [
+        name
+        for name, function in inspect.getmembers(hookspecs, inspect.isfunction)
+        if hasattr(function, "dcsim_spec")
+    ]
+    assert len(specs) == 5
+    for name in specs:
+        assert f"### {name}\n" in text, f"hook {name} has no entry in docs/plugins.md"
