@@ -107,7 +107,8 @@ def make(plugin_class: type[Plugin], params: Any = None, seed: int = SEED) -> Pl
     return plugin_class(params, np.random.default_rng(seed))
 
 
-def _fail(message: str) -> None:
+def fail(message: str) -> None:
+    """Raise a :class:`ContractViolation` saying what the plugin did."""
     raise ContractViolation(message)
 
 
@@ -216,7 +217,8 @@ def _first_difference(first: list, second: list) -> int:
     return next(i for i, (x, y) in enumerate(zip(first, second, strict=True)) if not _same(x, y))
 
 
-def _run(plugin_class: type[Plugin], inputs: list, what: str) -> list:
+def run_plugin(plugin_class: type[Plugin], inputs: list, what: str) -> list:
+    """Feed ``inputs`` to a fresh instance; an exception becomes a violation naming ``what``."""
     try:
         return feed(make(plugin_class), inputs)
     except Exception as error:  # a plugin's own failure: name it, with the problem posed
@@ -235,7 +237,7 @@ def check_metadata(plugin_class: type[Plugin]) -> None:
     try:
         check_plugin_class(plugin_class)
     except PluginInterfaceError as error:
-        _fail(str(error))
+        fail(str(error))
 
 
 METADATA_CHECK = _CHECKS[-1]
@@ -251,7 +253,7 @@ def check_round_trip(plugin_class: type[Plugin]) -> None:
     dumped = defaults.model_dump(mode="json")
     again = plugin_class.Params.parse(plugin_class.name, dumped)
     if again != defaults:
-        _fail(f"{dumped} validated to {again.model_dump()}, not to the defaults it came from")
+        fail(f"{dumped} validated to {again.model_dump()}, not to the defaults it came from")
 
 
 @contract(
@@ -262,7 +264,7 @@ def check_construction(plugin_class: type[Plugin]) -> None:
     try:
         make(plugin_class)
     except Exception as error:  # a plugin's own constructor failing
-        _fail(f"construction with defaults raised {type(error).__name__}: {error}")
+        fail(f"construction with defaults raised {type(error).__name__}: {error}")
 
 
 def _invalid_parameter_sets(plugin_class: type[Plugin]) -> list[dict[str, Any]]:
@@ -290,8 +292,8 @@ def check_invalid_parameters(plugin_class: type[Plugin]) -> None:
             continue
         except Exception as error:  # anything else is the wrong way to refuse
             name = type(error).__name__
-            _fail(f"parameters {values} raised {name}: {error}, not PluginParameterError")
-        _fail(f"parameters {values} were accepted")
+            fail(f"parameters {values} raised {name}: {error}, not PluginParameterError")
+        fail(f"parameters {values} were accepted")
 
 
 @contract(
@@ -299,11 +301,11 @@ def check_invalid_parameters(plugin_class: type[Plugin]) -> None:
     "two instances with the same seed, given the same inputs, give identical outputs",
 )
 def check_determinism(plugin_class: type[Plugin]) -> None:
-    first = _run(plugin_class, standard_inputs(plugin_class.kind), "the standard problem")
-    second = _run(plugin_class, standard_inputs(plugin_class.kind), "the standard problem")
+    first = run_plugin(plugin_class, standard_inputs(plugin_class.kind), "the standard problem")
+    second = run_plugin(plugin_class, standard_inputs(plugin_class.kind), "the standard problem")
     if not _same(first, second):
         i = _first_difference(first, second)
-        _fail(
+        fail(
             f"output {i} differs between two identically seeded runs: {first[i]!r} vs {second[i]!r}"
         )
 
@@ -315,11 +317,11 @@ def check_determinism(plugin_class: type[Plugin]) -> None:
 def check_no_mutation(plugin_class: type[Plugin]) -> None:
     inputs = standard_inputs(plugin_class.kind)
     pristine = copy.deepcopy(inputs)
-    _run(plugin_class, inputs, "the standard problem")
+    run_plugin(plugin_class, inputs, "the standard problem")
     given, kept = _flatten(inputs), _flatten(pristine)
     if not _same(given, kept):
         i = _first_difference(given, kept)
-        _fail(f"an input was changed: it is now {given[i]!r}, it was given as {kept[i]!r}")
+        fail(f"an input was changed: it is now {given[i]!r}, it was given as {kept[i]!r}")
 
 
 def _check_output(kind: str, output: Any) -> str | None:
@@ -364,10 +366,12 @@ def _check_output(kind: str, output: Any) -> str | None:
     "outputs are of the documented types, with finite values and valid shapes",
 )
 def check_outputs(plugin_class: type[Plugin]) -> None:
-    for output in _run(plugin_class, standard_inputs(plugin_class.kind), "the standard problem"):
+    for output in run_plugin(
+        plugin_class, standard_inputs(plugin_class.kind), "the standard problem"
+    ):
         problem = _check_output(plugin_class.kind, output)
         if problem:
-            _fail(problem)
+            fail(problem)
 
 
 @contract(
@@ -388,7 +392,7 @@ def check_public_api(plugin_class: type[Plugin]) -> None:
             names = [node.module]
         for name in names:
             if name.split(".")[0] == "dcsim" and name not in ("dcsim.api", "dcsim.testing"):
-                _fail(f"imports {name}; plugins may use dcsim.api only")
+                fail(f"imports {name}; plugins may use dcsim.api only")
 
 
 @contract(
@@ -397,12 +401,14 @@ def check_public_api(plugin_class: type[Plugin]) -> None:
     "empty answer (an unconverged estimate, an empty plan, a path, a command) instead of raising",
 )
 def check_empty_inputs(plugin_class: type[Plugin]) -> None:
-    outputs = _run(plugin_class, standard_inputs(plugin_class.kind, empty=True), "empty inputs")
+    outputs = run_plugin(
+        plugin_class, standard_inputs(plugin_class.kind, empty=True), "empty inputs"
+    )
     for output in outputs:
         problem = _check_output(plugin_class.kind, output)
         if problem:
-            _fail(f"on empty inputs {problem}")
+            fail(f"on empty inputs {problem}")
     if plugin_class.kind == "task_planner" and (outputs[0].tasks or outputs[0].drop_visits):
-        _fail(f"with no targets and nothing carried the plan should be empty, got {outputs[0]!r}")
+        fail(f"with no targets and nothing carried the plan should be empty, got {outputs[0]!r}")
     if plugin_class.kind == "path_planner" and not isinstance(outputs[0], Trajectory):
-        _fail(f"with no obstacles and no bounds there is a path, got {outputs[0]!r}")
+        fail(f"with no obstacles and no bounds there is a path, got {outputs[0]!r}")

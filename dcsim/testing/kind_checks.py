@@ -12,10 +12,10 @@ from dcsim.testing import problems
 from dcsim.testing.contracts import (
     LOCALISER_ERROR_BOUND,
     TIME_SLACK,
-    _fail,
-    _run,
     contract,
+    fail,
     make,
+    run_plugin,
     standard_inputs,
 )
 
@@ -29,7 +29,7 @@ def _localise(plugin_class: type[Plugin]) -> tuple[list[LocationEstimate], probl
         problem.start_time,
         [(s.motion, s.dt, list(s.ranges)) for s in problem.steps],
     ]
-    return _run(plugin_class, inputs, "the standard beacon problem"), problem
+    return run_plugin(plugin_class, inputs, "the standard beacon problem"), problem
 
 
 @contract(
@@ -43,9 +43,9 @@ def check_convergence(plugin_class: type[Plugin]) -> None:
     final = estimates[-1]
     error = float(np.linalg.norm(final.position - problem.steps[-1].truth))
     if error >= LOCALISER_ERROR_BOUND:
-        _fail(f"final position error {error:.3f} m after {len(estimates)} updates")
+        fail(f"final position error {error:.3f} m after {len(estimates)} updates")
     if not final.converged:
-        _fail(f"the estimate never reported converged (final error {error:.3f} m)")
+        fail(f"the estimate never reported converged (final error {error:.3f} m)")
 
 
 @contract(
@@ -59,9 +59,9 @@ def check_covariance(plugin_class: type[Plugin]) -> None:
         c = estimate.covariance
         scale = max(float(np.abs(c).max()), 1e-300)
         if np.abs(c - c.T).max() > 1e-9 * scale:
-            _fail(f"covariance {index} is not symmetric:\n{c}")
+            fail(f"covariance {index} is not symmetric:\n{c}")
         if np.linalg.eigvalsh(0.5 * (c + c.T)).min() < -1e-9 * scale:
-            _fail(f"covariance {index} has a negative eigenvalue:\n{c}")
+            fail(f"covariance {index} has a negative eigenvalue:\n{c}")
 
 
 # --------------------------------------------------------------------- task planner
@@ -69,7 +69,7 @@ def check_covariance(plugin_class: type[Plugin]) -> None:
 
 def _plan(plugin_class: type[Plugin], request=None):
     request = request or problems.task_request()
-    return _run(plugin_class, [request], "the standard task request")[0], request
+    return run_plugin(plugin_class, [request], "the standard task request")[0], request
 
 
 @contract(
@@ -82,11 +82,9 @@ def check_known_targets(plugin_class: type[Plugin]) -> None:
     known = {t.id for t in request.targets}
     ids = [task.target_id for task in plan.tasks]
     if set(ids) - known:
-        _fail(
-            f"planned unknown targets {sorted(set(ids) - known)}; the request has {sorted(known)}"
-        )
+        fail(f"planned unknown targets {sorted(set(ids) - known)}; the request has {sorted(known)}")
     if len(ids) != len(set(ids)):
-        _fail(f"planned a target more than once: {ids}")
+        fail(f"planned a target more than once: {ids}")
 
 
 def _events(plan) -> list[tuple[float, str]]:
@@ -109,13 +107,13 @@ def check_times(plugin_class: type[Plugin]) -> None:
     plan, request = _plan(plugin_class)
     events = _events(plan)
     if events and events[0][0] < request.time:
-        _fail(
+        fail(
             f"the {events[0][1]} is at {events[0][0]:g} s, "
             f"before the request time {request.time:g} s"
         )
     for (t0, a), (t1, b) in zip(events, events[1:], strict=False):
         if t1 <= t0:
-            _fail(f"the {b} at {t1:g} s is not after the {a} at {t0:g} s")
+            fail(f"the {b} at {t1:g} s is not after the {a} at {t0:g} s")
 
 
 @contract(
@@ -130,14 +128,14 @@ def check_capacity(plugin_class: type[Plugin]) -> None:
     for index, task in enumerate(plan.tasks):
         carried += 1
         if carried > request.capacity:
-            _fail(
+            fail(
                 f"target {task.target_id} would be the {carried}th on board; "
                 f"capacity is {request.capacity}"
             )
         if index in drops:
             carried = 0
     if plan.tasks and (len(plan.tasks) - 1) not in drops:
-        _fail("the last pickup is not followed by a drop visit")
+        fail("the last pickup is not followed by a drop visit")
 
 
 @contract(
@@ -149,7 +147,7 @@ def check_completeness(plugin_class: type[Plugin]) -> None:
     plan, request = _plan(plugin_class)
     missing = {t.id for t in request.targets} - {task.target_id for task in plan.tasks}
     if missing:
-        _fail(f"targets {sorted(missing)} were left out of the plan")
+        fail(f"targets {sorted(missing)} were left out of the plan")
 
 
 @contract(
@@ -165,7 +163,7 @@ def check_task_budget(plugin_class: type[Plugin]) -> None:
     plugin.plan(request)
     elapsed = time.perf_counter() - start
     if elapsed > 1.2 * request.time_budget + TIME_SLACK:
-        _fail(f"took {elapsed:.3f} s with a budget of {request.time_budget} s")
+        fail(f"took {elapsed:.3f} s with a budget of {request.time_budget} s")
 
 
 # --------------------------------------------------------------------- path planner
@@ -173,9 +171,9 @@ def check_task_budget(plugin_class: type[Plugin]) -> None:
 
 def _path(plugin_class: type[Plugin]) -> tuple[Trajectory, object]:
     problem = problems.path_problem()
-    result = _run(plugin_class, [problem], "the standard path problem")[0]
+    result = run_plugin(plugin_class, [problem], "the standard path problem")[0]
     if not isinstance(result, Trajectory):
-        _fail(f"found no path on the standard problem, which has one: {result!r}")
+        fail(f"found no path on the standard problem, which has one: {result!r}")
     return result, problem
 
 
@@ -206,13 +204,13 @@ def check_endpoints(plugin_class: type[Plugin]) -> None:
     trajectory, problem = _path(plugin_class)
     start_gap = np.linalg.norm(trajectory.positions[0] - problem.start.position)
     if start_gap > 1e-6 or abs(trajectory.times[0] - problem.start.time) > 1e-9:
-        _fail(
+        fail(
             f"starts {start_gap:.3g} m and {trajectory.times[0] - problem.start.time:.3g} s "
             "away from the start state"
         )
     end_gap = np.linalg.norm(trajectory.positions[-1] - problem.goal.position)
     if end_gap > problem.goal.tolerance:
-        _fail(
+        fail(
             f"ends {end_gap:.3f} m from the goal; "
             f"the goal region's radius is {problem.goal.tolerance} m"
         )
@@ -229,7 +227,7 @@ def check_bounds(plugin_class: type[Plugin]) -> None:
     outside = ~problem.bounds.contains(positions)
     if outside.any():
         i = int(np.flatnonzero(outside)[0])
-        _fail(f"at t = {times[i]:.2f} s it is at {positions[i]}, outside {problem.bounds!r}")
+        fail(f"at t = {times[i]:.2f} s it is at {positions[i]}, outside {problem.bounds!r}")
 
 
 @contract(
@@ -243,9 +241,9 @@ def check_limits(plugin_class: type[Plugin]) -> None:
     speeds = np.linalg.norm(velocities, axis=1)
     if speeds.max() > problem.max_speed * (1 + 1e-6):
         i = int(np.argmax(speeds))
-        _fail(f"speed {speeds[i]:.4f} m/s at t = {times[i]:.2f} s exceeds {problem.max_speed} m/s")
+        fail(f"speed {speeds[i]:.4f} m/s at t = {times[i]:.2f} s exceeds {problem.max_speed} m/s")
     if trajectory.delta_v > problem.max_delta_v:
-        _fail(
+        fail(
             f"needs {trajectory.delta_v:.3f} m/s of delta-v; the limit is {problem.max_delta_v} m/s"
         )
 
@@ -267,7 +265,7 @@ def check_collisions(plugin_class: type[Plugin]) -> None:
         )
         if gaps.min() < 0:
             i = int(np.argmin(gaps))
-            _fail(f"overlaps obstacle {obstacle.id} by {-gaps[i]:.3f} m at t = {times[i]:.2f} s")
+            fail(f"overlaps obstacle {obstacle.id} by {-gaps[i]:.3f} m at t = {times[i]:.2f} s")
 
 
 @contract(
@@ -278,12 +276,12 @@ def check_collisions(plugin_class: type[Plugin]) -> None:
 def check_impossible(plugin_class: type[Plugin]) -> None:
     problem = problems.impossible_path_problem(time_budget=1.0)
     start = time.perf_counter()
-    result = _run(plugin_class, [problem], "a problem whose goal is inside an obstacle")[0]
+    result = run_plugin(plugin_class, [problem], "a problem whose goal is inside an obstacle")[0]
     elapsed = time.perf_counter() - start
     if not isinstance(result, NoPath) or not result.reason.strip():
-        _fail(f"answered {result!r} for a goal inside obstacle 9")
+        fail(f"answered {result!r} for a goal inside obstacle 9")
     if elapsed > 1.2 * problem.time_budget + TIME_SLACK:
-        _fail(f"took {elapsed:.3f} s with a budget of {problem.time_budget} s")
+        fail(f"took {elapsed:.3f} s with a budget of {problem.time_budget} s")
 
 
 # --------------------------------------------------------------------- controller
@@ -297,11 +295,11 @@ def check_impossible(plugin_class: type[Plugin]) -> None:
 def check_command_limits(plugin_class: type[Plugin]) -> None:
     robot = problems.ROBOT
     for index, command in enumerate(
-        _run(plugin_class, standard_inputs("controller"), "the standard ticks")
+        run_plugin(plugin_class, standard_inputs("controller"), "the standard ticks")
     ):
         force, torque = np.linalg.norm(command.force), np.linalg.norm(command.torque)
         if force > robot.max_force * (1 + 1e-9) or torque > robot.max_torque * (1 + 1e-9):
-            _fail(
+            fail(
                 f"command {index} asks {force:.3f} N and {torque:.3f} N*m; the limits are "
                 f"{robot.max_force} N and {robot.max_torque} N*m"
             )
@@ -317,12 +315,12 @@ def check_rest(plugin_class: type[Plugin]) -> None:
     estimate = LocationEstimate(time=0.0, position=[3.0, -4.0, 5.0], converged=True)
     reference = Reference(time=0.0, position=[3.0, -4.0, 5.0])
     inputs = [robot, [(0.0, estimate, reference, Surroundings())]]
-    command = _run(plugin_class, inputs, "a collector at rest on its reference")[0]
+    command = run_plugin(plugin_class, inputs, "a collector at rest on its reference")[0]
     if (
         np.linalg.norm(command.force) > 1e-6 * robot.max_force
         or np.linalg.norm(command.torque) > 1e-6 * robot.max_torque
     ):
-        _fail(f"commands {command!r} while at rest on the reference")
+        fail(f"commands {command!r} while at rest on the reference")
 
 
 @contract(
@@ -346,4 +344,4 @@ def check_double_integrator(plugin_class: type[Plugin]) -> None:
         position = position + velocity * dt
     error, speed = float(np.linalg.norm(position)), float(np.linalg.norm(velocity))
     if error > 0.1 or speed > 0.01:
-        _fail(f"after 1000 s it is {error:.3f} m from the reference moving at {speed:.4f} m/s")
+        fail(f"after 1000 s it is {error:.3f} m from the reference moving at {speed:.4f} m/s")
