@@ -252,6 +252,57 @@ def bench_world_command(objects: str, duration: float) -> None:
     )
 
 
+@bench_group.command("localisers")
+@click.option(
+    "--runs", type=click.IntRange(min=1), default=10, show_default=True, help="Monte Carlo runs."
+)
+@click.option(
+    "--steps",
+    type=click.IntRange(min=10),
+    default=400,
+    show_default=True,
+    help="Updates per run (0.5 s each).",
+)
+@click.option(
+    "--sigma",
+    type=click.FloatRange(min=0, min_open=True),
+    default=1.0,
+    show_default=True,
+    help="Range noise, m.",
+)
+@click.option(
+    "--acceleration-sigma",
+    type=click.FloatRange(min=0, min_open=True),
+    default=0.005,
+    show_default=True,
+    help="Thrust noise of the manoeuvring collector, m/s^2 (the filters are told).",
+)
+@click.option(
+    "--plot",
+    "plot_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Save the RMSE-over-time plot here.",
+)
+def bench_localisers_command(
+    runs: int, steps: int, sigma: float, acceleration_sigma: float, plot_path: Path | None
+) -> None:
+    """Localisers' RMSE against the posterior Cramér–Rao bound, and their update latency.
+
+    Every localiser (trilateration, ekf, ukf, sspf with 1k, 10k and 100k particles; the
+    last on two runs only) flies the same runs of a manoeuvring collector ranging to the
+    three nearest of eight beacons. Prints a Markdown table for docs/benchmarks.md.
+    """
+    from dcsim.bench.localisers import bench_localisers, markdown_table, plot
+
+    bound, results = bench_localisers(
+        runs, steps, sigma, acceleration_sigma, progress=lambda line: click.echo(line, err=True)
+    )
+    click.echo(markdown_table(bound, results))
+    if plot_path is not None:
+        plot(bound, results, plot_path)
+        click.echo(f"plot: {plot_path}")
+
+
 def main() -> None:
     """Entry point of the ``dcsim`` console script."""
     cli(prog_name="dcsim")

@@ -104,7 +104,7 @@ def test_run_default_writes_a_run_directory_and_prints_a_summary(dcsim_cli, tmp_
     resolved = yaml.safe_load((run_dir / "scenario.yaml").read_text())
     assert resolved["controller"]["params"]["bandwidth"] > 0  # defaults filled in
     summary = json.loads((run_dir / "summary.json").read_text())
-    assert summary["plugins"]["localiser"]["name"] == "trilateration"
+    assert summary["plugins"]["localiser"]["name"] == "ekf"
     assert summary["sim_time_s"] == pytest.approx(3.0)
     assert result.stderr == ""  # no progress bar when piped, no PyBullet banner
 

@@ -304,3 +304,10 @@ def test_thesis_debris_field_runs_to_completion():
     assert summary["status"] == "completed" and summary["reason"] == "all targets delivered"
     assert summary["delivered"] == 4 and summary["collisions"] == 0
     assert set(modes(runner.recorder.events)) <= ALLOWED
+
+
+@pytest.mark.parametrize("localiser", ["trilateration", "ukf", "sspf"])
+def test_default_scenario_delivers_with_each_localiser(localiser):
+    _, summary = run(overrides=[f"localiser.plugin={localiser}"])
+    assert summary["status"] == "completed" and summary["delivered"] == 4
+    assert summary["collisions"] == 0

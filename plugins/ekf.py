@@ -1,0 +1,124 @@
+"""``ekf`` localiser: an extended Kalman filter on beacon ranges (filterpy).
+
+State ``[position, velocity]`` with a constant-velocity model driven by the commanded
+acceleration; thrust uncertainty is white acceleration noise ``acceleration_sigma``.
+Each update uses however many ranges are in view (none skips the update), linearised
+at the current estimate. The filter starts from the first least-squares fix once three
+or more beacons are in view (``initialise: fix``), or straight from the prior
+(``initialise: prior``). It reports converged once the position's largest standard
+deviation is below ``convergence_sigma``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Literal
+
+import numpy as np
+from dcsim_plugins.range_models import (
+    beacon_arrays,
+    least_squares_fix,
+    predicted_ranges,
+    process_noise,
+    range_jacobian,
+    transition,
+)
+from filterpy.kalman import ExtendedKalmanFilter
+
+from dcsim.api import (
+    BeaconRange,
+    Localiser,
+    LocationEstimate,
+    MotionInput,
+    PluginParams,
+    Prior,
+    hookimpl,
+    quantity,
+    unit,
+)
+
+
+class EKFParams(PluginParams):
+    """Parameters of :class:`EKFLocaliser`."""
+
+    acceleration_sigma: float = quantity(
+        0.005, unit="m/s^2", gt=0, description="Thrust uncertainty as white acceleration noise."
+    )
+    initialise: Literal["fix", "prior"] = quantity(
+        "fix", description="Start from the first least-squares fix, or from the prior."
+    )
+    convergence_sigma: float = quantity(
+        1.0, unit="m", gt=0, description="Position standard deviation below which it is converged."
+    )
+
+
+class EKFLocaliser(Localiser):
+    """Extended Kalman filter, constant velocity, range measurements."""
+
+    name = "ekf"
+    summary = "Extended Kalman filter on beacon ranges, constant-velocity model (filterpy)"
+    Params = EKFParams
+    params: EKFParams
+
+    def reset(self, prior: Prior, time: float) -> None:
+        """Start from the prior: its mean, and its standard deviations as a diagonal covariance."""
+        self.filter = ExtendedKalmanFilter(dim_x=6, dim_z=1, dim_u=3)
+        self.filter.x = np.concatenate([prior.position, prior.velocity]).reshape(6, 1)
+        self.filter.P = np.diag([prior.position_sigma**2] * 3 + [prior.velocity_sigma**2] * 3)
+        self.time = time
+        self.started = self.params.initialise == "prior"
+        self.heading = unit(prior.velocity)
+
+    def predict(self, motion: MotionInput, dt: float) -> None:
+        """Propagate with the commanded acceleration over ``dt`` s."""
+        self.filter.F, self.filter.B = transition(dt)
+        self.filter.Q = process_noise(dt, self.params.acceleration_sigma)
+        self.filter.predict(u=np.asarray(motion.acceleration).reshape(3, 1))
+        self.time += dt
+
+    def update(self, ranges: Sequence[BeaconRange]) -> None:
+        """Correct with the ranges in view (none: nothing to do)."""
+        if not ranges:
+            return
+        beacons, measured, variances = beacon_arrays(ranges)
+        if not self.started:
+            if len(ranges) < 3:
+                return
+            self._start_at_fix(
+                *least_squares_fix(self.filter.x.ravel()[:3], beacons, measured, variances)
+            )
+        self.filter.update(
+            measured.reshape(-1, 1),
+            HJacobian=lambda x: range_jacobian(x.ravel(), beacons),
+            Hx=lambda x: predicted_ranges(x.ravel()[:3], beacons).reshape(-1, 1),
+            R=np.diag(variances),
+        )
+
+    def _start_at_fix(self, position: np.ndarray, covariance: np.ndarray) -> None:
+        """Replace the prior's position belief by a least-squares fix and its covariance."""
+        self.filter.x[:3] = position.reshape(self.filter.x[:3].shape)
+        self.filter.P[:3, :] = 0.0
+        self.filter.P[:, :3] = 0.0
+        self.filter.P[:3, :3] = covariance
+        self.started = True
+
+    def estimate(self) -> LocationEstimate:
+        """The filter's mean and covariance."""
+        state = self.filter.x.ravel()
+        covariance = 0.5 * (self.filter.P + self.filter.P.T)
+        self.heading = unit(state[3:], fallback=self.heading)
+        spread = float(np.sqrt(np.linalg.eigvalsh(covariance[:3, :3]).max()))
+        return LocationEstimate(
+            time=self.time,
+            position=state[:3],
+            velocity=state[3:],
+            heading=self.heading,
+            covariance=covariance,
+            converged=self.started and spread <= self.params.convergence_sigma,
+        )
+
+
+@hookimpl
+def dcsim_plugin_classes() -> list[type]:
+    """Register the EKF localiser."""
+    return [EKFLocaliser]

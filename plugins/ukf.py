@@ -1,0 +1,87 @@
+"""``ukf`` localiser: an unscented Kalman filter on beacon ranges (filterpy).
+
+The same constant-velocity model, noise and initialisation as ``ekf``; the range
+measurement is propagated through Van der Merwe's scaled sigma points instead of being
+linearised.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from dcsim_plugins.ekf import EKFLocaliser, EKFParams
+from dcsim_plugins.range_models import (
+    beacon_arrays,
+    least_squares_fix,
+    predicted_ranges,
+    process_noise,
+    transition,
+)
+from filterpy.kalman import MerweScaledSigmaPoints, UnscentedKalmanFilter
+
+from dcsim.api import (
+    BeaconRange,
+    MotionInput,
+    Prior,
+    hookimpl,
+    quantity,
+    unit,
+)
+
+
+class UKFParams(EKFParams):
+    """Parameters of :class:`UKFLocaliser`."""
+
+    alpha: float = quantity(0.5, gt=0, le=1, description="Sigma-point spread α.")
+
+
+def _propagate(x: np.ndarray, dt: float, acceleration: np.ndarray) -> np.ndarray:
+    f, b = transition(dt)
+    return f @ x + b @ acceleration
+
+
+class UKFLocaliser(EKFLocaliser):
+    """Unscented Kalman filter, constant velocity, range measurements."""
+
+    name = "ukf"
+    summary = "Unscented Kalman filter on beacon ranges, constant-velocity model (filterpy)"
+    Params = UKFParams
+    params: UKFParams
+
+    def reset(self, prior: Prior, time: float) -> None:
+        """Start from the prior's mean and diagonal covariance."""
+        points = MerweScaledSigmaPoints(6, alpha=self.params.alpha, beta=2.0, kappa=0.0)
+        self.filter = UnscentedKalmanFilter(6, 1, 1.0, hx=None, fx=_propagate, points=points)
+        self.filter.x = np.concatenate([prior.position, prior.velocity])
+        self.filter.P = np.diag([prior.position_sigma**2] * 3 + [prior.velocity_sigma**2] * 3)
+        self.time = time
+        self.started = self.params.initialise == "prior"
+        self.heading = unit(prior.velocity)
+
+    def predict(self, motion: MotionInput, dt: float) -> None:
+        """Propagate the sigma points with the commanded acceleration over ``dt`` s."""
+        self.filter.Q = process_noise(dt, self.params.acceleration_sigma)
+        self.filter.predict(dt=dt, acceleration=np.asarray(motion.acceleration))
+        self.time += dt
+
+    def update(self, ranges: Sequence[BeaconRange]) -> None:
+        """Correct with the ranges in view (none: nothing to do)."""
+        if not ranges:
+            return
+        beacons, measured, variances = beacon_arrays(ranges)
+        if not self.started:
+            if len(ranges) < 3:
+                return
+            self._start_at_fix(*least_squares_fix(self.filter.x[:3], beacons, measured, variances))
+            # the update reuses the predicted sigma points: draw them again around the fix
+            self.filter.sigmas_f = self.filter.points_fn.sigma_points(self.filter.x, self.filter.P)
+        self.filter.update(
+            measured, R=np.diag(variances), hx=lambda x: predicted_ranges(x[:3], beacons)
+        )
+
+
+@hookimpl
+def dcsim_plugin_classes() -> list[type]:
+    """Register the UKF localiser."""
+    return [UKFLocaliser]
