@@ -137,9 +137,8 @@ class ScatteredParticleLocaliser(Localiser):
         """Apply the commanded motion to every particle."""
         acceleration = np.asarray(motion.acceleration)
         if self.params.motion_sigma > 0:
-            acceleration = acceleration + self.rng.normal(
-                0.0, self.params.motion_sigma, self.velocities.shape
-            )
+            noise = self.rng.standard_normal(self.velocities.shape, dtype=np.float32)
+            acceleration = acceleration + self.params.motion_sigma * noise
         self.positions = self.positions + self.velocities * dt + 0.5 * acceleration * dt**2
         self.velocities = self.velocities + acceleration * dt
         self.time += dt
@@ -179,9 +178,10 @@ class ScatteredParticleLocaliser(Localiser):
     def _resample(self, weights: np.ndarray) -> np.ndarray:
         n = len(weights)
         if self.params.resampling == "multinomial":
-            return self.rng.choice(n, size=n, p=weights)
-        positions = (self.rng.random() + np.arange(n)) / n
-        return np.minimum(np.searchsorted(np.cumsum(weights), positions), n - 1)
+            draws = np.sort(self.rng.random(n))  # sorted: same draw, faster lookup
+        else:
+            draws = (self.rng.random() + np.arange(n)) / n
+        return np.minimum(np.searchsorted(np.cumsum(weights), draws), n - 1)
 
     def _jitter_scale(self, values: np.ndarray | None = None) -> np.ndarray:
         """Roughening per axis: a fraction of the cloud's extent times particles^(-1/3)."""
@@ -191,15 +191,16 @@ class ScatteredParticleLocaliser(Localiser):
 
     def _scatter(self, grew: np.ndarray) -> None:
         n = len(self.positions)
-        scattered = (self.rng.random(n) < self.params.scatter_prob)[:, None]
-        jitter = self.rng.normal(0.0, 1.0, (n, 6)) * np.concatenate(
+        scattered = np.flatnonzero(self.rng.random(n) < self.params.scatter_prob)
+        scale = np.concatenate(
             [self._jitter_scale(self.positions), self._jitter_scale(self.velocities)]
         )
-        self.positions = self.positions + jitter[:, :3] * scattered
-        self.velocities = self.velocities + jitter[:, 3:] * scattered
-        turn = scattered[:, 0] & grew
-        if turn.any():
-            directions = self.rng.normal(size=(int(turn.sum()), 3))
+        jitter = self.rng.standard_normal((len(scattered), 6), dtype=np.float32) * scale
+        self.positions[scattered] += jitter[:, :3]
+        self.velocities[scattered] += jitter[:, 3:]
+        turn = scattered[grew[scattered]]
+        if turn.size:
+            directions = self.rng.normal(size=(turn.size, 3))
             directions /= np.linalg.norm(directions, axis=1, keepdims=True)
             speeds = np.linalg.norm(self.velocities[turn], axis=1, keepdims=True)
             self.velocities[turn] = directions * speeds

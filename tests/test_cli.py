@@ -183,3 +183,16 @@ def test_bench_world_prints_a_table_for_each_size(dcsim_cli):
     assert [row.split("|")[1].strip() for row in rows] == ["5", "20"]
     assert "default scenario: completed (all targets delivered)" in result.stdout
     assert "5 objects: bare stepping" in result.stderr
+
+
+def test_bench_localisers_prints_the_bound_and_every_localiser(dcsim_cli, tmp_path):
+    plot = tmp_path / "localisers.png"
+    result = dcsim_cli("bench", "localisers", "--runs", "1", "--steps", "20", "--plot", str(plot))
+    assert result.returncode == 0, result.stderr
+    labels = [
+        line.split("|")[1].strip() for line in result.stdout.splitlines() if line.startswith("| ")
+    ]
+    assert labels[0] == "localiser"
+    for name in ("PCRB", "trilateration", "ekf", "ukf", "sspf 1k", "sspf 10k", "sspf 100k"):
+        assert name in labels
+    assert plot.stat().st_size > 10_000

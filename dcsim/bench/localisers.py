@@ -54,9 +54,11 @@ def make_run(
     """A manoeuvring collector and its noisy ranges to the nearest beacons."""
     rng = np.random.default_rng(seed)
     position, velocity = np.array([-60.0, 40.0, 10.0]), np.array([0.5, -0.2, 0.05])
-    prior_position = position + rng.normal(0.0, 20.0, 3)
     prior = Prior(
-        position=prior_position, position_sigma=20.0, velocity=velocity, velocity_sigma=0.2
+        position=position + rng.normal(0.0, 20.0, 3),
+        position_sigma=20.0,
+        velocity=velocity + rng.normal(0.0, 0.2, 3),
+        velocity_sigma=0.2,
     )
     motions, ranges, states = [], [], []
     for k in range(steps):
@@ -133,7 +135,11 @@ def fly(
 
 
 def candidates(acceleration_sigma: float) -> list[tuple[str, str, dict, int]]:
-    """(label, plugin, parameters, runs cap) of every localiser benchmarked."""
+    """(label, plugin, parameters, runs cap) of every localiser benchmarked.
+
+    The particle filters use the thesis's weights with their default knots, and, for
+    10k particles, the Gaussian likelihood as well.
+    """
     sspf = {"motion_sigma": acceleration_sigma}
     return [
         ("trilateration", "trilateration", {}, 10**6),
@@ -142,6 +148,12 @@ def candidates(acceleration_sigma: float) -> list[tuple[str, str, dict, int]]:
         ("sspf 1k", "sspf", {**sspf, "particles": 1_000}, 10**6),
         ("sspf 10k", "sspf", {**sspf, "particles": 10_000}, 10**6),
         ("sspf 100k", "sspf", {**sspf, "particles": 100_000}, 2),
+        (
+            "sspf 10k gaussian",
+            "sspf",
+            {**sspf, "particles": 10_000, "likelihood": "gaussian"},
+            10**6,
+        ),
     ]
 
 
