@@ -62,8 +62,9 @@ class EKFLocaliser(Localiser):
 
     def reset(self, prior: Prior, time: float) -> None:
         """Start from the prior: its mean, and its standard deviations as a diagonal covariance."""
-        self.filter = ExtendedKalmanFilter(dim_x=6, dim_z=1, dim_u=3)
-        self.filter.x = np.concatenate([prior.position, prior.velocity]).reshape(6, 1)
+        self.filter = self._new_filter()
+        mean = np.concatenate([prior.position, prior.velocity])
+        self.filter.x = mean.reshape(self.filter.x.shape)
         self.filter.P = np.diag([prior.position_sigma**2] * 3 + [prior.velocity_sigma**2] * 3)
         self.time = time
         self.started = self.params.initialise == "prior"
@@ -84,9 +85,15 @@ class EKFLocaliser(Localiser):
         if not self.started:
             if len(ranges) < 3:
                 return
-            self._start_at_fix(
-                *least_squares_fix(self.filter.x.ravel()[:3], beacons, measured, variances)
-            )
+            fix = least_squares_fix(self.filter.x.ravel()[:3], beacons, measured, variances)
+            self._start_at_fix(*fix)
+        self._correct(beacons, measured, variances)
+
+    def _new_filter(self) -> ExtendedKalmanFilter:
+        return ExtendedKalmanFilter(dim_x=6, dim_z=1, dim_u=3)
+
+    def _correct(self, beacons: np.ndarray, measured: np.ndarray, variances: np.ndarray) -> None:
+        """The filter's own measurement update with these ranges."""
         self.filter.update(
             measured.reshape(-1, 1),
             HJacobian=lambda x: range_jacobian(x.ravel(), beacons),

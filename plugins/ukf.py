@@ -7,13 +7,9 @@ linearised.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-
 import numpy as np
 from dcsim_plugins.ekf import EKFLocaliser, EKFParams
 from dcsim_plugins.range_models import (
-    beacon_arrays,
-    least_squares_fix,
     predicted_ranges,
     process_noise,
     transition,
@@ -21,12 +17,9 @@ from dcsim_plugins.range_models import (
 from filterpy.kalman import MerweScaledSigmaPoints, UnscentedKalmanFilter
 
 from dcsim.api import (
-    BeaconRange,
     MotionInput,
-    Prior,
     hookimpl,
     quantity,
-    unit,
 )
 
 
@@ -49,15 +42,9 @@ class UKFLocaliser(EKFLocaliser):
     Params = UKFParams
     params: UKFParams
 
-    def reset(self, prior: Prior, time: float) -> None:
-        """Start from the prior's mean and diagonal covariance."""
+    def _new_filter(self) -> UnscentedKalmanFilter:
         points = MerweScaledSigmaPoints(6, alpha=self.params.alpha, beta=2.0, kappa=0.0)
-        self.filter = UnscentedKalmanFilter(6, 1, 1.0, hx=None, fx=_propagate, points=points)
-        self.filter.x = np.concatenate([prior.position, prior.velocity])
-        self.filter.P = np.diag([prior.position_sigma**2] * 3 + [prior.velocity_sigma**2] * 3)
-        self.time = time
-        self.started = self.params.initialise == "prior"
-        self.heading = unit(prior.velocity)
+        return UnscentedKalmanFilter(6, 1, 1.0, hx=None, fx=_propagate, points=points)
 
     def predict(self, motion: MotionInput, dt: float) -> None:
         """Propagate the sigma points with the commanded acceleration over ``dt`` s."""
@@ -65,17 +52,13 @@ class UKFLocaliser(EKFLocaliser):
         self.filter.predict(dt=dt, acceleration=np.asarray(motion.acceleration))
         self.time += dt
 
-    def update(self, ranges: Sequence[BeaconRange]) -> None:
-        """Correct with the ranges in view (none: nothing to do)."""
-        if not ranges:
-            return
-        beacons, measured, variances = beacon_arrays(ranges)
-        if not self.started:
-            if len(ranges) < 3:
-                return
-            self._start_at_fix(*least_squares_fix(self.filter.x[:3], beacons, measured, variances))
-            # the update reuses the predicted sigma points: draw them again around the fix
-            self.filter.sigmas_f = self.filter.points_fn.sigma_points(self.filter.x, self.filter.P)
+    def _start_at_fix(self, position: np.ndarray, covariance: np.ndarray) -> None:
+        super()._start_at_fix(position, covariance)
+        # the update reuses the predicted sigma points: draw them again around the fix
+        self.filter.sigmas_f = self.filter.points_fn.sigma_points(self.filter.x, self.filter.P)
+
+    def _correct(self, beacons: np.ndarray, measured: np.ndarray, variances: np.ndarray) -> None:
+        """Unscented update with these ranges."""
         self.filter.update(
             measured, R=np.diag(variances), hx=lambda x: predicted_ranges(x[:3], beacons)
         )
