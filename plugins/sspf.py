@@ -11,7 +11,9 @@ Each particle is a position and a velocity (its heading and speed). Every step:
    ``se_probability``; appendix A.3), or, with ``likelihood: gaussian``, the Gaussian
    likelihood of the range residuals under range noise plus motion noise (the
    improvement the thesis asks for in §6.3.2).
-3. **Resample** with replacement: multinomial as in the thesis, or systematic.
+3. **Resample** with replacement: multinomial as in the thesis, or systematic; every
+   step as in the thesis, or (``resample_below`` < 1) only when the effective sample size
+   falls below that fraction of the particles, the weights carried over otherwise.
 4. **Scatter**: each copied particle is scattered with probability ``scatter_prob``:
    its position and velocity jitter (by ``roughening`` times the cloud's extent per
    axis, shrinking as the cloud converges), and if its error grew since the last step
@@ -78,6 +80,13 @@ class SSPFParams(PluginParams):
         ge=0,
         description="Position and velocity jitter of a scattered particle, per axis, as a fraction "
         "of the cloud's extent times particles^(-1/3).",
+    )
+    resample_below: float = quantity(
+        1.0,
+        gt=0,
+        le=1,
+        description="Resample when the effective sample size falls below this fraction of "
+        "the particles (1: every step, as in the thesis).",
     )
     resampling: Literal["multinomial", "systematic"] = quantity(
         "multinomial", description="Resampling scheme."
@@ -153,8 +162,13 @@ class ScatteredParticleLocaliser(Localiser):
             np.linalg.norm(self.positions[:, None, :] - beacons[None, :, :], axis=2) - measured
         )
         errors = np.abs(residuals).sum(axis=1)
-        weights = self._weights(errors, residuals, ranges)
+        weights = self.weights * self._weights(errors, residuals, ranges)
+        total = weights.sum()
+        weights = weights / total if total > 0 else np.full(len(weights), 1.0 / len(weights))
         self.mean_error = float(errors.mean())
+        if 1.0 / np.sum(weights**2) > self.params.resample_below * len(weights):
+            self.weights, self.errors = weights, errors
+            return
         chosen = self._resample(weights)
         previous = self.errors[chosen]
         self.positions, self.velocities = self.positions[chosen], self.velocities[chosen]

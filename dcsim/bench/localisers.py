@@ -138,7 +138,8 @@ def candidates(acceleration_sigma: float) -> list[tuple[str, str, dict, int]]:
     """(label, plugin, parameters, runs cap) of every localiser benchmarked.
 
     The particle filters use the thesis's weights with their default knots, and, for
-    10k particles, the Gaussian likelihood as well.
+    10k particles, the Gaussian likelihood as well, resampling every step or only when
+    the effective sample size falls below 30 % of the particles.
     """
     sspf = {"motion_sigma": acceleration_sigma}
     return [
@@ -152,6 +153,12 @@ def candidates(acceleration_sigma: float) -> list[tuple[str, str, dict, int]]:
             "sspf 10k gaussian",
             "sspf",
             {**sspf, "particles": 10_000, "likelihood": "gaussian"},
+            10**6,
+        ),
+        (
+            "sspf 10k gaussian, ESS",
+            "sspf",
+            {**sspf, "particles": 10_000, "likelihood": "gaussian", "resample_below": 0.3},
             10**6,
         ),
     ]

@@ -121,3 +121,21 @@ def test_sspf_converges_from_the_thesis_shells():
     errors = errors_over(sspf, problem)
     assert errors[-60:].mean() < 0.5
     assert sspf.estimate().converged
+
+
+def test_sspf_resamples_only_when_the_effective_sample_size_drops():
+    problem = problems.beacon_problem(steps=1)
+    near = Prior(position=problem.steps[0].truth, position_sigma=0.5, velocity=[0.2, 0.1, 0.0])
+    lazy = ScatteredParticleLocaliser({"resample_below": 0.01}, np.random.default_rng(0))
+    lazy.reset(near, 0.0)
+    step = problem.steps[0]
+    lazy.predict(step.motion, step.dt)
+    before = lazy.positions.copy()
+    lazy.update(step.ranges)
+    assert np.array_equal(lazy.positions, before)  # weighted, not resampled or scattered
+    assert lazy.weights.std() > 0
+    eager = ScatteredParticleLocaliser({}, np.random.default_rng(0))
+    eager.reset(near, 0.0)
+    eager.predict(step.motion, step.dt)
+    eager.update(step.ranges)
+    assert np.all(eager.weights == eager.weights[0])  # the thesis resamples every step
