@@ -129,7 +129,7 @@ def test_run_writes_resolved_scenario_with_seed_and_overrides(dcsim_cli, tmp_pat
     written = yaml.safe_load((out / "scenario.yaml").read_text())
     assert written["world"]["seed"] == 7
     assert written["robot"]["max_force"] == 123.5
-    assert written["controller"]["params"] == {"bandwidth": 0.2, "damping": 1.2}
+    assert written["controller"]["params"] == {"bandwidth": 0.1, "damping": 1.2}
 
 
 @pytest.mark.parametrize(
