@@ -26,7 +26,8 @@ Plan cost
 Kinematics
     :func:`rest_to_rest_time`, :func:`cruise_speed`.
 Geometry
-    :func:`spherical_to_cartesian`, :func:`quaternion_between`, :func:`rotate`, :func:`unit`.
+    :func:`spherical_to_cartesian`, :func:`quaternion_between`, :func:`rotate`, :func:`unit`,
+    :func:`clip_norm`.
 Registry and hooks
     :data:`hookimpl`, :class:`PluginRegistry`.
 Errors
@@ -43,7 +44,7 @@ from dcsim.errors import (
     PluginParameterError,
     ScenarioError,
 )
-from dcsim.geometry import quaternion_between, rotate, spherical_to_cartesian, unit
+from dcsim.geometry import clip_norm, quaternion_between, rotate, spherical_to_cartesian, unit
 from dcsim.hookspecs import hookimpl
 from dcsim.interfaces import PLUGIN_KINDS, Controller, Localiser, PathPlanner, Plugin, TaskPlanner
 from dcsim.kinematics import cruise_speed, rest_to_rest_time
@@ -91,6 +92,7 @@ __all__ = [
     "ClohessyWiltshireMotion",
     "Command",
     "Controller",
+    "clip_norm",
     "cruise_speed",
     "CostWeights",
     "DcsimError",

@@ -48,6 +48,13 @@ def unit(v: ArrayLike, fallback: ArrayLike = (1.0, 0.0, 0.0)) -> Vector:
     return v / n if n > _EPS else np.asarray(fallback, dtype=float)
 
 
+def clip_norm(vector: ArrayLike, largest: float) -> Vector:
+    """``vector`` scaled down, keeping its direction, so its norm is at most ``largest``."""
+    vector = np.asarray(vector, dtype=float)
+    norm = float(np.linalg.norm(vector))
+    return vector * (largest / norm) if norm > largest else vector
+
+
 def quaternion_between(a: ArrayLike, b: ArrayLike) -> Vector:
     """Shortest rotation taking direction ``a`` onto direction ``b``.
 

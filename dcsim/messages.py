@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from dcsim.geometry import Vector, rotate, unit
+from dcsim.geometry import Vector, clip_norm, rotate, unit
 from dcsim.motion import LinearMotion, MotionModel
 
 
@@ -614,7 +614,4 @@ class MoveCommand(Message):
             ``F = m (v_cmd − v) / response_time``, limited to ``max_force``; no torque.
         """
         force = mass * (self.desired_velocity(heading) - np.asarray(velocity)) / response_time
-        norm = float(np.linalg.norm(force))
-        if norm > max_force:
-            force = force * (max_force / norm)
-        return Command(force=force)
+        return Command(force=clip_norm(force, max_force))

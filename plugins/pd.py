@@ -24,6 +24,7 @@ from dcsim.api import (
     Reference,
     RobotSpec,
     Surroundings,
+    clip_norm,
     hookimpl,
     quantity,
 )
@@ -62,11 +63,6 @@ def design_gains(bandwidth: float, damping: float) -> tuple[float, float]:
     return float(gains[0]), float(gains[1])
 
 
-def _limit(vector: np.ndarray, largest: float) -> np.ndarray:
-    norm = float(np.linalg.norm(vector))
-    return vector * (largest / norm) if norm > largest else vector
-
-
 class PDController(Controller):
     """Speed- and force-limited PD tracking with pole-placed gains."""
 
@@ -89,9 +85,9 @@ class PDController(Controller):
     ) -> Command:
         """Force towards the reference; zero torque."""
         error = reference.position - estimate.position
-        v_cmd = _limit(reference.velocity + (self.kp / self.kd) * error, self.robot.max_speed)
+        v_cmd = clip_norm(reference.velocity + (self.kp / self.kd) * error, self.robot.max_speed)
         acceleration = self.kd * (v_cmd - estimate.velocity) + reference.acceleration
-        return Command(force=_limit(self.robot.mass * acceleration, self.robot.max_force))
+        return Command(force=clip_norm(self.robot.mass * acceleration, self.robot.max_force))
 
 
 @hookimpl

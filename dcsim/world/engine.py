@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from dcsim.geometry import clip_norm
 from dcsim.messages import BeaconRange, DropPoint, MotionInput, ObjectKind, ObjectTrack, RobotSpec
 from dcsim.scenario.model import Scenario, point_to_cartesian
 from dcsim.world.objects import ObjectField, ObjectStatus, SpaceObject
@@ -340,8 +341,8 @@ class World:
         """
         if inputs is not None:
             self.inputs = inputs
-        force = _clip(np.asarray(self.inputs.force, dtype=float), self.robot.max_force)
-        torque = _clip(np.asarray(self.inputs.torque, dtype=float), self.robot.max_torque)
+        force = clip_norm(self.inputs.force, self.robot.max_force)
+        torque = clip_norm(self.inputs.torque, self.robot.max_torque)
         self._period_mass = self.assembly_mass()
         self._update_broad_phase(force)
         disturbance = tuple(float(f) for f in self.inputs.disturbance_force)
@@ -617,8 +618,3 @@ class World:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
-
-
-def _clip(vector: np.ndarray, largest: float) -> np.ndarray:
-    norm = float(np.linalg.norm(vector))
-    return vector * (largest / norm) if norm > largest else vector

@@ -20,6 +20,7 @@ from dcsim.api import (
     Reference,
     RobotSpec,
     Surroundings,
+    clip_norm,
     hookimpl,
     quantity,
 )
@@ -68,14 +69,9 @@ class LQRController(Controller):
     ) -> Command:
         """Regulate towards the reference within the force and speed limits."""
         wanted = reference.velocity + (self.kp / self.kd) * (reference.position - estimate.position)
-        speed = float(np.linalg.norm(wanted))
-        if speed > self.robot.max_speed:
-            wanted = wanted * (self.robot.max_speed / speed)
+        wanted = clip_norm(wanted, self.robot.max_speed)
         force = self.robot.mass * (self.kd * (wanted - estimate.velocity) + reference.acceleration)
-        norm = float(np.linalg.norm(force))
-        if norm > self.robot.max_force:
-            force = force * (self.robot.max_force / norm)
-        return Command(force=force)
+        return Command(force=clip_norm(force, self.robot.max_force))
 
 
 @hookimpl
