@@ -123,6 +123,15 @@ class Mission:
         self.retry_at = -np.inf
         self.release_refused = False
         self.time = 0.0
+        self._handlers: dict[Mode, Callable[[], Reference]] = {
+            Mode.LOCALIZE: self._localize,
+            Mode.IDLE: self._idle,
+            Mode.DEVISE_PLAN: self._devise_plan,
+            Mode.SELECT_NEXT: self._select_next,
+            Mode.MOVE_TO_NEXT: self._move_to_next,
+            Mode.GRAB: self._grab,
+            Mode.MOVE_TO_DROP: self._move_to_drop,
+        }
 
     # ------------------------------------------------------------------ tick
     def tick(
@@ -147,16 +156,7 @@ class Mission:
             self.hold = None
 
     def _step(self) -> Reference:
-        handler = {
-            Mode.LOCALIZE: self._localize,
-            Mode.IDLE: self._idle,
-            Mode.DEVISE_PLAN: self._devise_plan,
-            Mode.SELECT_NEXT: self._select_next,
-            Mode.MOVE_TO_NEXT: self._move_to_next,
-            Mode.GRAB: self._grab,
-            Mode.MOVE_TO_DROP: self._move_to_drop,
-        }[self.mode]
-        return handler()
+        return self._handlers[self.mode]()
 
     # ------------------------------------------------------------------ helpers
     def _free_targets(self) -> list[ObjectTrack]:
@@ -272,8 +272,9 @@ class Mission:
     def _move_to_next(self) -> Reference:
         task = self.task
         track = self.known[task.target_id]
-        if self._new_target() is not None:
-            self._go(Mode.DEVISE_PLAN, f"new target {self._new_target().id} in sight")
+        newcomer = self._new_target()
+        if newcomer is not None:
+            self._go(Mode.DEVISE_PLAN, f"new target {newcomer.id} in sight")
             return self._holding()
         if self.trajectory is None and self.time >= self.retry_at:
             goal_position, goal_velocity = self._standoff(track, task.pickup_time)

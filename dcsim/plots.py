@@ -15,7 +15,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
 import numpy as np  # noqa: E402
 
-from dcsim.motion import batch_states  # noqa: E402
+from dcsim.motion import MotionSet  # noqa: E402
 from dcsim.scenario.model import Scenario  # noqa: E402
 from dcsim.world.engine import build_objects  # noqa: E402
 
@@ -49,7 +49,8 @@ def _object_paths(scenario: Scenario, times: np.ndarray, events: Sequence[Mappin
     """Each object's path over the run, targets cut at their grab."""
     grabbed = {e["target"]: e["t"] for e in events if e["event"] == "grab" and e["success"]}
     objects = build_objects(scenario)
-    sampled = [batch_states([o.motion for o in objects], float(t))[0] for t in times]
+    motions = MotionSet([o.motion for o in objects])
+    sampled = [motions.state_at(float(t))[0] for t in times]
     positions = np.stack(sampled, axis=1) if objects else np.zeros((0, len(times), 3))
     for obj, path in zip(objects, positions, strict=True):
         end = grabbed.get(obj.id, np.inf)

@@ -240,7 +240,7 @@ def check_metadata(plugin_class: type[Plugin]) -> None:
         fail(str(error))
 
 
-METADATA_CHECK = _CHECKS[-1]
+METADATA_CHECK = next(c for c in _CHECKS if c.function is check_metadata)
 """The check every other check relies on."""
 
 

@@ -166,6 +166,7 @@ class World:
         )
         self.field = ObjectField(build_objects(scenario))
         self._client = connect_direct()
+        self._state_cache: tuple[int, tuple[np.ndarray, ...]] | None = None
         pb.setTimeStep(self.physics_step, physicsClientId=self._client)
         self.collector = self._create_collector()
         self._bodies = [self._create_object_body(i) for i in range(len(self.field))]
@@ -237,12 +238,21 @@ class World:
         return self._steps * self.physics_step
 
     def collector_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """True ``(position, velocity, attitude [x, y, z, w], angular velocity)``."""
-        position, attitude = pb.getBasePositionAndOrientation(
-            self.collector, physicsClientId=self._client
-        )
-        velocity, angular = pb.getBaseVelocity(self.collector, physicsClientId=self._client)
-        return np.array(position), np.array(velocity), np.array(attitude), np.array(angular)
+        """True ``(position, velocity, attitude [x, y, z, w], angular velocity)``.
+
+        Read from PyBullet once per physics step; sensors, outputs and the broad phase of
+        one tick share the reading.
+        """
+        if self._state_cache is None or self._state_cache[0] != self._steps:
+            position, attitude = pb.getBasePositionAndOrientation(
+                self.collector, physicsClientId=self._client
+            )
+            velocity, angular = pb.getBaseVelocity(self.collector, physicsClientId=self._client)
+            state = tuple(np.array(v) for v in (position, velocity, attitude, angular))
+            for array in state:
+                array.setflags(write=False)
+            self._state_cache = (self._steps, state)
+        return self._state_cache[1]
 
     def collector_mass(self) -> float:
         """Collector mass, propellant included, kg."""
