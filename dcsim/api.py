@@ -22,7 +22,8 @@ Motion models
     :class:`MotionModel`, :class:`StaticMotion`, :class:`LinearMotion`,
     :class:`SphericalMotion`, :class:`ClohessyWiltshireMotion`, :func:`mean_motion`.
 Plan cost
-    :func:`plan_delta_v`, :func:`legs_delta_v`.
+    :func:`plan_delta_v`, :func:`plan_duration`, :func:`plan_cost`, :func:`legs_delta_v`,
+    :func:`leg_delta_v`.
 Kinematics
     :func:`rest_to_rest_time`, :func:`cruise_speed`.
 Geometry
@@ -82,7 +83,7 @@ from dcsim.motion import (
     mean_motion,
 )
 from dcsim.params import PluginParams, quantity
-from dcsim.plancost import legs_delta_v, plan_delta_v
+from dcsim.plancost import leg_delta_v, legs_delta_v, plan_cost, plan_delta_v, plan_duration
 from dcsim.registry import PluginRegistry
 
 __all__ = [
@@ -133,9 +134,12 @@ __all__ = [
     "TaskRequest",
     "Trajectory",
     "hookimpl",
+    "leg_delta_v",
     "legs_delta_v",
     "mean_motion",
+    "plan_cost",
     "plan_delta_v",
+    "plan_duration",
     "quantity",
     "quaternion_between",
     "rest_to_rest_time",

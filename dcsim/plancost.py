@@ -14,6 +14,40 @@ from numpy.typing import ArrayLike
 from dcsim.messages import Plan, TaskRequest
 
 
+def leg_delta_v(
+    start_position: ArrayLike,
+    start_velocity: ArrayLike,
+    end_position: ArrayLike,
+    end_velocity: ArrayLike,
+    duration: ArrayLike,
+) -> np.ndarray:
+    """Delta-v of the two burns of one straight constant-velocity leg (vectorised).
+
+    Parameters
+    ----------
+    start_position, end_position : array_like, shape (..., 3)
+        Where the leg starts and ends, m.
+    start_velocity, end_velocity : array_like, shape (..., 3)
+        Velocity to leave from and to match on arrival, m/s.
+    duration : array_like, shape (...)
+        Leg duration, s (positive).
+
+    Returns
+    -------
+    ndarray, shape (...)
+        ``|v − v_start| + |v − v_end|`` with leg velocity ``v = Δp / duration``, m/s.
+    """
+    start_position = np.asarray(start_position, dtype=float)
+    duration = np.asarray(duration, dtype=float)
+    velocity = (np.asarray(end_position, dtype=float) - start_position) / duration[..., None]
+    return _norm(velocity - start_velocity) + _norm(velocity - end_velocity)
+
+
+def _norm(vectors: np.ndarray) -> np.ndarray:
+    """Euclidean norm over the last axis (faster than ``np.linalg.norm`` on small vectors)."""
+    return np.sqrt(np.einsum("...i,...i->...", vectors, vectors))
+
+
 def legs_delta_v(times: ArrayLike, positions: ArrayLike, velocities: ArrayLike) -> float:
     """Total impulsive delta-v of flying straight legs through timed nodes.
 
@@ -37,10 +71,7 @@ def legs_delta_v(times: ArrayLike, positions: ArrayLike, velocities: ArrayLike) 
     v = np.asarray(velocities, dtype=float)
     if len(t) < 2:
         return 0.0
-    legs = np.diff(p, axis=0) / np.diff(t)[:, None]
-    departures = np.linalg.norm(legs - v[:-1], axis=1)
-    arrivals = np.linalg.norm(legs - v[1:], axis=1)
-    return float(departures.sum() + arrivals.sum())
+    return float(leg_delta_v(p[:-1], v[:-1], p[1:], v[1:], np.diff(t)).sum())
 
 
 def plan_nodes(request: TaskRequest, plan: Plan) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -70,3 +101,27 @@ def plan_nodes(request: TaskRequest, plan: Plan) -> tuple[np.ndarray, np.ndarray
 def plan_delta_v(request: TaskRequest, plan: Plan) -> float:
     """Total impulsive delta-v (m/s) of flying ``plan`` from the request's robot state."""
     return legs_delta_v(*plan_nodes(request, plan))
+
+
+def plan_duration(request: TaskRequest, plan: Plan) -> float:
+    """Time (s) from the request to the plan's last pickup or drop visit."""
+    times = plan_nodes(request, plan)[0]
+    return float(times[-1] - request.time)
+
+
+def plan_cost(request: TaskRequest, plan: Plan, time_weight: float = 0.0) -> float:
+    """Fuel-and-time cost of a plan: ``plan_delta_v + time_weight * plan_duration``.
+
+    Parameters
+    ----------
+    request, plan
+        The request and a plan for it.
+    time_weight : float
+        Price of plan time, (m/s)/s.
+
+    Returns
+    -------
+    float
+        m/s.
+    """
+    return plan_delta_v(request, plan) + time_weight * plan_duration(request, plan)
