@@ -303,6 +303,87 @@ def bench_localisers_command(
         click.echo(f"plot: {plot_path}")
 
 
+@bench_group.command("task-planners")
+@click.option(
+    "--instances",
+    type=click.IntRange(min=1),
+    default=100,
+    show_default=True,
+    help="Random instances per problem size (both studies).",
+)
+@click.option(
+    "--moving-instances",
+    type=click.IntRange(min=0),
+    default=100,
+    show_default=True,
+    help="Instances per size for the gap to the grid optimum with moving targets.",
+)
+@click.option(
+    "--repeats",
+    type=click.IntRange(min=2),
+    default=10,
+    show_default=True,
+    help="Runs with different seeds per instance for the dispersion.",
+)
+@click.option(
+    "--dispersion-instances",
+    type=click.IntRange(min=1),
+    default=10,
+    show_default=True,
+    help="Instances whose dispersion is measured.",
+)
+@click.option(
+    "--grid-step",
+    type=click.FloatRange(min=0, min_open=True),
+    default=10.0,
+    show_default=True,
+    help="Time grid of the moving-target optimum, s.",
+)
+@click.option(
+    "--plots",
+    "plot_dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Save task_planner_strategies.png and task_planner_gaps.png here.",
+)
+def bench_task_planners_command(
+    instances: int,
+    moving_instances: int,
+    repeats: int,
+    dispersion_instances: int,
+    grid_step: float,
+    plot_dir: Path | None,
+) -> None:
+    """The ga planner's time strategies (thesis ch. 3) and task planners' gaps to the optimum.
+
+    Time strategies: 5, 10 and 15 moving targets. Gaps: stationary targets with 5, 7, 9
+    and 11 (exact Held-Karp optimum), moving targets with 5 and 7 (optimum over a time
+    grid). Prints Markdown tables for docs/benchmarks.md.
+    """
+    from dcsim.bench.task_planners import (
+        compare_strategies,
+        gap_table,
+        optimality_gaps,
+        plot_gaps,
+        plot_strategies,
+        strategy_table,
+    )
+
+    def progress(line: str) -> None:
+        click.echo(line, err=True)
+
+    gaps = optimality_gaps(
+        (5, 7, 9, 11), (5, 7), instances, moving_instances, grid_step, 1500.0, progress
+    )
+    click.echo(gap_table(gaps) + "\n")
+    strategies = compare_strategies((5, 10, 15), instances, repeats, dispersion_instances, progress)
+    click.echo(strategy_table(strategies, repeats))
+    if plot_dir is not None:
+        plot_dir.mkdir(parents=True, exist_ok=True)
+        plot_gaps(gaps, plot_dir / "task_planner_gaps.png")
+        plot_strategies(strategies, plot_dir / "task_planner_strategies.png")
+        click.echo(f"plots: {plot_dir}")
+
+
 def main() -> None:
     """Entry point of the ``dcsim`` console script."""
     cli(prog_name="dcsim")

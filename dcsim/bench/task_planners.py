@@ -1,0 +1,313 @@
+"""``dcsim bench task-planners``: the thesis's time-strategy comparison and gaps to the optimum.
+
+Two studies on random instances (a collector at rest at the origin, targets in a cube of
+half-width 50 m, a drop point within 20 m, capacity 3, speed limit 0.5 m/s,
+acceleration 0.02 m/s²):
+
+1. **Time strategies** (the thesis's figures 3.1–3.10): the ``ga`` planner with each
+   time strategy on moving targets (random velocities, σ = 0.02 m/s per axis), n = 5, 10
+   and 15: mean plan cost, generations, planning time, plan duration, and dispersion —
+   the number of distinct plans (order and drop visits) over repeated runs with
+   different seeds on one instance. The thesis's algorithm alone (no local search) is
+   compared, with the planner's default configuration beside it.
+2. **Gap to the optimum**: the plan cost of ``ga`` (defaults) and of the ``nearest``
+   baseline against the exact optimum — Held–Karp over subsets for stationary targets,
+   the same dynamic programming on a time grid for moving ones
+   (:mod:`dcsim.bench.optimal_plans`). Every plan is costed by
+   :func:`dcsim.api.plan_cost` with the ``ga`` planner's time weight.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from dcsim.api import (
+    DropPoint,
+    LinearMotion,
+    LocationEstimate,
+    ObjectKind,
+    ObjectTrack,
+    Plan,
+    StaticMotion,
+    TaskRequest,
+    plan_cost,
+    plan_duration,
+)
+from dcsim.bench.optimal_plans import LegRules, optimal_grid_plan, optimal_static_plan
+from dcsim.registry import PluginRegistry
+
+AREA = 50.0
+"""Half-width of the cube the targets start in, m."""
+DROP_AREA = 20.0
+"""Half-width of the cube the drop point lies in, m."""
+TARGET_SPEED_SIGMA = 0.02
+"""Standard deviation of a moving target's velocity per axis, m/s."""
+CAPACITY = 3
+MAX_SPEED = 0.5
+MAX_ACCELERATION = 0.02
+
+STRATEGY_VARIANTS: tuple[tuple[str, dict], ...] = (
+    ("brute-force", {"time_strategy": "brute-force", "local_search": False}),
+    ("minimum-distance", {"time_strategy": "minimum-distance", "local_search": False}),
+    ("mixed", {"time_strategy": "mixed", "local_search": False}),
+    ("mixed + local search (default)", {}),
+)
+"""(label, ``ga`` parameters) of the time-strategy comparison."""
+
+Progress = Callable[[str], None]
+
+
+def random_request(
+    rng: np.random.Generator, n: int, moving: bool, time_budget: float = 10.0
+) -> TaskRequest:
+    """A random benchmark instance (see the module documentation)."""
+    tracks = []
+    for i in range(n):
+        position = rng.uniform(-AREA, AREA, 3)
+        velocity = rng.normal(0.0, TARGET_SPEED_SIGMA, 3) if moving else np.zeros(3)
+        tracks.append(
+            ObjectTrack(
+                i + 1,
+                ObjectKind.TARGET,
+                0.0,
+                position,
+                velocity,
+                mass=5.0,
+                radius=0.3,
+                motion=LinearMotion(position, velocity),
+            )
+        )
+    return TaskRequest(
+        time=0.0,
+        robot=LocationEstimate(time=0.0, position=[0.0, 0.0, 0.0], converged=True),
+        targets=tuple(tracks),
+        drop_point=DropPoint(StaticMotion(rng.uniform(-DROP_AREA, DROP_AREA, 3)), tolerance=1.0),
+        capacity=CAPACITY,
+        max_speed=MAX_SPEED,
+        max_acceleration=MAX_ACCELERATION,
+        time_budget=time_budget,
+    )
+
+
+def _plan(registry: PluginRegistry, name: str, params: dict, seed: int, request: TaskRequest):
+    """Plan with a fresh planner; return the plan, the wall time and the planner."""
+    planner = registry.create("task_planner", name, params, np.random.default_rng(seed))
+    start = time.perf_counter()
+    plan = planner.plan(request)
+    return plan, time.perf_counter() - start, planner
+
+
+def _signature(plan: Plan) -> tuple:
+    return tuple(t.target_id for t in plan.tasks), tuple(v.after_task for v in plan.drop_visits)
+
+
+# --------------------------------------------------------------------- time strategies
+
+
+@dataclass
+class StrategyResult:
+    """One time strategy on one problem size."""
+
+    label: str
+    n: int
+    costs: list[float] = field(default_factory=list)
+    iterations: list[int] = field(default_factory=list)
+    seconds: list[float] = field(default_factory=list)
+    durations: list[float] = field(default_factory=list)
+    distinct: list[int] = field(default_factory=list)
+
+
+def compare_strategies(
+    sizes: Sequence[int],
+    instances: int,
+    repeats: int,
+    dispersion_instances: int,
+    progress: Progress = print,
+) -> list[StrategyResult]:
+    """Run every variant of :data:`STRATEGY_VARIANTS` on the same moving instances."""
+    registry = PluginRegistry.discover()
+    results = []
+    for n in sizes:
+        requests = [
+            random_request(np.random.default_rng(seed), n, True) for seed in range(instances)
+        ]
+        for label, params in STRATEGY_VARIANTS:
+            result = StrategyResult(label, n)
+            weight = registry.create("task_planner", "ga", params).params.time_weight
+            for seed, request in enumerate(requests):
+                plan, seconds, planner = _plan(registry, "ga", params, seed, request)
+                result.costs.append(plan_cost(request, plan, weight))
+                result.iterations.append(planner.statistics.iterations)
+                result.seconds.append(seconds)
+                result.durations.append(plan_duration(request, plan))
+            for request in requests[:dispersion_instances]:
+                plans = {
+                    _signature(_plan(registry, "ga", params, 1000 + r, request)[0])
+                    for r in range(repeats)
+                }
+                result.distinct.append(len(plans))
+            results.append(result)
+            progress(
+                f"n={n} {label}: mean cost {np.mean(result.costs):.3f} m/s, "
+                f"mean time {np.mean(result.seconds):.3f} s"
+            )
+    return results
+
+
+def strategy_table(results: list[StrategyResult], repeats: int) -> str:
+    """Markdown table of the time-strategy comparison."""
+    lines = [
+        "| n | strategy | mean cost [m/s] | mean generations | mean planning time [s] "
+        f"| mean plan duration [s] | distinct plans in {repeats} runs (mean) |",
+        "|---:|---|---:|---:|---:|---:|---:|",
+    ]
+    for r in results:
+        lines.append(
+            f"| {r.n} | {r.label} | {np.mean(r.costs):.3f} | {np.mean(r.iterations):.0f} | "
+            f"{np.mean(r.seconds):.3f} | {np.mean(r.durations):.0f} | {np.mean(r.distinct):.1f} |"
+        )
+    return "\n".join(lines)
+
+
+def plot_strategies(results: list[StrategyResult], path: Path) -> None:
+    """Bar charts of the five compared quantities against n, one bar per strategy."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    labels = list(dict.fromkeys(r.label for r in results))
+    sizes = sorted({r.n for r in results})
+    panels = [
+        ("mean cost [m/s]", lambda r: np.mean(r.costs)),
+        ("mean generations", lambda r: np.mean(r.iterations)),
+        ("mean planning time [s]", lambda r: np.mean(r.seconds)),
+        ("mean plan duration [s]", lambda r: np.mean(r.durations)),
+        ("distinct plans (dispersion)", lambda r: np.mean(r.distinct)),
+    ]
+    figure, axes = plt.subplots(1, len(panels), figsize=(20, 4.2))
+    width = 0.8 / len(labels)
+    for axis, (title, value) in zip(axes, panels, strict=True):
+        for i, label in enumerate(labels):
+            heights = [
+                value(next(r for r in results if r.label == label and r.n == n)) for n in sizes
+            ]
+            axis.bar(np.arange(len(sizes)) + i * width, heights, width, label=label)
+        axis.set_xticks(np.arange(len(sizes)) + 0.4 - width / 2, [f"n = {n}" for n in sizes])
+        axis.set_title(title)
+        axis.grid(alpha=0.3, axis="y")
+    axes[0].legend(fontsize=8)
+    figure.suptitle("ga time strategies on moving targets (thesis figures 3.1–3.10)")
+    figure.tight_layout()
+    figure.savefig(path, dpi=100)
+    plt.close(figure)
+
+
+# --------------------------------------------------------------------- gaps
+
+
+@dataclass
+class GapResult:
+    """One planner's relative gaps to the optimum on one problem size."""
+
+    label: str
+    moving: bool
+    n: int
+    gaps: list[float] = field(default_factory=list)
+    seconds: list[float] = field(default_factory=list)
+    incomplete: int = 0
+
+
+def optimality_gaps(
+    static_sizes: Sequence[int],
+    moving_sizes: Sequence[int],
+    instances: int,
+    moving_instances: int,
+    grid_step: float,
+    grid_horizon: float,
+    progress: Progress = print,
+) -> list[GapResult]:
+    """Gaps of ``ga`` and ``nearest`` to the exact (or grid-exact) optimum."""
+    registry = PluginRegistry.discover()
+    ga = registry.create("task_planner", "ga", {}).params
+    rules = LegRules(ga.time_weight, ga.MIN_TIME_STEP, ga.speed_fraction, ga.max_leg_time)
+    planners = [
+        ("ga", "ga", {}),
+        (
+            "nearest",
+            "nearest",
+            {"min_time_step": ga.MIN_TIME_STEP, "speed_fraction": ga.speed_fraction},
+        ),
+    ]
+    cases = [(False, n, instances) for n in static_sizes] + [
+        (True, n, moving_instances) for n in moving_sizes
+    ]
+    results = []
+    for moving, n, count in cases:
+        rows = {label: GapResult(label, moving, n) for label, _, _ in planners}
+        for seed in range(count):
+            request = random_request(np.random.default_rng(10_000 + seed), n, moving, 1.0)
+            if moving:
+                best = optimal_grid_plan(request, rules, grid_step, grid_horizon)
+            else:
+                best = optimal_static_plan(request, rules)
+            for label, name, params in planners:
+                plan, seconds, _ = _plan(registry, name, params, seed, request)
+                row = rows[label]
+                row.seconds.append(seconds)
+                if len(plan.tasks) < n:
+                    row.incomplete += 1
+                    continue
+                row.gaps.append(plan_cost(request, plan, rules.time_weight) / best.cost - 1.0)
+        results.extend(rows.values())
+        ga_row = rows["ga"]
+        progress(
+            f"{'moving' if moving else 'stationary'} n={n}: ga median gap "
+            f"{100 * np.median(ga_row.gaps):.2f} %, max time {max(ga_row.seconds):.2f} s"
+        )
+    return results
+
+
+def gap_table(results: list[GapResult]) -> str:
+    """Markdown table of the gaps to the optimum."""
+    lines = [
+        "| targets | n | planner | instances | gap median [%] | gap p95 [%] | gap max [%] "
+        "| time median [s] | time max [s] |",
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|",
+    ]
+    for r in results:
+        gaps = 100 * np.array(r.gaps)
+        kind = "moving (grid optimum)" if r.moving else "stationary"
+        done = f"{len(r.gaps)}" + (f" (+{r.incomplete} incomplete)" if r.incomplete else "")
+        lines.append(
+            f"| {kind} | {r.n} | {r.label} | {done} | {np.median(gaps):.2f} | "
+            f"{np.percentile(gaps, 95):.2f} | {gaps.max():.2f} | {np.median(r.seconds):.3f} | "
+            f"{max(r.seconds):.3f} |"
+        )
+    return "\n".join(lines)
+
+
+def plot_gaps(results: list[GapResult], path: Path) -> None:
+    """Box plots of the gap distributions, per problem and planner."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    figure, axis = plt.subplots(figsize=(11, 4.5))
+    data = [100 * np.array(r.gaps) for r in results]
+    names = [f"{'mov' if r.moving else 'stat'} {r.n}\n{r.label}" for r in results]
+    axis.boxplot(data, whis=(5, 95), showfliers=True)
+    axis.set_xticks(np.arange(1, len(names) + 1), names, fontsize=8)
+    axis.set_yscale("symlog", linthresh=0.1)
+    axis.set_ylabel("plan cost above the optimum [%]")
+    axis.set_title("Task planners against the exact optimum (whiskers: 5th–95th percentile)")
+    axis.grid(alpha=0.3, axis="y")
+    figure.tight_layout()
+    figure.savefig(path, dpi=100)
+    plt.close(figure)
