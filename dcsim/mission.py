@@ -45,6 +45,10 @@ from dcsim.world import World
 Emit = Callable[..., None]
 
 
+#: Gap kept between carried cargo and a target being approached, m.
+CARGO_CLEARANCE = 0.1
+
+
 class Mode(enum.IntEnum):
     """Mission modes, with the integer each is reported as."""
 
@@ -117,6 +121,7 @@ class Mission:
         self.planned: set[int] = set()
         self.steps: deque[PlanTask | DropVisit] = deque()
         self.task: PlanTask | None = None
+        self.visit: DropVisit | None = None
         self.trajectory: Trajectory | None = None
         self.approach = np.zeros(3)
         self.hold: np.ndarray | None = None
@@ -254,6 +259,7 @@ class Mission:
         step = self.steps.popleft()
         self.trajectory = None
         if isinstance(step, DropVisit):
+            self.visit = step
             self._go(Mode.MOVE_TO_DROP, "drop visit")
         else:
             self.task = step
@@ -264,9 +270,21 @@ class Mission:
             self._go(Mode.MOVE_TO_NEXT, f"pickup of target {step.target_id}")
         return self._holding()
 
+    def _standoff_gap(self) -> float:
+        """Surface gap to hold from a target: half the reach, or clear of any cargo.
+
+        Cargo sticks out of the collector on whatever side it was grabbed, and the
+        assembly may turn, so with cargo on board the collector stops where the cargo
+        cannot touch the target on any side, if that is within grab distance.
+        """
+        clear = self.world.cargo_protrusion() + CARGO_CLEARANCE
+        return min(
+            max(0.5 * self.settings.reach, clear), self.robot.grab_distance - CARGO_CLEARANCE
+        )
+
     def _standoff(self, track: ObjectTrack, time: float) -> tuple[np.ndarray, np.ndarray]:
         position, velocity = track.predict(time)
-        distance = self.robot.radius + track.radius + 0.5 * self.settings.reach
+        distance = self.robot.radius + track.radius + self._standoff_gap()
         return position + self.approach * distance, velocity
 
     def _move_to_next(self) -> Reference:
@@ -284,6 +302,8 @@ class Mission:
             )
         if self.trajectory is None:
             if self.world.carried_ids():
+                self.steps.clear()  # deliver what is on board, then plan afresh
+                self.visit = None
                 self._go(Mode.MOVE_TO_DROP, "no path to the target")
             elif self.time > task.pickup_time + self.settings.pickup_slack:
                 self._go(Mode.DEVISE_PLAN, "pickup missed")
@@ -294,7 +314,7 @@ class Mission:
             - self.robot.radius
             - track.radius
         )
-        if gap <= self.settings.reach:
+        if gap <= min(self._standoff_gap() + 0.5 * self.settings.reach, self.robot.grab_distance):
             self._go(Mode.GRAB, f"target {task.target_id} in reach")
         elif self.time > task.pickup_time + self.settings.pickup_slack:
             self.emit("pickup_missed", target=task.target_id, planned=task.pickup_time)
@@ -316,11 +336,13 @@ class Mission:
             self._go(Mode.DEVISE_PLAN, "grab failed")
             return reference
         self.known.pop(self.task.target_id, None)
+        self.trajectory = None
         full = len(self.world.carried_ids()) >= self.robot.capacity
         if self.steps and isinstance(self.steps[0], DropVisit):
-            self.steps.popleft()
+            self.visit = self.steps.popleft()
             self._go(Mode.MOVE_TO_DROP, "drop visit")
         elif full or not self.steps:
+            self.visit = None
             self._go(Mode.MOVE_TO_DROP, "full" if full else "last pickup")
         else:
             self._go(Mode.SELECT_NEXT, "grabbed")
@@ -329,8 +351,11 @@ class Mission:
     def _move_to_drop(self) -> Reference:
         drop = self.world.drop_point
         if self.trajectory is None and self.time >= self.retry_at:
-            position, velocity = drop.state_at(self.time)
-            self.trajectory = self._plan_path(GoalRegion(position, 0.5 * drop.tolerance, velocity))
+            arrive = self.visit.time if self.visit and self.visit.time > self.time else None
+            position, velocity = drop.state_at(self.time if arrive is None else arrive)
+            self.trajectory = self._plan_path(
+                GoalRegion(position, 0.5 * drop.tolerance, velocity, arrive)
+            )
             self.release_refused = False
         reference = self._follow(lambda: drop.state_at(self.time))
         distance = np.linalg.norm(self.estimate.position - drop.state_at(self.time)[0])
@@ -339,6 +364,7 @@ class Mission:
             if result.delivered or not self.world.carried_ids():
                 self.emit("release", delivered=list(result.delivered), reason=result.reason)
                 self.trajectory = None
+                self.visit = None
                 self._go(Mode.SELECT_NEXT if self.steps else Mode.LOCALIZE, "delivered")
             elif not self.release_refused:
                 self.emit("release", delivered=[], reason=result.reason)

@@ -135,6 +135,24 @@ def test_default_run_follows_the_executer_state_machine(default_run):
         assert all(t > plan["t"] for t in times) and np.all(np.diff(times) > 0)
 
 
+def test_every_delivery_is_flown_on_a_planned_path_timed_by_the_plan(default_run):
+    _, _, out = default_run
+    events = [json.loads(line) for line in (out / "events.jsonl").read_text().splitlines()]
+    plan = next(e for e in events if e["event"] == "plan")
+    flying_to_drop = False
+    for event in events:
+        if event["event"] == "mode":
+            flying_to_drop = event["mode"] == "MOVE_TO_DROP"
+            paths = []
+        elif event["event"] == "path" and flying_to_drop:
+            paths.append(event)
+        elif event["event"] == "release" and event["delivered"]:
+            assert paths, f"delivery at {event['t']} s without a planned path"
+    first_drop_time = plan["drops"][0][1]
+    first_release = next(e for e in events if e["event"] == "release")
+    assert first_release["t"] == pytest.approx(first_drop_time, abs=15.0)
+
+
 def test_a_failed_grab_makes_a_new_plan(tmp_path):
     path = scenario_file(
         tmp_path,

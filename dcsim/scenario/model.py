@@ -271,8 +271,9 @@ class MissionSection(Section):
         0.5,
         unit="m",
         gt=0,
-        description="Surface gap to a target at which GRAB is entered (REACH); "
-        "at most robot.grab_distance.",
+        description="Surface gap to a target at which GRAB is entered with an empty hold "
+        "(REACH; the collector holds at half of it); at most robot.grab_distance. With cargo "
+        "on board the collector holds clear of the cargo (docs/architecture.md, Mission).",
     )
     pickup_slack: float = quantity(
         30.0, unit="s", ge=0, description="How late a pickup may be before the plan is remade."

@@ -294,6 +294,14 @@ class World:
         ]
         return float(np.min(gaps))
 
+    def cargo_protrusion(self) -> float:
+        """How far carried targets reach beyond the collector's surface, m (0 if none)."""
+        centre, radius = self._assembly_spheres()[0]
+        return max(
+            [np.linalg.norm(c - centre) + r - radius for c, r in self._assembly_spheres()[1:]],
+            default=0.0,
+        )
+
     def _assembly_spheres(self) -> list[tuple[np.ndarray, float]]:
         spheres = [(self.collector_state()[0], self.robot.radius)]
         for index, (body, _) in self._carried.items():

@@ -129,6 +129,15 @@ def test_grabbed_target_leaves_the_field_and_rides_with_the_collector():
     assert world.assembly_mass() == pytest.approx(world.collector_mass() + 5.0)
 
 
+def test_cargo_protrusion_is_how_far_cargo_sticks_out_of_the_collector():
+    world = world_from(FIELD.replace("position: [0, 2.2, 0]", "position: [0, 1.9, 0]"))
+    assert world.cargo_protrusion() == 0.0
+    grabbed = world.grab(2)
+    assert grabbed.success
+    # The gap to the target plus its diameter (0.5 m radius).
+    assert world.cargo_protrusion() == pytest.approx(grabbed.gap + 1.0, abs=1e-6)
+
+
 def test_release_only_at_the_drop_point():
     world = world_from(
         FIELD.replace("position: [0, 2.2, 0]", "position: [0, 1.9, 0]").rstrip(" ")
