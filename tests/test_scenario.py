@@ -62,12 +62,9 @@ def test_packaged_default_is_the_repository_default():
 def test_resolution_fills_plugin_defaults(registry):
     scenario = load_scenario(registry=registry)
     assert scenario.controller.params == {"bandwidth": 0.2, "damping": 0.9}
-    assert set(scenario.task_planner.params) == {
-        "min_time_step",
-        "speed_fraction",
-        "horizon",
-        "time_resolution",
-    }
+    assert scenario.task_planner.plugin == "ga"
+    assert scenario.task_planner.params["time_strategy"] == "mixed"
+    assert scenario.task_planner.params["MIN_TIME_STEP"] == 1.0
 
 
 def test_thesis_scenario_is_geocentric_near_150_km():
