@@ -240,7 +240,7 @@ class RobotSpec(Message):
     mass : float
         Current mass, kg.
     radius : float
-        Radius of the collector's bounding sphere, m.
+        Radius of a sphere about the collector's centre that holds it and any cargo, m.
     max_force : float
         Largest thrust magnitude, N.
     max_torque : float
@@ -528,12 +528,16 @@ class Reference(Message):
         Reference state, m and m/s.
     acceleration : ndarray (3,)
         Feed-forward acceleration, m/s².
+    max_speed : float
+        Speed not to exceed on this leg, m/s (``inf``: the robot's own limit applies); the
+        mission lowers it on the way to the drop point (the thesis's DROP_SPEED).
     """
 
     time: float
     position: Vector = array_field()
     velocity: Vector = array_field(default=(0.0, 0.0, 0.0))
     acceleration: Vector = array_field(default=(0.0, 0.0, 0.0))
+    max_speed: float = float("inf")
 
 
 @_message
@@ -544,9 +548,13 @@ class Surroundings(Message):
     ----------
     obstacles : tuple of ObjectTrack
         Obstacles currently tracked.
+    safety_distance : float
+        Least surface gap to keep from any obstacle, m (the thesis's SAFETY_DISTANCE;
+        0 if the scenario sets none).
     """
 
     obstacles: tuple[ObjectTrack, ...] = ()
+    safety_distance: float = 0.0
 
 
 @_message

@@ -15,6 +15,7 @@ reported through the ``emit`` callback as an event.
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 from collections import deque
 from collections.abc import Callable, Sequence
@@ -189,7 +190,7 @@ class Mission:
             start=PathState(self.time, self.estimate.position, self.estimate.velocity),
             goal=goal,
             obstacles=self._obstacles(),
-            robot_radius=self.robot.radius,
+            robot_radius=self.world.robot_spec().radius,
             max_speed=self.robot.max_speed,
             max_acceleration=self._max_acceleration(),
             time_budget=self.settings.planning_budget,
@@ -358,6 +359,8 @@ class Mission:
             )
             self.release_refused = False
         reference = self._follow(lambda: drop.state_at(self.time))
+        if self.settings.drop_speed > 0:
+            reference = dataclasses.replace(reference, max_speed=self.settings.drop_speed)
         distance = np.linalg.norm(self.estimate.position - drop.state_at(self.time)[0])
         if distance <= self.settings.release_fraction * drop.tolerance:
             result = self.world.release()

@@ -41,7 +41,7 @@ def write_plots(
     folder.mkdir(parents=True, exist_ok=True)
     paths = [folder / "trajectory.png", folder / "timeline.png"]
     _trajectory(paths[0], scenario, telemetry, events)
-    _timeline(paths[1], telemetry)
+    _timeline(paths[1], telemetry, scenario.mission.safety_distance)
     return paths
 
 
@@ -104,7 +104,7 @@ def _trajectory(path: Path, scenario: Scenario, telemetry, events) -> None:
     plt.close(figure)
 
 
-def _timeline(path: Path, telemetry) -> None:
+def _timeline(path: Path, telemetry, safety_distance: float) -> None:
     times = telemetry["time"]
     error = np.linalg.norm(
         np.column_stack(
@@ -117,7 +117,7 @@ def _timeline(path: Path, telemetry) -> None:
     )
     converged = telemetry["converged"].astype(bool)
     modes = np.array([_MODES.index(m) for m in telemetry["mode"]])
-    figure, axes = plt.subplots(3, 1, figsize=(11, 7), sharex=True)
+    figure, axes = plt.subplots(4, 1, figsize=(11, 9), sharex=True)
     axes[0].step(times, modes, where="post", color="tab:purple")
     axes[0].set_yticks(range(len(_MODES)), _MODES, fontsize=7)
     axes[0].set_title("Mission mode")
@@ -128,11 +128,22 @@ def _timeline(path: Path, telemetry) -> None:
     twin.set_ylabel("delta-v [m/s]")
     axes[1].set_title("Fuel")
     axes[2].semilogy(times[converged], np.maximum(error[converged], 1e-6), color="tab:blue", lw=0.8)
-    axes[2].set(
-        xlabel="time [s]", ylabel="error [m]", title="Localisation error |true - estimated|"
-    )
+    axes[2].set(ylabel="error [m]", title="Localisation error |true - estimated|")
+    _obstacle_panel(axes[3], times, telemetry["nearest_obstacle"], safety_distance)
     for axis in axes:
         axis.grid(alpha=0.3)
     figure.tight_layout()
     figure.savefig(path, dpi=110)
     plt.close(figure)
+
+
+def _obstacle_panel(axis, times, gap: np.ndarray, safety_distance: float) -> None:
+    """Surface gap to the nearest obstacle over time, with the safety distance and contact."""
+    finite = np.isfinite(gap)
+    axis.plot(times[finite], gap[finite], color="tab:red", lw=0.9, label="nearest obstacle")
+    axis.axhline(safety_distance, color="k", ls="--", lw=1, label="safety distance")
+    axis.axhline(0.0, color="tab:red", lw=0.6, ls=":", label="contact")
+    axis.set(xlabel="time [s]", ylabel="gap [m]", title="Distance to the nearest obstacle")
+    if finite.any() and np.max(gap[finite]) > 10 * max(safety_distance, 1.0):
+        axis.set_yscale("symlog", linthresh=max(safety_distance, 1.0))
+    axis.legend(fontsize=8, loc="upper right")

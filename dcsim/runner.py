@@ -169,7 +169,7 @@ class Runner:
                 cargo = world.carried_ids()
                 call_plugin(self.plugins, "controller", "reset", world.robot_spec())
             obstacles = tuple(tr for tr in tracks if tr.kind.value == "obstacle")
-            surroundings = Surroundings(obstacles)
+            surroundings = Surroundings(obstacles, scenario.mission.safety_distance)
             command = call_plugin(
                 self.plugins, "controller", "command", t, estimate, reference, surroundings
             )

@@ -85,7 +85,8 @@ class PDController(Controller):
     ) -> Command:
         """Force towards the reference; zero torque."""
         error = reference.position - estimate.position
-        v_cmd = clip_norm(reference.velocity + (self.kp / self.kd) * error, self.robot.max_speed)
+        limit = min(self.robot.max_speed, reference.max_speed)
+        v_cmd = clip_norm(reference.velocity + (self.kp / self.kd) * error, limit)
         acceleration = self.kd * (v_cmd - estimate.velocity) + reference.acceleration
         return Command(force=clip_norm(self.robot.mass * acceleration, self.robot.max_force))
 

@@ -8,7 +8,8 @@ required time if one is given, otherwise as soon as a cruise speed of
 ``speed_fraction`` of the speed limit allows. The path is checked against every
 obstacle's predicted motion every ``check_spacing`` metres; if it passes closer than
 the two radii plus ``clearance`` the answer is "no path", naming the obstacle and the
-time. This is the yardstick the real planners are compared with.
+time (unless ``check_obstacles`` is false). This is the yardstick the real planners are
+compared with.
 """
 
 from __future__ import annotations
@@ -42,6 +43,11 @@ class StraightLineParams(PluginParams):
     )
     clearance: float = quantity(
         0.5, unit="m", ge=0, description="Margin kept beyond the sum of robot and obstacle radii."
+    )
+    check_obstacles: bool = quantity(
+        True,
+        description="Refuse paths that pass too close to an obstacle; false leaves avoidance "
+        "to the controller, as the thesis's executer does.",
     )
     check_spacing: float = quantity(
         0.25, unit="m", gt=0, description="Distance between collision checks along the path."
@@ -126,9 +132,10 @@ class StraightLinePlanner(PathPlanner):
             return NoPath(
                 f"the path needs {delta_v:.3g} m/s of delta-v, above {problem.max_delta_v:g}"
             )
-        blocked = self._first_conflict(problem, start.time + fine_tau, fine_positions)
-        if blocked is not None:
-            return blocked
+        if self.params.check_obstacles:
+            blocked = self._first_conflict(problem, start.time + fine_tau, fine_positions)
+            if blocked is not None:
+                return blocked
         tau = profile.sample_times()
         positions, velocities = states(tau)
         return Trajectory(

@@ -58,7 +58,7 @@ def test_plugins_json_and_kind_filter(dcsim_cli):
     result = dcsim_cli("plugins", "--json", "--kind", "controller")
     assert result.returncode == 0
     entries = json.loads(result.stdout)
-    assert [e["name"] for e in entries] == ["pd"]
+    assert [e["name"] for e in entries] == ["elastic", "pd"]
     assert entries[0]["kind"] == "controller"
     assert entries[0]["distribution"] == "dcsim"
     assert entries[0]["summary"]
@@ -121,7 +121,7 @@ def test_run_writes_resolved_scenario_with_seed_and_overrides(dcsim_cli, tmp_pat
         "--set",
         "robot.max_force=123.5",
         "--set",
-        "controller.params.damping=1.2",
+        "controller.params.response_time=12.5",
         "--set",
         "world.duration=2",
     )
@@ -129,7 +129,11 @@ def test_run_writes_resolved_scenario_with_seed_and_overrides(dcsim_cli, tmp_pat
     written = yaml.safe_load((out / "scenario.yaml").read_text())
     assert written["world"]["seed"] == 7
     assert written["robot"]["max_force"] == 123.5
-    assert written["controller"]["params"] == {"bandwidth": 0.1, "damping": 1.2}
+    assert written["controller"]["params"] == {
+        "gain": 0.05,
+        "repulsion_gain": 0.5,
+        "response_time": 12.5,
+    }
 
 
 @pytest.mark.parametrize(
@@ -137,7 +141,7 @@ def test_run_writes_resolved_scenario_with_seed_and_overrides(dcsim_cli, tmp_pat
     [
         (
             "controller.plugin=pdd",
-            "no controller plugin named 'pdd' (available: pd); did you mean 'pd'?",
+            "no controller plugin named 'pdd' (available: elastic, pd); did you mean 'pd'?",
         ),
         (
             "controller.params.bandwidth=-1",

@@ -275,6 +275,19 @@ class MissionSection(Section):
         "(REACH; the collector holds at half of it); at most robot.grab_distance. With cargo "
         "on board the collector holds clear of the cargo (docs/architecture.md, Mission).",
     )
+    safety_distance: float = quantity(
+        2.0,
+        unit="m",
+        ge=0,
+        description="Least surface gap to keep from obstacles (SAFETY_DISTANCE), given to the "
+        "controller and marked on the run's plots.",
+    )
+    drop_speed: float = quantity(
+        0.0,
+        unit="m/s",
+        ge=0,
+        description="Speed limit on the way to the drop point (DROP_SPEED); 0 for robot.max_speed.",
+    )
     pickup_slack: float = quantity(
         30.0, unit="s", ge=0, description="How late a pickup may be before the plan is remade."
     )

@@ -264,9 +264,10 @@ class World:
         return self.collector_mass() + carried
 
     def robot_spec(self) -> RobotSpec:
-        """The collector's current mass and limits."""
+        """The collector's current mass, limits and bounding radius (cargo included)."""
         r = self.robot
-        return RobotSpec(self.assembly_mass(), r.radius, r.max_force, r.max_torque, r.max_speed)
+        radius = r.radius + self.cargo_protrusion()
+        return RobotSpec(self.assembly_mass(), radius, r.max_force, r.max_torque, r.max_speed)
 
     def carried_ids(self) -> list[int]:
         """Ids of the targets on board."""

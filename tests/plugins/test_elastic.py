@@ -1,0 +1,173 @@
+"""The elastic controller: eqs 5.1-5.3, the Move message, and avoidance in the world."""
+
+from __future__ import annotations
+
+import textwrap
+
+import numpy as np
+import pytest
+from dcsim_plugins.elastic import ElasticController, perpendicular_repulsion, repulsion
+
+from dcsim.api import (
+    LinearMotion,
+    LocationEstimate,
+    ObjectKind,
+    ObjectTrack,
+    Reference,
+    RobotSpec,
+    Surroundings,
+    rotate,
+    unit,
+)
+from dcsim.runner import Runner
+from dcsim.runsetup import prepare_run
+
+ROBOT = RobotSpec(mass=100.0, radius=0.5, max_force=5.0, max_torque=0.5, max_speed=0.5)
+
+
+def controller(**params):
+    plugin = ElasticController(params)
+    plugin.reset(ROBOT)
+    return plugin
+
+
+def obstacle(position, velocity=(0.0, 0.0, 0.0), radius=1.0, obstacle_id=9):
+    return ObjectTrack(
+        obstacle_id,
+        ObjectKind.OBSTACLE,
+        0.0,
+        position,
+        velocity,
+        radius=radius,
+        motion=LinearMotion(position, velocity),
+    )
+
+
+def at(position, velocity=(0.0, 0.0, 0.0)):
+    return LocationEstimate(time=0.0, position=position, velocity=velocity, converged=True)
+
+
+# --------------------------------------------------------------------- equations
+
+
+def test_the_two_cross_products_and_the_less_disruptive_choice():
+    closeness = np.array([[1.0, 0.0, 0.0]])
+    velocity = np.array([[0.0, 2.0, 0.0]])
+    plus, minus, take_plus = perpendicular_repulsion(closeness, velocity, np.array([0, 0, 1.0]))
+    np.testing.assert_allclose(plus, [[0.0, 0.0, 2.0]])  # (D' - D) x V
+    np.testing.assert_allclose(minus, [[0.0, 0.0, -2.0]])  # V x (D' - D)
+    assert take_plus.tolist() == [True]  # +z agrees with an attraction along +z
+    assert perpendicular_repulsion(closeness, velocity, np.array([0, 0.3, -1.0]))[2].tolist() == [
+        False
+    ]
+
+
+def test_a_perpendicular_push_grows_with_the_depth_inside_the_safety_sphere():
+    push = repulsion(
+        np.array([[0.8, 0.0, 0.0]]),
+        np.array([[0.0, 0.3, 0.0]]),
+        np.array([0.0, 0.0, 0.4]),
+        gain=0.5,
+        take_plus=np.array([True]),
+    )
+    np.testing.assert_allclose(push, [[0.0, 0.0, 0.5 * 0.8]], atol=1e-12)
+
+
+def test_head_on_and_static_cases_push_half_away_half_aside():
+    closeness = np.array([[2.0, 0.0, 0.0]])
+    attraction = np.array([-0.3, 0.1, 0.0])  # towards the obstacle, leaning to +y
+    expected = 0.5 * 2.0 * np.array([1.0, 1.0, 0.0]) / np.sqrt(2.0)
+    for velocity in ([[0.0, 0.0, 0.0]], [[-0.4, 0.0, 0.0]]):  # both at rest; head-on
+        push = repulsion(closeness, np.array(velocity), attraction, 0.5, np.array([True]))
+        np.testing.assert_allclose(push, [expected], atol=1e-12)
+
+
+def test_desired_velocity_is_attraction_plus_the_pushes_of_closing_obstacles():
+    plugin = controller(gain=0.1, repulsion_gain=0.5)
+    reference = Reference(time=0.0, position=[2.0, 0.0, 0.0])
+    estimate = at([0.0, 0.0, 0.0], velocity=[0.3, 0.0, 0.0])
+    attraction = np.array([0.2, 0.0, 0.0])  # 0.1/s x 2 m
+    far = Surroundings((obstacle([0.0, 30.0, 0.0]),), safety_distance=2.0)
+    np.testing.assert_allclose(plugin.desired_velocity(0.0, estimate, reference, far), attraction)
+    # Beside the path while the collector closes: D = (-0.5, 3, 0), |D| = 3.04 m inside the
+    # 2 + 0.5 + 1 m sphere; C x V with V = (-0.3, 0, 0) points along z, and sin(C, V) =
+    # 3 / |D| of the push is perpendicular, the rest half radial, half aside.
+    beside = Surroundings((obstacle([0.5, -3.0, 0.0]),), safety_distance=2.0)
+    push = plugin.desired_velocity(0.0, estimate, reference, beside) - attraction
+    distance = np.hypot(0.5, 3.0)
+    depth, sine = 3.5 - distance, 3.0 / distance
+    assert abs(push[2]) == pytest.approx(0.5 * depth * sine)
+    assert np.linalg.norm(push[:2]) == pytest.approx(0.5 * depth * (1 - sine))
+    # The same obstacle once passed (the collector moving away from it) does not push.
+    receding = Surroundings((obstacle([-0.5, -3.0, 0.0]),), safety_distance=2.0)
+    np.testing.assert_allclose(
+        plugin.desired_velocity(0.0, estimate, reference, receding), attraction
+    )
+
+
+def test_drop_speed_limits_the_desired_velocity():
+    plugin = controller()
+    reference = Reference(time=0.0, position=[100.0, 0.0, 0.0], max_speed=0.2)
+    desired = plugin.desired_velocity(0.0, at([0.0, 0.0, 0.0]), reference, Surroundings())
+    assert np.linalg.norm(desired) == pytest.approx(0.2)
+
+
+@pytest.mark.parametrize("velocity", [[0.2, 0.0, 0.0], [0.0, -0.3, 0.1], [-0.2, 0.0, 0.0]])
+def test_the_move_quaternion_turns_the_heading_onto_the_commanded_direction(velocity):
+    plugin = controller()
+    estimate = at([0.0, 0.0, 0.0], velocity=velocity)
+    reference = Reference(time=0.0, position=[3.0, 4.0, 0.0])
+    surroundings = Surroundings((obstacle([1.5, 1.5, 0.3], [0.0, 0.05, 0.0]),), safety_distance=2.0)
+    move = plugin.move(0.0, estimate, reference, surroundings)
+    desired = plugin.desired_velocity(0.0, estimate, reference, surroundings)
+    np.testing.assert_allclose(np.linalg.norm(move.rotation), 1.0)
+    np.testing.assert_allclose(rotate(move.rotation, unit(velocity)), unit(desired), atol=1e-9)
+    assert move.speed == pytest.approx(np.linalg.norm(desired))
+    force = plugin.command(0.0, estimate, reference, surroundings).force
+    assert np.linalg.norm(force) <= ROBOT.max_force + 1e-9
+
+
+# --------------------------------------------------------------------- in the world
+
+CROSSING = """\
+    world: {{frame: geocentric, duration: 600}}
+    robot: {{radius: 0.5, max_speed: 0.5, initial: {{position: [0, 0, 0]}}}}
+    targets:
+      - {{id: 1, radius: 0.3, motion: {{type: static, position: [40, 0, 0]}}}}
+    obstacles:
+      - {{id: 9, radius: 1.0, motion: {{type: cartesian, position: {obstacle_at}, velocity: {obstacle_v}}}}}
+    beacons: {{positions: [[100, 100, 100], [100, -100, -100], [-100, 100, -100], [-100, -100, 100]]}}
+    drop_point: {{position: [-5, 0, 0], tolerance: 1.5}}
+    mission: {{safety_distance: 5.0}}
+    localiser: {{plugin: ekf}}
+    task_planner: {{plugin: nearest}}
+    path_planner: {{plugin: straight-line, params: {{check_obstacles: false}}}}
+    controller: {{plugin: {controller}}}
+    stop: {{on_collision: false}}
+    """
+
+
+def fly(tmp_path, controller_name, obstacle_at, obstacle_v):
+    path = tmp_path / f"{controller_name}.yaml"
+    path.write_text(
+        textwrap.dedent(CROSSING).format(
+            controller=controller_name, obstacle_at=obstacle_at, obstacle_v=obstacle_v
+        )
+    )
+    return Runner(prepare_run(path), None).run()
+
+
+@pytest.mark.parametrize(
+    "case, obstacle_at, obstacle_v",
+    [
+        ("static, on the line", "[20, 0, 0]", "[0, 0, 0]"),
+        ("head-on", "[45, 0, 0]", "[-0.1, 0, 0]"),
+    ],
+)
+def test_elastic_flies_round_what_pd_flies_into(tmp_path, case, obstacle_at, obstacle_v):
+    pd = fly(tmp_path, "pd", obstacle_at, obstacle_v)
+    assert pd["collisions"] > 0, case  # the straight line really is blocked
+    elastic = fly(tmp_path, "elastic", obstacle_at, obstacle_v)
+    assert elastic["collisions"] == 0, case
+    assert elastic["delivered"] == 1, case
+    assert elastic["min_obstacle_distance_m"] > 0.5, case
