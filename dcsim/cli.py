@@ -314,7 +314,7 @@ def bench_localisers_command(
 @click.option(
     "--moving-instances",
     type=click.IntRange(min=0),
-    default=100,
+    default=50,
     show_default=True,
     help="Instances per size for the gap to the grid optimum with moving targets.",
 )
@@ -328,7 +328,7 @@ def bench_localisers_command(
 @click.option(
     "--dispersion-instances",
     type=click.IntRange(min=1),
-    default=10,
+    default=5,
     show_default=True,
     help="Instances whose dispersion is measured.",
 )
@@ -357,7 +357,7 @@ def bench_task_planners_command(
 
     Time strategies: 5, 10 and 15 moving targets. Gaps: stationary targets with 5, 7, 9
     and 11 (exact Held-Karp optimum), moving targets with 5 and 7 (optimum over a time
-    grid). Prints Markdown tables for docs/benchmarks.md.
+    grid of 2500 s). Prints Markdown tables for docs/benchmarks.md.
     """
     from dcsim.bench.task_planners import (
         compare_strategies,
@@ -372,7 +372,7 @@ def bench_task_planners_command(
         click.echo(line, err=True)
 
     gaps = optimality_gaps(
-        (5, 7, 9, 11), (5, 7), instances, moving_instances, grid_step, 1500.0, progress
+        (5, 7, 9, 11), (5, 7), instances, moving_instances, grid_step, 2500.0, progress
     )
     click.echo(gap_table(gaps) + "\n")
     strategies = compare_strategies((5, 10, 15), instances, repeats, dispersion_instances, progress)
@@ -382,6 +382,72 @@ def bench_task_planners_command(
         plot_gaps(gaps, plot_dir / "task_planner_gaps.png")
         plot_strategies(strategies, plot_dir / "task_planner_strategies.png")
         click.echo(f"plots: {plot_dir}")
+
+
+@bench_group.command("controllers")
+@click.option(
+    "--seeds",
+    type=click.IntRange(min=1),
+    default=50,
+    show_default=True,
+    help="Fields (and world seeds) flown by every controller.",
+)
+@click.option(
+    "--controllers",
+    default="elastic,pd",
+    show_default=True,
+    help="Comma-separated controller plugins (default parameters).",
+)
+@click.option(
+    "--workers",
+    type=click.IntRange(min=1),
+    default=2,
+    show_default=True,
+    help="Runs flown at once (processes).",
+)
+@click.option(
+    "--set",
+    "overrides",
+    multiple=True,
+    metavar="KEY.PATH=VALUE",
+    help="Override a value of the crowded-field scenario, as for dcsim run. Repeatable.",
+)
+@click.option(
+    "--plot",
+    "plot_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Save the distribution of the closest approach here.",
+)
+def bench_controllers_command(
+    seeds: int,
+    controllers: str,
+    workers: int,
+    overrides: tuple[str, ...],
+    plot_path: Path | None,
+) -> None:
+    """Controllers crossing scenarios/crowded_field.yaml, a fresh field of 60 obstacles per seed.
+
+    Reports per controller the runs with a collision, the closest approach to any
+    obstacle, delta-v and mission time as a Markdown table for docs/benchmarks.md.
+    """
+    from dcsim.bench.controllers import bench_controllers, markdown_table, plot
+    from dcsim.scenario import packaged_scenario_path
+
+    scenario = packaged_scenario_path("crowded_field.yaml")
+    names = [name.strip() for name in controllers.split(",") if name.strip()]
+    safety = load_scenario(scenario, overrides).mission.safety_distance  # checks the overrides
+    runs = bench_controllers(
+        scenario,
+        names,
+        seeds,
+        overrides,
+        workers,
+        progress=lambda line: click.echo(line, err=True),
+    )
+    click.echo(markdown_table(runs))
+    if plot_path is not None:
+        plot(runs, safety, plot_path)
+        click.echo(f"plot: {plot_path}")
 
 
 def main() -> None:

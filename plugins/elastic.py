@@ -29,7 +29,15 @@ turns, in proportion to ``1 − sin θ`` (θ the angle between ``C`` and ``V``),
 that is half radial (straight away from the obstacle) and half sidestep (perpendicular
 to ``D``, towards the side ``V_robot`` already leans to, or a fixed side if it leans to
 none): a purely radial push would hold the collector in front of an obstacle that sits
-on its way, balanced against the attraction, for ever.
+on its way, balanced against the attraction, for ever. The same push takes over, in
+proportion, when the relative speed falls below ``slow_obstacle_speed``: then ``C × V``
+turns with every wobble of the velocity estimate.
+
+Where eq. 5.2 cannot choose. For an obstacle at rest both candidates are perpendicular
+to an attraction that points along the collector's path, so the choice falls to noise
+and the push would change side from one period to the next. The side taken when the
+obstacle starts to repel is kept until the other is preferred by more than
+``side_hysteresis`` (a difference of the two cosines).
 
 The safety distance must leave room to manoeuvre: the collector needs about
 ``v² / a`` to turn aside at speed ``v`` and acceleration ``a``; inside that, no
@@ -72,6 +80,20 @@ class ElasticParams(PluginParams):
         description="Repulsion: velocity per metre the collector is inside an obstacle's "
         "safety sphere.",
     )
+    side_hysteresis: float = quantity(
+        0.5,
+        ge=0,
+        le=2,
+        description="How much more (difference of cosines, eq. 5.2) the other side must be "
+        "preferred before a repelling obstacle's push changes side.",
+    )
+    slow_obstacle_speed: float = quantity(
+        0.05,
+        unit="m/s",
+        ge=0,
+        description="Relative speed below which the push turns from perpendicular to "
+        "radial-and-aside in proportion.",
+    )
     response_time: float = quantity(
         2.0, unit="s", gt=0, description="Time constant of the velocity-tracking loop."
     )
@@ -100,12 +122,15 @@ def perpendicular_repulsion(
     """
     plus = np.cross(closeness, relative_velocity)
     minus = np.cross(relative_velocity, closeness)
-    return plus, minus, _cosine(plus, attraction) >= _cosine(minus, attraction)
+    return plus, minus, preference(plus, attraction) >= 0
 
 
-def _cosine(vectors: np.ndarray, reference: np.ndarray) -> np.ndarray:
-    norms = np.linalg.norm(vectors, axis=1) * np.linalg.norm(reference)
-    return np.divide(vectors @ reference, norms, out=np.zeros(len(vectors)), where=norms > 0)
+def preference(plus: np.ndarray, attraction: np.ndarray) -> np.ndarray:
+    """How much eq. 5.2 prefers ``F⁺`` over ``F⁻ = −F⁺``: the difference of their cosines
+    with ``attraction`` (in [−2, 2]; 0 when both are perpendicular to it)."""
+    norms = np.linalg.norm(plus, axis=1) * np.linalg.norm(attraction)
+    cosine = np.divide(plus @ attraction, norms, out=np.zeros(len(plus)), where=norms > 0)
+    return 2.0 * cosine
 
 
 def repulsion(
@@ -114,6 +139,7 @@ def repulsion(
     attraction: np.ndarray,
     gain: float,
     take_plus: np.ndarray,
+    speed_scale: float = 0.0,
 ) -> np.ndarray:
     """Repulsive velocity per obstacle inside its safety sphere, m/s (see the module docs).
 
@@ -127,6 +153,9 @@ def repulsion(
         Velocity per metre of closeness, 1/s.
     take_plus : ndarray of bool (K,)
         Which perpendicular candidate to use: ``C × V`` where True, ``V × C`` elsewhere.
+    speed_scale : float
+        Relative speed, m/s, below which the perpendicular share fades in proportion
+        (a slow obstacle's ``C × V`` turns with every wobble of the velocity estimate).
 
     Returns
     -------
@@ -139,6 +168,8 @@ def repulsion(
     speed = np.linalg.norm(relative_velocity, axis=1)
     size = np.linalg.norm(chosen, axis=1)
     sine = np.divide(size, depth * speed, out=np.zeros(len(depth)), where=depth * speed > _PARALLEL)
+    if speed_scale > 0:
+        sine *= np.minimum(speed / speed_scale, 1.0)
     perpendicular = chosen / np.maximum(size, 1e-300)[:, None]
     fallback = radial + _sidestep(radial, attraction)
     fallback /= np.linalg.norm(fallback, axis=1)[:, None]
@@ -166,6 +197,7 @@ class ElasticController(Controller):
     def reset(self, robot: RobotSpec) -> None:
         """Remember the robot's limits, mass and size (called again after a grab or release)."""
         self.robot = robot
+        self.kept_sides: dict[int, bool] = {}
 
     def move(
         self,
@@ -224,15 +256,42 @@ class ElasticController(Controller):
         attraction = clip_norm(reference.velocity + self.params.gain * error, limit)
         if not surroundings.obstacles:
             return attraction
-        closeness, relative = self._inside(time, estimate, surroundings)
-        take_plus = perpendicular_repulsion(closeness, relative, attraction)[2]
-        push = repulsion(closeness, relative, attraction, self.params.repulsion_gain, take_plus)
+        ids, closeness, relative = self._inside(time, estimate, surroundings)
+        take_plus = self._sides(ids, closeness, relative, attraction)
+        push = repulsion(
+            closeness,
+            relative,
+            attraction,
+            self.params.repulsion_gain,
+            take_plus,
+            self.params.slow_obstacle_speed,
+        )
         return clip_norm(attraction + push.sum(axis=0), limit)
+
+    def _sides(
+        self, ids: list[int], closeness: np.ndarray, relative: np.ndarray, attraction: np.ndarray
+    ) -> np.ndarray:
+        """Eq. 5.2's choice per obstacle, kept while the obstacle repels unless clearly wrong.
+
+        For an obstacle at rest the two candidates are both perpendicular to the
+        attraction, so eq. 5.2 decides on noise and would flip the push from one control
+        period to the next; the side taken on entering the safety sphere is kept until
+        the other side is preferred by more than ``side_hysteresis``.
+        """
+        score = preference(np.cross(closeness, relative), attraction)
+        sides = []
+        for obstacle_id, margin in zip(ids, score, strict=True):
+            kept = self.kept_sides.get(obstacle_id)
+            if kept is None or abs(margin) > self.params.side_hysteresis:
+                kept = bool(margin >= 0)
+            sides.append(kept)
+        self.kept_sides = dict(zip(ids, sides, strict=True))
+        return np.array(sides, dtype=bool)
 
     def _inside(
         self, time: float, estimate: LocationEstimate, surroundings: Surroundings
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """Closeness ``D′ − D`` and relative velocity of the obstacles that repel.
+    ) -> tuple[list[int], np.ndarray, np.ndarray]:
+        """Ids, closeness ``D′ − D`` and relative velocity of the obstacles that repel.
 
         An obstacle repels while the collector is inside its safety sphere and the two
         are closing; once they separate, pushing on would only cost fuel.
@@ -249,7 +308,8 @@ class ElasticController(Controller):
         repel = (distance < sphere) & closing
         direction = away[repel] / np.maximum(distance[repel], 1e-12)[:, None]
         closeness = direction * (sphere - distance)[repel][:, None]
-        return closeness, relative[repel]
+        ids = [track.id for track, on in zip(obstacles, repel, strict=True) if on]
+        return ids, closeness, relative[repel]
 
 
 @hookimpl

@@ -5,6 +5,7 @@ from dcsim.scenario.loader import (
     default_scenario_path,
     dump_scenario,
     load_scenario,
+    packaged_scenario_path,
     resolve_plugins,
     validate,
 )
@@ -14,6 +15,7 @@ __all__ = [
     "Scenario",
     "ScenarioDocument",
     "default_scenario_path",
+    "packaged_scenario_path",
     "dump_scenario",
     "format_key_path",
     "load_scenario",

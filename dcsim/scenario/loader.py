@@ -35,7 +35,12 @@ DEFAULT_SCENARIO = "default.yaml"
 
 def default_scenario_path() -> Path:
     """Path of the default scenario shipped inside the package."""
-    return Path(str(resources.files("dcsim") / "scenarios" / DEFAULT_SCENARIO))
+    return packaged_scenario_path(DEFAULT_SCENARIO)
+
+
+def packaged_scenario_path(name: str) -> Path:
+    """Path of scenario file ``name`` shipped inside the package (``default.yaml``, ...)."""
+    return Path(str(resources.files("dcsim") / "scenarios" / name))
 
 
 def load_scenario(

@@ -82,6 +82,39 @@ def test_head_on_and_static_cases_push_half_away_half_aside():
         np.testing.assert_allclose(push, [expected], atol=1e-12)
 
 
+def test_a_slow_obstacle_pushes_away_and_aside_rather_than_perpendicular():
+    closeness = np.array([[1.0, 0.0, 0.0]])
+    attraction = np.array([0.0, 0.2, 0.0])
+    slow = repulsion(
+        closeness,
+        np.array([[0.0, 0.0, 0.001]]),
+        attraction,
+        0.5,
+        np.array([True]),
+        speed_scale=0.05,
+    )
+    fast = repulsion(
+        closeness, np.array([[0.0, 0.0, 0.2]]), attraction, 0.5, np.array([True]), speed_scale=0.05
+    )
+    # C x V is along -y for V along +z; the slow one is 2 % of that, the rest radial + aside.
+    np.testing.assert_allclose(fast, [[0.0, -0.5, 0.0]], atol=1e-12)
+    aside = 0.5 * np.array([1.0, 1.0, 0.0]) / np.sqrt(2.0)
+    np.testing.assert_allclose(slow, [0.02 * np.array([0, -0.5, 0]) + 0.98 * aside], atol=1e-12)
+
+
+def test_the_side_of_a_push_is_kept_until_clearly_wrong():
+    plugin = controller(side_hysteresis=0.5)
+    ids, closeness, relative = [9], np.array([[1.0, 0.0, 0.0]]), np.array([[0.0, -0.3, 0.0]])
+    # C x V = (0, 0, -0.3): "plus" points down. A slight upward lean of the attraction picks
+    # "minus" on entry; a slight downward lean later does not flip it; a clear one does.
+    assert plugin._sides(ids, closeness, relative, np.array([0.0, 0.3, 0.02])).tolist() == [False]
+    assert plugin._sides(ids, closeness, relative, np.array([0.0, 0.3, -0.02])).tolist() == [False]
+    assert plugin._sides(ids, closeness, relative, np.array([0.0, 0.1, -0.3])).tolist() == [True]
+    # An obstacle that stopped repelling is forgotten: re-entering decides afresh.
+    plugin._sides([], np.zeros((0, 3)), np.zeros((0, 3)), np.array([0.0, 0.3, 0.0]))
+    assert plugin._sides(ids, closeness, relative, np.array([0.0, 0.3, 0.02])).tolist() == [False]
+
+
 def test_desired_velocity_is_attraction_plus_the_pushes_of_closing_obstacles():
     plugin = controller(gain=0.1, repulsion_gain=0.5)
     reference = Reference(time=0.0, position=[2.0, 0.0, 0.0])
