@@ -35,9 +35,10 @@ turns with every wobble of the velocity estimate.
 
 Where eq. 5.2 cannot choose. For an obstacle at rest both candidates are perpendicular
 to an attraction that points along the collector's path, so the choice falls to noise
-and the push would change side from one period to the next. The side taken when the
-obstacle starts to repel is kept until the other is preferred by more than
-``side_hysteresis`` (a difference of the two cosines).
+and the perpendicular push changes side from one period to the next; on average it
+cancels, and what avoids the obstacle is the radial-and-aside share. Keeping the side
+taken on entry (a hysteresis) was tried and flew into single obstacles the plain rule
+passes, so the thesis's rule stands.
 
 The safety distance must leave room to manoeuvre: the collector needs about
 ``v² / a`` to turn aside at speed ``v`` and acceleration ``a``; inside that, no
@@ -64,7 +65,7 @@ from dcsim.api import (
     unit,
 )
 
-_PARALLEL = 1e-9  # |sin θ| below which two directions count as parallel
+_PARALLEL = 1e-9  # |C| |V| (m²/s) below which C × V is taken to vanish
 
 
 class ElasticParams(PluginParams):
@@ -79,13 +80,6 @@ class ElasticParams(PluginParams):
         gt=0,
         description="Repulsion: velocity per metre the collector is inside an obstacle's "
         "safety sphere.",
-    )
-    side_hysteresis: float = quantity(
-        0.5,
-        ge=0,
-        le=2,
-        description="How much more (difference of cosines, eq. 5.2) the other side must be "
-        "preferred before a repelling obstacle's push changes side.",
     )
     slow_obstacle_speed: float = quantity(
         0.05,
@@ -197,7 +191,6 @@ class ElasticController(Controller):
     def reset(self, robot: RobotSpec) -> None:
         """Remember the robot's limits, mass and size (called again after a grab or release)."""
         self.robot = robot
-        self.kept_sides: dict[int, bool] = {}
 
     def move(
         self,
@@ -256,8 +249,8 @@ class ElasticController(Controller):
         attraction = clip_norm(reference.velocity + self.params.gain * error, limit)
         if not surroundings.obstacles:
             return attraction
-        ids, closeness, relative = self._inside(time, estimate, surroundings)
-        take_plus = self._sides(ids, closeness, relative, attraction)
+        closeness, relative = self._inside(time, estimate, surroundings)
+        take_plus = perpendicular_repulsion(closeness, relative, attraction)[2]
         push = repulsion(
             closeness,
             relative,
@@ -268,30 +261,10 @@ class ElasticController(Controller):
         )
         return clip_norm(attraction + push.sum(axis=0), limit)
 
-    def _sides(
-        self, ids: list[int], closeness: np.ndarray, relative: np.ndarray, attraction: np.ndarray
-    ) -> np.ndarray:
-        """Eq. 5.2's choice per obstacle, kept while the obstacle repels unless clearly wrong.
-
-        For an obstacle at rest the two candidates are both perpendicular to the
-        attraction, so eq. 5.2 decides on noise and would flip the push from one control
-        period to the next; the side taken on entering the safety sphere is kept until
-        the other side is preferred by more than ``side_hysteresis``.
-        """
-        score = preference(np.cross(closeness, relative), attraction)
-        sides = []
-        for obstacle_id, margin in zip(ids, score, strict=True):
-            kept = self.kept_sides.get(obstacle_id)
-            if kept is None or abs(margin) > self.params.side_hysteresis:
-                kept = bool(margin >= 0)
-            sides.append(kept)
-        self.kept_sides = dict(zip(ids, sides, strict=True))
-        return np.array(sides, dtype=bool)
-
     def _inside(
         self, time: float, estimate: LocationEstimate, surroundings: Surroundings
-    ) -> tuple[list[int], np.ndarray, np.ndarray]:
-        """Ids, closeness ``D′ − D`` and relative velocity of the obstacles that repel.
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Closeness ``D′ − D`` and relative velocity of the obstacles that repel.
 
         An obstacle repels while the collector is inside its safety sphere and the two
         are closing; once they separate, pushing on would only cost fuel.
@@ -308,8 +281,7 @@ class ElasticController(Controller):
         repel = (distance < sphere) & closing
         direction = away[repel] / np.maximum(distance[repel], 1e-12)[:, None]
         closeness = direction * (sphere - distance)[repel][:, None]
-        ids = [track.id for track, on in zip(obstacles, repel, strict=True) if on]
-        return ids, closeness, relative[repel]
+        return closeness, relative[repel]
 
 
 @hookimpl

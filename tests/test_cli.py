@@ -129,11 +129,8 @@ def test_run_writes_resolved_scenario_with_seed_and_overrides(dcsim_cli, tmp_pat
     written = yaml.safe_load((out / "scenario.yaml").read_text())
     assert written["world"]["seed"] == 7
     assert written["robot"]["max_force"] == 123.5
-    assert written["controller"]["params"] == {
-        "gain": 0.05,
-        "repulsion_gain": 0.5,
-        "response_time": 12.5,
-    }
+    assert written["controller"]["params"]["gain"] == 0.05  # from the file
+    assert written["controller"]["params"]["response_time"] == 12.5  # from --set
 
 
 @pytest.mark.parametrize(

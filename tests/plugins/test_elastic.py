@@ -102,19 +102,6 @@ def test_a_slow_obstacle_pushes_away_and_aside_rather_than_perpendicular():
     np.testing.assert_allclose(slow, [0.02 * np.array([0, -0.5, 0]) + 0.98 * aside], atol=1e-12)
 
 
-def test_the_side_of_a_push_is_kept_until_clearly_wrong():
-    plugin = controller(side_hysteresis=0.5)
-    ids, closeness, relative = [9], np.array([[1.0, 0.0, 0.0]]), np.array([[0.0, -0.3, 0.0]])
-    # C x V = (0, 0, -0.3): "plus" points down. A slight upward lean of the attraction picks
-    # "minus" on entry; a slight downward lean later does not flip it; a clear one does.
-    assert plugin._sides(ids, closeness, relative, np.array([0.0, 0.3, 0.02])).tolist() == [False]
-    assert plugin._sides(ids, closeness, relative, np.array([0.0, 0.3, -0.02])).tolist() == [False]
-    assert plugin._sides(ids, closeness, relative, np.array([0.0, 0.1, -0.3])).tolist() == [True]
-    # An obstacle that stopped repelling is forgotten: re-entering decides afresh.
-    plugin._sides([], np.zeros((0, 3)), np.zeros((0, 3)), np.array([0.0, 0.3, 0.0]))
-    assert plugin._sides(ids, closeness, relative, np.array([0.0, 0.3, 0.02])).tolist() == [False]
-
-
 def test_desired_velocity_is_attraction_plus_the_pushes_of_closing_obstacles():
     plugin = controller(gain=0.1, repulsion_gain=0.5)
     reference = Reference(time=0.0, position=[2.0, 0.0, 0.0])
