@@ -25,7 +25,7 @@ Plan cost
     :func:`plan_delta_v`, :func:`plan_duration`, :func:`plan_cost`, :func:`legs_delta_v`,
     :func:`leg_delta_v`.
 Kinematics
-    :func:`rest_to_rest_time`, :func:`cruise_speed`.
+    :func:`rest_to_rest_time`, :func:`shortest_leg`, :func:`cruise_speed`.
 Geometry
     :func:`spherical_to_cartesian`, :func:`quaternion_between`, :func:`rotate`, :func:`unit`,
     :func:`clip_norm`.
@@ -48,7 +48,7 @@ from dcsim.errors import (
 from dcsim.geometry import clip_norm, quaternion_between, rotate, spherical_to_cartesian, unit
 from dcsim.hookspecs import hookimpl
 from dcsim.interfaces import PLUGIN_KINDS, Controller, Localiser, PathPlanner, Plugin, TaskPlanner
-from dcsim.kinematics import cruise_speed, rest_to_rest_time
+from dcsim.kinematics import cruise_speed, rest_to_rest_time, shortest_leg
 from dcsim.messages import (
     BeaconRange,
     Bounds,
@@ -144,6 +144,7 @@ __all__ = [
     "quaternion_between",
     "rest_to_rest_time",
     "rotate",
+    "shortest_leg",
     "spherical_to_cartesian",
     "unit",
 ]

@@ -42,6 +42,28 @@ def rest_to_rest_time(
     )
 
 
+def shortest_leg(
+    distance: ArrayLike, max_speed: float, max_acceleration: float, min_duration: float
+) -> NDArray:
+    """Shortest duration of a plan leg: the rest-to-rest time, but at least ``min_duration``.
+
+    Parameters
+    ----------
+    distance : array_like
+        Leg length, m.
+    max_speed, max_acceleration : float
+        The leg's speed (m/s) and acceleration (m/s², ``inf`` for impulsive) limits.
+    min_duration : float
+        Least duration of any leg, s.
+
+    Returns
+    -------
+    ndarray
+        s.
+    """
+    return np.maximum(min_duration, rest_to_rest_time(distance, max_speed, max_acceleration))
+
+
 def cruise_speed(distance: float, duration: float, max_acceleration: float) -> float:
     """Cruise speed of the trapezoid that covers ``distance`` in exactly ``duration``.
 

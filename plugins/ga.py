@@ -39,12 +39,14 @@ The minimum-distance search times one leg at a time, in flying order: it takes t
 arrival time that makes that leg cheapest (the thesis took the time of closest
 approach, which says nothing for stationary targets; the leg's own cost is the
 criterion the distance stood in for). A geometric grid of durations from MIN_TIME_STEP
-to ``max_leg_time`` brackets the optimum and golden-section search refines it (in
-place of the thesis's gradient descent and MIN_GRAD).
+to ``max_leg_time`` brackets the optimum; a parabola through the bracket and the
+shortest feasible duration are tried as refinements (in place of the thesis's gradient
+descent and MIN_GRAD).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass
 from typing import Literal
@@ -165,7 +167,9 @@ class GeneticTaskPlanner(TaskPlanner):
         """Plan the request's targets; see the module documentation."""
         deadline = time.perf_counter() + request.time_budget
         problem = self._problem(request, list(request.targets))
-        problem = self._problem(request, self._reachable(problem))
+        reachable = self._reachable(problem)
+        if len(reachable) < problem.n:
+            problem = self._problem(request, reachable)
         if problem.n == 0:
             self.statistics = SearchStatistics(0, True, ())
             return self._drop_only(request, problem)
@@ -216,9 +220,11 @@ class GeneticTaskPlanner(TaskPlanner):
         while iterations < p.MAX_ITERATIONS and not converged:
             started = time.perf_counter()
             population = self._generation(problem, population, scores, best)
-            if searching:
-                population, elite_settled = self._descend(problem, population, elite_settled)
             scores = evaluate(problem, population)
+            if searching:
+                population, scores, elite_settled = self._descend(
+                    problem, population, scores, elite_settled
+                )
             i = int(np.argmin(scores.cost))
             elite_settled = elite_settled and i == 0
             best = population.take(np.array([i]))
@@ -260,22 +266,22 @@ class GeneticTaskPlanner(TaskPlanner):
         return children.put(np.array([0]), best)
 
     def _descend(
-        self, problem: TaskProblem, population: Population, elite_settled: bool
-    ) -> tuple[Population, bool]:
+        self, problem: TaskProblem, population: Population, scores: Evaluation, elite_settled: bool
+    ) -> tuple[Population, Evaluation, bool]:
         """One local-search step: on row 0 (the kept best), or on the best child once it settled.
 
         The individual is replaced by its best neighbour if that is cheaper. Returns the
-        population and whether row 0 is now known to be a local optimum.
+        population, its scores, and whether row 0 is now known to be a local optimum.
         """
-        costs = evaluate(problem, population).cost
-        row = 1 + int(np.argmin(costs[1:])) if elite_settled else 0
+        row = 1 + int(np.argmin(scores.cost[1:])) if elite_settled else 0
         around = neighbours(problem, population.take(np.array([row])))
-        neighbour_costs = evaluate(problem, around).cost
-        i = int(np.argmin(neighbour_costs))
-        improved = neighbour_costs[i] < costs[row]
+        around_scores = evaluate(problem, around)
+        i = int(np.argmin(around_scores.cost))
+        improved = around_scores.cost[i] < scores.cost[row]
         if improved:
             population = population.put(np.array([row]), around.take(np.array([i])))
-        return population, elite_settled or not improved
+            scores = scores.put(row, around_scores, i)
+        return population, scores, elite_settled or not improved
 
     def _time_mutation(
         self, problem: TaskProblem, children: Population, migrants: np.ndarray
@@ -306,8 +312,7 @@ class GeneticTaskPlanner(TaskPlanner):
             visits.append(self._visit(request, -1, problem.t0 + float(best.pre_gap[0])))
         for k in np.flatnonzero(best.drops[0]):
             visits.append(self._visit(request, int(k), float(times[k] + best.drop_gaps[0, k])))
-        plan = Plan(tuple(tasks), tuple(visits))
-        return Plan(plan.tasks, plan.drop_visits, plan_cost(request, plan, self.params.time_weight))
+        return self._costed(request, Plan(tuple(tasks), tuple(visits)))
 
     @staticmethod
     def _visit(request: TaskRequest, after_task: int, at: float) -> DropVisit:
@@ -323,8 +328,12 @@ class GeneticTaskPlanner(TaskPlanner):
             np.array([problem.t0]),
             np.array([problem.drop]),
         )
-        plan = Plan(drop_visits=(self._visit(request, -1, float(arrival[0])),))
-        return Plan(plan.tasks, plan.drop_visits, plan_cost(request, plan, self.params.time_weight))
+        return self._costed(
+            request, Plan(drop_visits=(self._visit(request, -1, float(arrival[0])),))
+        )
+
+    def _costed(self, request: TaskRequest, plan: Plan) -> Plan:
+        return dataclasses.replace(plan, cost=plan_cost(request, plan, self.params.time_weight))
 
 
 @hookimpl

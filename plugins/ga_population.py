@@ -88,6 +88,19 @@ class Evaluation:
     violation: np.ndarray
     arrival_cost: np.ndarray
 
+    def put(self, row: int, other: Evaluation, other_row: int) -> Evaluation:
+        """A copy with row ``row`` replaced by ``other``'s row ``other_row``."""
+        arrays = []
+        for mine, theirs in zip(
+            (self.cost, self.violation, self.arrival_cost),
+            (other.cost, other.violation, other.arrival_cost),
+            strict=True,
+        ):
+            merged = np.array(mine)
+            merged[row] = theirs[other_row]
+            arrays.append(merged)
+        return Evaluation(*arrays)
+
 
 def evaluate(problem: TaskProblem, population: Population) -> Evaluation:
     """Cost every individual of ``population`` on ``problem`` (one pass, no loop over rows)."""
@@ -297,7 +310,8 @@ def greedy_crossover(
     target it takes whichever parent's next target (after that same target in the
     parent's order) is cheaper to reach, if not already taken — a random remaining target
     when both are. Each target carries the duration of the leg that reached it in the
-    parent it came from; drop visits follow the mother's, repaired for capacity.
+    parent it came from; drop visits follow the mother's (valid: they depend on
+    positions only).
 
     Parameters
     ----------
@@ -338,7 +352,7 @@ def greedy_crossover(
         options = [succ[0][rows, chosen], succ[1][rows, chosen]]
     return Population(
         order,
-        repair_runs(problem, mothers.drops),
+        np.array(mothers.drops),
         gaps,
         np.array(mothers.drop_gaps),
         np.array(mothers.pre_gap),

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dcsim.api import ObjectTrack, TaskRequest, leg_delta_v, rest_to_rest_time
+from dcsim.api import ObjectTrack, TaskRequest, leg_delta_v, shortest_leg
 
 #: Cost added per second of leg-time shortfall, (m/s)/s: large enough that any feasible
 #: plan beats an infeasible one of similar shape.
@@ -92,7 +92,6 @@ class TaskProblem:
     """
 
     def __init__(self, request: TaskRequest, targets: list[ObjectTrack], model: PlanModel):
-        self.request = request
         self.targets = targets
         self.model = model
         self.n = len(targets)
@@ -127,9 +126,7 @@ class TaskProblem:
 
     def min_duration(self, distance: np.ndarray) -> np.ndarray:
         """Shortest feasible leg over ``distance`` m, s."""
-        return np.maximum(
-            self.model.min_time_step, rest_to_rest_time(distance, self.speed, self.acceleration)
-        )
+        return shortest_leg(distance, self.speed, self.acceleration, self.model.min_time_step)
 
     # ------------------------------------------------------------------ legs
     def legs(
@@ -196,7 +193,8 @@ class TaskProblem:
         )
         scores = coarse.penalised()
         rows = np.arange(len(t_from))
-        k = np.clip(np.argmin(scores, axis=1), 1, len(grid) - 2)
+        best = np.argmin(scores, axis=1)
+        k = np.clip(best, 1, len(grid) - 2)
         x = np.log(grid)
         f0, f1, f2 = scores[rows, k - 1], scores[rows, k], scores[rows, k + 1]
         curvature = f0 - 2.0 * f1 + f2
@@ -207,7 +205,7 @@ class TaskProblem:
         vertex = np.exp(x[k] + np.clip(step, -1.0, 1.0) * spacing)
         distance = np.linalg.norm(coarse.position[rows, k] - position, axis=-1)
         edge = self.min_duration(distance) * (1.0 + 1e-9)
-        candidates = np.stack([np.exp(x[np.argmin(scores, axis=1)]), vertex, edge], axis=1)
+        candidates = np.stack([grid[best], vertex, edge], axis=1)
         tried = self.legs(
             position[:, None],
             velocity[:, None],

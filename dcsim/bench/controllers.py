@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from dcsim.bench.figures import pyplot, save
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
 
@@ -139,10 +140,7 @@ def markdown_table(runs: list[ControllerRun]) -> str:
 
 def plot(runs: list[ControllerRun], safety_distance: float, path: Path) -> None:
     """Distribution of the closest approach per controller, with the safety distance."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     names = list(dict.fromkeys(r.controller for r in runs))
     figure, axis = plt.subplots(figsize=(8, 4.5))
@@ -159,6 +157,4 @@ def plot(runs: list[ControllerRun], safety_distance: float, path: Path) -> None:
     )
     axis.legend()
     axis.grid(alpha=0.3)
-    figure.tight_layout()
-    figure.savefig(path, dpi=100)
-    plt.close(figure)
+    save(figure, path)

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from dcsim.bench.figures import pyplot, save
 from dcsim.messages import BeaconRange, MotionInput, Prior
 from dcsim.registry import PluginRegistry
 
@@ -211,10 +212,7 @@ def markdown_table(bound: np.ndarray, results: list[LocaliserResult]) -> str:
 
 def plot(bound: np.ndarray, results: list[LocaliserResult], path) -> None:
     """RMSE over time of every localiser with the bound, log scale."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     times = DT * (np.arange(len(bound)) + 1)
     figure, axis = plt.subplots(figsize=(10, 5.5))
@@ -228,6 +226,4 @@ def plot(bound: np.ndarray, results: list[LocaliserResult], path) -> None:
     )
     axis.grid(alpha=0.3, which="both")
     axis.legend(fontsize=8)
-    figure.tight_layout()
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
+    save(figure, path, dpi=110)

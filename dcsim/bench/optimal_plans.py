@@ -3,8 +3,8 @@
 Both solvers plan every target of a request under the plan model of the ``ga`` planner
 (and of :func:`dcsim.api.plan_cost`): straight constant-velocity legs with impulsive
 burns matching each node's velocity, cost = delta-v + ``time_weight`` × duration, runs of
-at most ``capacity`` pickups each ending with a drop visit (a first drop visit only if
-the collector starts full), and a leg feasible when its duration lies between
+at most ``capacity`` pickups each ending with a drop visit (the collector starts with
+nothing on board), and a leg feasible when its duration lies between
 ``min_time_step`` (and the rest-to-rest time of its length) and ``max_leg_time``.
 
 - :func:`optimal_static_plan`: stationary targets and drop point, a collector at rest.
@@ -20,6 +20,7 @@ Cost is exponential in the number of targets (2^n subsets); both are meant for n
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,7 +32,7 @@ from dcsim.api import (
     TaskRequest,
     leg_delta_v,
     plan_cost,
-    rest_to_rest_time,
+    shortest_leg,
 )
 
 
@@ -59,9 +60,7 @@ class LegRules:
     def min_duration(self, request: TaskRequest, distance: np.ndarray) -> np.ndarray:
         """Shortest feasible leg over ``distance`` m, s."""
         speed = self.speed_fraction * request.max_speed
-        return np.maximum(
-            self.min_time_step, rest_to_rest_time(distance, speed, request.max_acceleration)
-        )
+        return shortest_leg(distance, speed, request.max_acceleration, self.min_time_step)
 
 
 @dataclass
@@ -95,8 +94,9 @@ def optimal_static_plan(request: TaskRequest, rules: LegRules) -> Plan:
     """
     n = len(request.targets)
     t0 = request.time
-    points = np.array([track.predict(t0)[0] for track in request.targets])
-    speeds = np.array([track.predict(t0)[1] for track in request.targets])
+    states = [track.predict(t0) for track in request.targets]
+    points = np.array([p for p, _ in states])
+    speeds = np.array([v for _, v in states])
     if np.any(speeds) or np.any(request.robot.velocity) or request.carried:
         raise ValueError(
             "optimal_static_plan needs stationary targets, a collector at rest and nothing on board"
@@ -210,17 +210,9 @@ def optimal_grid_plan(
     first = _leg(request, rules, start_p, start_v, t0, position, velocity, grid)  # (n+1, G)
     route = _grid_dp(legs, first, n, request.capacity)
     order, drops, pick_k, drop_k = route
-    to_time = {k: float(grid[k]) for k in set(pick_k) | set(drop_k) if k >= 0}
-    return _plan(
-        request,
-        rules,
-        _Route(
-            order,
-            drops,
-            [to_time[k] for k in pick_k],
-            [to_time[k] if k >= 0 else np.nan for k in drop_k],
-        ),
-    )
+    pickup_times = [float(grid[k]) for k in pick_k]
+    drop_times = [float(grid[k]) if k >= 0 else np.nan for k in drop_k]
+    return _plan(request, rules, _Route(order, drops, pickup_times, drop_times))
 
 
 def _leg(request, rules, p_from, v_from, t_from, p_to, v_to, t_to) -> np.ndarray:
@@ -330,4 +322,4 @@ def _plan(request: TaskRequest, rules: LegRules, route: _Route) -> Plan:
             at = route.drop_times[index]
             visits.append(DropVisit(index, at, request.drop_point.state_at(at)[0]))
     plan = Plan(tuple(tasks), tuple(visits))
-    return Plan(plan.tasks, plan.drop_visits, plan_cost(request, plan, rules.time_weight))
+    return dataclasses.replace(plan, cost=plan_cost(request, plan, rules.time_weight))

@@ -38,6 +38,7 @@ from dcsim.api import (
     plan_cost,
     plan_duration,
 )
+from dcsim.bench.figures import pyplot, save
 from dcsim.bench.optimal_plans import LegRules, optimal_grid_plan, optimal_static_plan
 from dcsim.registry import PluginRegistry
 
@@ -138,10 +139,9 @@ def compare_strategies(
         ]
         for label, params in STRATEGY_VARIANTS:
             result = StrategyResult(label, n)
-            weight = registry.create("task_planner", "ga", params).params.time_weight
             for seed, request in enumerate(requests):
                 plan, seconds, planner = _plan(registry, "ga", params, seed, request)
-                result.costs.append(plan_cost(request, plan, weight))
+                result.costs.append(plan.cost)  # ga's cost is plan_cost with its time weight
                 result.iterations.append(planner.statistics.iterations)
                 result.seconds.append(seconds)
                 result.durations.append(plan_duration(request, plan))
@@ -176,10 +176,7 @@ def strategy_table(results: list[StrategyResult], repeats: int) -> str:
 
 def plot_strategies(results: list[StrategyResult], path: Path) -> None:
     """Bar charts of the five compared quantities against n, one bar per strategy."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     labels = list(dict.fromkeys(r.label for r in results))
     sizes = sorted({r.n for r in results})
@@ -203,9 +200,7 @@ def plot_strategies(results: list[StrategyResult], path: Path) -> None:
         axis.grid(alpha=0.3, axis="y")
     axes[0].legend(fontsize=8)
     figure.suptitle("ga time strategies on moving targets (thesis figures 3.1–3.10)")
-    figure.tight_layout()
-    figure.savefig(path, dpi=100)
-    plt.close(figure)
+    save(figure, path)
 
 
 # --------------------------------------------------------------------- gaps
@@ -278,9 +273,14 @@ def optimality_gaps(
         ga_row = rows["ga"]
         progress(
             f"{'moving' if moving else 'stationary'} n={n}: ga median gap "
-            f"{100 * np.median(ga_row.gaps):.2f} %, max time {max(ga_row.seconds):.2f} s"
+            f"{_percent(ga_row.gaps, np.median)} %, max time {max(ga_row.seconds, default=0):.2f} s"
         )
     return results
+
+
+def _percent(gaps: list[float], statistic: Callable[[np.ndarray], float]) -> str:
+    """``statistic`` of relative gaps as a percentage, or "–" if there is none."""
+    return f"{100 * statistic(np.array(gaps)):.2f}" if gaps else "–"
 
 
 def gap_table(results: list[GapResult]) -> str:
@@ -291,7 +291,6 @@ def gap_table(results: list[GapResult]) -> str:
         "|---|---:|---|---:|---:|---:|---:|---:|---:|",
     ]
     for r in results:
-        gaps = 100 * np.array(r.gaps)
         kind = "moving (grid optimum)" if r.moving else "stationary"
         done = f"{len(r.gaps)}"
         if r.incomplete:
@@ -299,19 +298,16 @@ def gap_table(results: list[GapResult]) -> str:
         if r.unsolved:
             done += f" (+{r.unsolved} without an optimum in the horizon)"
         lines.append(
-            f"| {kind} | {r.n} | {r.label} | {done} | {np.median(gaps):.2f} | "
-            f"{np.percentile(gaps, 95):.2f} | {gaps.max():.2f} | {np.median(r.seconds):.3f} | "
-            f"{max(r.seconds):.3f} |"
+            f"| {kind} | {r.n} | {r.label} | {done} | {_percent(r.gaps, np.median)} | "
+            f"{_percent(r.gaps, lambda g: np.percentile(g, 95))} | {_percent(r.gaps, np.max)} | "
+            f"{np.median(r.seconds):.3f} | {max(r.seconds):.3f} |"
         )
     return "\n".join(lines)
 
 
 def plot_gaps(results: list[GapResult], path: Path) -> None:
     """Box plots of the gap distributions, per problem and planner."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     figure, axis = plt.subplots(figsize=(11, 4.5))
     data = [100 * np.array(r.gaps) for r in results]
@@ -322,6 +318,4 @@ def plot_gaps(results: list[GapResult], path: Path) -> None:
     axis.set_ylabel("plan cost above the optimum [%]")
     axis.set_title("Task planners against the exact optimum (whiskers: 5th–95th percentile)")
     axis.grid(alpha=0.3, axis="y")
-    figure.tight_layout()
-    figure.savefig(path, dpi=100)
-    plt.close(figure)
+    save(figure, path)

@@ -56,8 +56,8 @@ def layouts(n, capacity):
             yield flags
 
 
-def node_sequence(request, order, flags):
-    """(object, is_drop) per node after the start."""
+def node_sequence(order, flags):
+    """Per node after the start: the target's index, or None for a drop visit."""
     nodes = []
     for target, drop_after in zip(order, flags, strict=True):
         nodes.append(target)
@@ -97,7 +97,7 @@ def test_static_optimum_equals_exhaustive_search_with_scanned_leg_times():
     for order in itertools.permutations(range(4)):
         for flags in layouts(4, 2):
             here, total = np.zeros(3), 0.0
-            for node in node_sequence(request, order, flags):
+            for node in node_sequence(order, flags):
                 there = points[4] if node is None else points[node]
                 total += best_leg(here, there)
                 here = there
@@ -113,7 +113,7 @@ def test_grid_optimum_equals_exhaustive_search_over_the_grid():
     best = np.inf
     for order in itertools.permutations(range(3)):
         for flags in layouts(3, 2):
-            count = len(node_sequence(request, order, flags))
+            count = len(node_sequence(order, flags))
             for times in itertools.combinations(grid, count):
                 plan = as_plan(request, order, flags, np.array(times))
                 if _feasible(request, plan):
