@@ -435,7 +435,12 @@ def bench_controllers_command(
 
     scenario = packaged_scenario_path("crowded_field.yaml")
     names = [name.strip() for name in controllers.split(",") if name.strip()]
-    safety = load_scenario(scenario, overrides).mission.safety_distance  # checks the overrides
+    if not names:
+        raise click.BadParameter("name at least one controller", param_hint="--controllers")
+    registry = PluginRegistry.discover()
+    for name in names:  # unknown controllers and bad overrides fail here, before any run
+        chosen = [f"controller.plugin={name}", "controller.params={}", *overrides]
+        safety = load_scenario(scenario, chosen, registry).mission.safety_distance
     runs = bench_controllers(
         scenario,
         names,

@@ -185,13 +185,14 @@ class Mission:
     def _new_target(self) -> ObjectTrack | None:
         return next((t for t in self._free_targets() if t.id not in self.planned), None)
 
-    def _plan_path(self, goal: GoalRegion) -> Trajectory | None:
+    def _plan_path(self, goal: GoalRegion, max_speed: float | None = None) -> Trajectory | None:
+        """Ask the path planner for a way to ``goal`` at up to ``max_speed`` (the robot's)."""
         problem = PathProblem(
             start=PathState(self.time, self.estimate.position, self.estimate.velocity),
             goal=goal,
             obstacles=self._obstacles(),
             robot_radius=self.world.robot_spec().radius,
-            max_speed=self.robot.max_speed,
+            max_speed=self.robot.max_speed if max_speed is None else max_speed,
             max_acceleration=self._max_acceleration(),
             time_budget=self.settings.planning_budget,
         )
@@ -270,6 +271,11 @@ class Mission:
             self.retry_at = -np.inf
             self._go(Mode.MOVE_TO_NEXT, f"pickup of target {step.target_id}")
         return self._holding()
+
+    def _drop_speed(self) -> float:
+        """Speed limit on the way to the drop point (DROP_SPEED), m/s."""
+        drop_speed = self.settings.drop_speed or np.inf
+        return min(self.robot.max_speed, drop_speed)
 
     def _standoff_gap(self) -> float:
         """Surface gap to hold from a target: half the reach, or clear of any cargo.
@@ -355,12 +361,13 @@ class Mission:
             arrive = self.visit.time if self.visit and self.visit.time > self.time else None
             position, velocity = drop.state_at(self.time if arrive is None else arrive)
             self.trajectory = self._plan_path(
-                GoalRegion(position, 0.5 * drop.tolerance, velocity, arrive)
+                GoalRegion(position, 0.5 * drop.tolerance, velocity, arrive), self._drop_speed()
             )
             self.release_refused = False
-        reference = self._follow(lambda: drop.state_at(self.time))
-        if self.settings.drop_speed > 0:
-            reference = dataclasses.replace(reference, max_speed=self.settings.drop_speed)
+        # The limit also holds once the trajectory is flown and the drop point is tracked.
+        reference = dataclasses.replace(
+            self._follow(lambda: drop.state_at(self.time)), max_speed=self._drop_speed()
+        )
         distance = np.linalg.norm(self.estimate.position - drop.state_at(self.time)[0])
         if distance <= self.settings.release_fraction * drop.tolerance:
             result = self.world.release()

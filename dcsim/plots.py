@@ -15,11 +15,12 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
 import numpy as np  # noqa: E402
 
+from dcsim.mission import Mode  # noqa: E402
 from dcsim.motion import MotionSet  # noqa: E402
 from dcsim.scenario.model import Scenario  # noqa: E402
 from dcsim.world.engine import build_objects  # noqa: E402
 
-_MODES = ("LOCALIZE", "DEVISE_PLAN", "SELECT_NEXT", "MOVE_TO_NEXT", "GRAB", "MOVE_TO_DROP", "IDLE")
+_MODES = tuple(mode.name for mode in Mode)
 
 
 def write_plots(

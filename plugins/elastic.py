@@ -109,22 +109,19 @@ def perpendicular_repulsion(
 
     Returns
     -------
-    plus, minus : ndarray (K, 3)
-        ``C × V`` and ``V × C``.
-    take_plus : ndarray of bool (K,)
-        Whether ``plus`` makes the larger cosine with ``attraction`` (True on a tie).
+    plus, minus, chosen : ndarray (K, 3)
+        ``C × V``, ``V × C`` and, per row, whichever makes the larger cosine with
+        ``attraction`` (``plus`` on a tie).
     """
     plus = np.cross(closeness, relative_velocity)
     minus = np.cross(relative_velocity, closeness)
-    return plus, minus, preference(plus, attraction) >= 0
+    take_plus = _cosine(plus, attraction) >= _cosine(minus, attraction)
+    return plus, minus, np.where(take_plus[:, None], plus, minus)
 
 
-def preference(plus: np.ndarray, attraction: np.ndarray) -> np.ndarray:
-    """How much eq. 5.2 prefers ``F⁺`` over ``F⁻ = −F⁺``: the difference of their cosines
-    with ``attraction`` (in [−2, 2]; 0 when both are perpendicular to it)."""
-    norms = np.linalg.norm(plus, axis=1) * np.linalg.norm(attraction)
-    cosine = np.divide(plus @ attraction, norms, out=np.zeros(len(plus)), where=norms > 0)
-    return 2.0 * cosine
+def _cosine(vectors: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    norms = np.linalg.norm(vectors, axis=1) * np.linalg.norm(reference)
+    return np.divide(vectors @ reference, norms, out=np.zeros(len(vectors)), where=norms > 0)
 
 
 def repulsion(
@@ -132,7 +129,7 @@ def repulsion(
     relative_velocity: np.ndarray,
     attraction: np.ndarray,
     gain: float,
-    take_plus: np.ndarray,
+    chosen: np.ndarray,
     speed_scale: float = 0.0,
 ) -> np.ndarray:
     """Repulsive velocity per obstacle inside its safety sphere, m/s (see the module docs).
@@ -145,8 +142,8 @@ def repulsion(
         ``V_robot``, m/s.
     gain : float
         Velocity per metre of closeness, 1/s.
-    take_plus : ndarray of bool (K,)
-        Which perpendicular candidate to use: ``C × V`` where True, ``V × C`` elsewhere.
+    chosen : ndarray (K, 3)
+        The perpendicular candidate eq. 5.2 chose (:func:`perpendicular_repulsion`).
     speed_scale : float
         Relative speed, m/s, below which the perpendicular share fades in proportion
         (a slow obstacle's ``C × V`` turns with every wobble of the velocity estimate).
@@ -157,8 +154,6 @@ def repulsion(
     """
     depth = np.linalg.norm(closeness, axis=1)
     radial = closeness / np.maximum(depth, 1e-12)[:, None]
-    plus = np.cross(closeness, relative_velocity)
-    chosen = np.where(take_plus[:, None], plus, -plus)
     speed = np.linalg.norm(relative_velocity, axis=1)
     size = np.linalg.norm(chosen, axis=1)
     sine = np.divide(size, depth * speed, out=np.zeros(len(depth)), where=depth * speed > _PARALLEL)
@@ -250,13 +245,13 @@ class ElasticController(Controller):
         if not surroundings.obstacles:
             return attraction
         closeness, relative = self._inside(time, estimate, surroundings)
-        take_plus = perpendicular_repulsion(closeness, relative, attraction)[2]
+        chosen = perpendicular_repulsion(closeness, relative, attraction)[2]
         push = repulsion(
             closeness,
             relative,
             attraction,
             self.params.repulsion_gain,
-            take_plus,
+            chosen,
             self.params.slow_obstacle_speed,
         )
         return clip_norm(attraction + push.sum(axis=0), limit)
@@ -270,7 +265,10 @@ class ElasticController(Controller):
         are closing; once they separate, pushing on would only cost fuel.
         """
         obstacles = surroundings.obstacles
-        states = [track.predict(time) for track in obstacles]
+        states = [  # tracks stamped now need no prediction (the usual case)
+            (track.position, track.velocity) if track.time == time else track.predict(time)
+            for track in obstacles
+        ]
         centres = np.array([p for p, _ in states])
         relative = np.array([v for _, v in states]) - estimate.velocity
         radii = np.array([track.radius for track in obstacles])

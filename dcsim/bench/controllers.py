@@ -76,9 +76,17 @@ def fly(scenario: Path, controller: str, seed: int, overrides: Sequence[str] = (
     """Fly ``scenario`` with ``controller`` on seed ``seed``'s field (nothing written).
 
     ``overrides`` (``key.path=value``) apply after the field and the controller's choice.
+
+    Raises
+    ------
+    RuntimeError
+        If the run did not complete (a plugin failed, or a stop rule other than a
+        collision ended it): its figures would not be comparable.
     """
     chosen = [field_override(seed), f"controller.plugin={controller}", "controller.params={}"]
     summary = Runner(prepare_run(scenario, [*chosen, *overrides], seed), None).run()
+    if summary["status"] != "completed":
+        raise RuntimeError(f"{controller} on seed {seed}: {summary['status']}, {summary['reason']}")
     return ControllerRun(
         controller,
         seed,

@@ -171,6 +171,7 @@ class World:
         self.collector = self._create_collector()
         self._bodies = [self._create_object_body(i) for i in range(len(self.field))]
         self._carried: dict[int, tuple[int, int]] = {}  # object index -> (body, constraint)
+        self._protrusion = 0.0  # m, see cargo_protrusion
         self._contacts: set[tuple[int, int]] = set()
         self._candidates = np.zeros(0, dtype=int)
         self._period_mass = self.assembly_mass()
@@ -296,12 +297,15 @@ class World:
         return float(np.min(gaps))
 
     def cargo_protrusion(self) -> float:
-        """How far carried targets reach beyond the collector's surface, m (0 if none)."""
-        centre, radius = self._assembly_spheres()[0]
-        return max(
-            [np.linalg.norm(c - centre) + r - radius for c, r in self._assembly_spheres()[1:]],
-            default=0.0,
-        )
+        """How far carried targets reach beyond the collector's surface, m (0 if none).
+
+        Cargo is held rigidly, so this changes only at a grab or a release.
+        """
+        return self._protrusion
+
+    def _measure_protrusion(self) -> float:
+        (centre, radius), *cargo = self._assembly_spheres()
+        return max((np.linalg.norm(c - centre) + r - radius for c, r in cargo), default=0.0)
 
     def _assembly_spheres(self) -> list[tuple[np.ndarray, float]]:
         spheres = [(self.collector_state()[0], self.robot.radius)]
@@ -594,6 +598,7 @@ class World:
         )
         pb.changeConstraint(constraint, maxForce=_CONSTRAINT_FORCE, physicsClientId=self._client)
         self._carried[index] = (body, constraint)
+        self._protrusion = self._measure_protrusion()
         self._bodies[index] = body
         self.field.status[index] = ObjectStatus.CARRIED
         self._contacts = {pair for pair in self._contacts if pair[0] != index}
@@ -620,6 +625,7 @@ class World:
             self.field.status[index] = ObjectStatus.DELIVERED
             delivered.append(self.field.objects[index].id)
         self._carried.clear()
+        self._protrusion = 0.0
         pb.changeDynamics(
             self.collector, -1, mass=self.collector_mass(), physicsClientId=self._client
         )

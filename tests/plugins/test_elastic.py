@@ -53,24 +53,25 @@ def at(position, velocity=(0.0, 0.0, 0.0)):
 def test_the_two_cross_products_and_the_less_disruptive_choice():
     closeness = np.array([[1.0, 0.0, 0.0]])
     velocity = np.array([[0.0, 2.0, 0.0]])
-    plus, minus, take_plus = perpendicular_repulsion(closeness, velocity, np.array([0, 0, 1.0]))
+    plus, minus, chosen = perpendicular_repulsion(closeness, velocity, np.array([0, 0, 1.0]))
     np.testing.assert_allclose(plus, [[0.0, 0.0, 2.0]])  # (D' - D) x V
     np.testing.assert_allclose(minus, [[0.0, 0.0, -2.0]])  # V x (D' - D)
-    assert take_plus.tolist() == [True]  # +z agrees with an attraction along +z
-    assert perpendicular_repulsion(closeness, velocity, np.array([0, 0.3, -1.0]))[2].tolist() == [
-        False
-    ]
+    np.testing.assert_allclose(chosen, plus)  # +z agrees with an attraction along +z
+    leaning_down = perpendicular_repulsion(closeness, velocity, np.array([0, 0.3, -1.0]))[2]
+    np.testing.assert_allclose(leaning_down, minus)
+
+
+def push(closeness, relative_velocity, attraction, gain=0.5, **options):
+    """The repulsion with eq. 5.2's own choice of side, as the controller uses it."""
+    chosen = perpendicular_repulsion(closeness, relative_velocity, attraction)[2]
+    return repulsion(closeness, relative_velocity, attraction, gain, chosen, **options)
 
 
 def test_a_perpendicular_push_grows_with_the_depth_inside_the_safety_sphere():
-    push = repulsion(
-        np.array([[0.8, 0.0, 0.0]]),
-        np.array([[0.0, 0.3, 0.0]]),
-        np.array([0.0, 0.0, 0.4]),
-        gain=0.5,
-        take_plus=np.array([True]),
+    pushed = push(
+        np.array([[0.8, 0.0, 0.0]]), np.array([[0.0, 0.3, 0.0]]), np.array([0.0, 0.0, 0.4])
     )
-    np.testing.assert_allclose(push, [[0.0, 0.0, 0.5 * 0.8]], atol=1e-12)
+    np.testing.assert_allclose(pushed, [[0.0, 0.0, 0.5 * 0.8]], atol=1e-12)
 
 
 def test_head_on_and_static_cases_push_half_away_half_aside():
@@ -78,28 +79,20 @@ def test_head_on_and_static_cases_push_half_away_half_aside():
     attraction = np.array([-0.3, 0.1, 0.0])  # towards the obstacle, leaning to +y
     expected = 0.5 * 2.0 * np.array([1.0, 1.0, 0.0]) / np.sqrt(2.0)
     for velocity in ([[0.0, 0.0, 0.0]], [[-0.4, 0.0, 0.0]]):  # both at rest; head-on
-        push = repulsion(closeness, np.array(velocity), attraction, 0.5, np.array([True]))
-        np.testing.assert_allclose(push, [expected], atol=1e-12)
+        pushed = push(closeness, np.array(velocity), attraction)
+        np.testing.assert_allclose(pushed, [expected], atol=1e-12)
 
 
 def test_a_slow_obstacle_pushes_away_and_aside_rather_than_perpendicular():
     closeness = np.array([[1.0, 0.0, 0.0]])
     attraction = np.array([0.0, 0.2, 0.0])
-    slow = repulsion(
-        closeness,
-        np.array([[0.0, 0.0, 0.001]]),
-        attraction,
-        0.5,
-        np.array([True]),
-        speed_scale=0.05,
-    )
-    fast = repulsion(
-        closeness, np.array([[0.0, 0.0, 0.2]]), attraction, 0.5, np.array([True]), speed_scale=0.05
-    )
-    # C x V is along -y for V along +z; the slow one is 2 % of that, the rest radial + aside.
-    np.testing.assert_allclose(fast, [[0.0, -0.5, 0.0]], atol=1e-12)
+    slow = push(closeness, np.array([[0.0, 0.0, 0.001]]), attraction, speed_scale=0.05)
+    fast = push(closeness, np.array([[0.0, 0.0, 0.2]]), attraction, speed_scale=0.05)
+    # V x C is along +y (the attraction's side) for V along +z; the slow obstacle gets 2 %
+    # of that push, the rest radial + aside.
+    np.testing.assert_allclose(fast, [[0.0, 0.5, 0.0]], atol=1e-12)
     aside = 0.5 * np.array([1.0, 1.0, 0.0]) / np.sqrt(2.0)
-    np.testing.assert_allclose(slow, [0.02 * np.array([0, -0.5, 0]) + 0.98 * aside], atol=1e-12)
+    np.testing.assert_allclose(slow, [0.02 * np.array([0, 0.5, 0]) + 0.98 * aside], atol=1e-12)
 
 
 def test_desired_velocity_is_attraction_plus_the_pushes_of_closing_obstacles():

@@ -134,8 +134,16 @@ def test_cargo_protrusion_is_how_far_cargo_sticks_out_of_the_collector():
     assert world.cargo_protrusion() == 0.0
     grabbed = world.grab(2)
     assert grabbed.success
-    # The gap to the target plus its diameter (0.5 m radius).
+    # The gap to the target plus its diameter (0.5 m radius); the robot's bounding radius
+    # grows by as much, and stays so while the assembly flies.
     assert world.cargo_protrusion() == pytest.approx(grabbed.gap + 1.0, abs=1e-6)
+    assert world.robot_spec().radius == pytest.approx(0.5 + grabbed.gap + 1.0, abs=1e-6)
+    for _ in range(100):
+        world.step(WorldInputs(force=np.array([5.0, 0.0, 0.0])))
+    (centre, radius), (cargo, cargo_radius) = world._assembly_spheres()
+    assert np.linalg.norm(cargo - centre) + cargo_radius - radius == pytest.approx(
+        world.cargo_protrusion(), abs=1e-4
+    )
 
 
 def test_release_only_at_the_drop_point():
@@ -147,6 +155,7 @@ def test_release_only_at_the_drop_point():
     assert world.grab(2).success
     assert world.release().delivered == (2,)
     assert world.outputs()["delivered"] == 1 and world.outputs()["carried"] == 0
+    assert world.cargo_protrusion() == 0.0 and world.robot_spec().radius == 0.5
     away = world_from(
         FIELD.replace("position: [0, 2.2, 0]", "position: [0, 1.9, 0]").rstrip(" ")
         + "    drop_point: {position: [9, 0, 0], tolerance: 0.5}\n"
@@ -154,6 +163,7 @@ def test_release_only_at_the_drop_point():
     assert away.grab(2).success
     refused = away.release()
     assert refused.delivered == () and "from the drop point" in refused.reason
+    assert away.cargo_protrusion() > 1.0  # still on board
 
 
 def test_thrust_bookkeeping_matches_impulse_over_mass():
