@@ -282,6 +282,9 @@ def test_ctrl_c_on_the_command_line_stops_the_run_and_writes_the_summary(tmp_pat
         stderr=subprocess.PIPE,
         text=True,
         env={**os.environ, "PYTHONPATH": ""},
+        # As at a terminal: a suite started in the background has SIGINT ignored, and
+        # the child would inherit that.
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     deadline = time.monotonic() + 60
     while not (out / "events.jsonl").exists() and time.monotonic() < deadline:
@@ -289,7 +292,7 @@ def test_ctrl_c_on_the_command_line_stops_the_run_and_writes_the_summary(tmp_pat
     time.sleep(1.0)
     process.send_signal(signal.SIGINT)
     stdout, stderr = process.communicate(timeout=60)
-    assert process.returncode == 130, stderr
+    assert process.returncode == 130, stdout + stderr
     assert "stopped (interrupted)" in stdout and "Traceback" not in stderr
     summary = json.loads((out / "summary.json").read_text())
     assert summary["reason"] == "interrupted" and summary["sim_time_s"] > 0
