@@ -27,8 +27,8 @@ from typing import Any
 import numpy as np
 
 from dcsim.hookspecs import RunInfo
-from dcsim.messages import LocationEstimate, Prior, Surroundings
-from dcsim.mission import Mission, PluginFailure, call_plugin
+from dcsim.messages import Command, LocationEstimate, Prior, Surroundings
+from dcsim.mission import Mission, Mode, PluginFailure, call_plugin
 from dcsim.plots import write_plots
 from dcsim.recording import Recorder
 from dcsim.runsetup import RunSetup
@@ -37,6 +37,8 @@ from dcsim.scenario.model import point_to_cartesian
 from dcsim.seeding import component_rng
 from dcsim.world import World, WorldInputs
 from dcsim.world.objects import ObjectStatus
+
+_ZERO = np.zeros(3)
 
 
 class LapTimer:
@@ -78,7 +80,12 @@ class _RunEnded(Exception):
 
 
 class Runner:
-    """Runs one scenario to its end and records it.
+    """Runs one scenario, one control period at a time, and records it.
+
+    :meth:`run` flies the scenario to its end. The same run can be driven step by step
+    (the FMU slave does): :meth:`open` builds the world and decides the first control
+    period, each :meth:`advance` flies one period and decides the next, and
+    :meth:`close` writes the records and returns the summary.
 
     Parameters
     ----------
@@ -88,7 +95,19 @@ class Runner:
         Run directory to write; None records in memory only.
     progress : callable, optional
         ``progress(sim_time, duration, mode, delivered, targets)``, called about four
-        times a second of wall time.
+        times a second of wall time by :meth:`run`.
+
+    Attributes
+    ----------
+    world : World or None
+        The world, from :meth:`open` on.
+    status, reason : str or None, str
+        How the run ended (``completed``, ``stopped`` or ``failed``) and why; None
+        while it goes on.
+    estimate : LocationEstimate or None
+        The localiser's estimate at the current time.
+    mode : Mode or None
+        The mission mode decided for the current control period.
     """
 
     def __init__(
@@ -104,110 +123,189 @@ class Runner:
         self.info = RunInfo(self.scenario, self.scenario.world.seed, out_dir)
         self.progress = progress
         self.world: World | None = None
+        self.mission: Mission | None = None
+        self.status: str | None = None
+        self.reason = ""
+        self.estimate: LocationEstimate | None = None
         self.summary: dict[str, Any] = {}
         self.laps = LapTimer()
+        self._command = Command()
+        self._cargo: list[int] = []
+        self._targets = 0
+        self._started = 0.0
+
+    @property
+    def ended(self) -> bool:
+        """Whether the run has ended (see :attr:`status`)."""
+        return self.status is not None
+
+    @property
+    def mode(self) -> Mode | None:
+        """The mission mode decided for the current control period."""
+        return None if self.mission is None else self.mission.mode
 
     # ------------------------------------------------------------------ public
     def run(self) -> dict[str, Any]:
         """Run to the end; return the summary (also written to ``summary.json``)."""
-        started = wallclock.perf_counter()
-        status, reason = "completed", ""
-        self.world = World(self.scenario, component_rng(self.scenario.world.seed, "world"))
+        last_progress = -np.inf
         try:
-            self._hook("dcsim_run_start", run=self.info)
-            self._loop(started)
-        except _RunEnded as end:
-            status, reason = end.status, end.reason
-        except PluginFailure as failure:
-            status, reason = "failed", str(failure)
-            self._event(
-                "plugin_failed", role=failure.role, plugin=failure.plugin, error=str(failure.error)
-            )
-        except HookFailure as failure:
-            status, reason = "failed", str(failure)
+            self.open()
+            while not self.ended:
+                self.advance()
+                wall = wallclock.perf_counter()
+                if self.progress is not None and wall - last_progress > 0.25:
+                    last_progress = wall
+                    self._report_progress()
+                self.laps.lap("recording")
         except KeyboardInterrupt:
-            status, reason = "stopped", "interrupted"
+            self._end("stopped", "interrupted")
             self._event("interrupted")
-        finally:
-            wall = wallclock.perf_counter() - started
-            self.summary = self._summary(status, reason, wall)
-            self.world.close()
-            if self.info.out_dir is not None:
-                self.recorder.write(self.summary, dump_scenario(self.scenario))
-                write_plots(
-                    self.info.out_dir,
-                    self.scenario,
-                    self.recorder.telemetry(),
-                    self.recorder.events,
+        return self.close()
+
+    def open(self) -> None:
+        """Build the world, reset the plugins and decide the first control period."""
+        self._started = wallclock.perf_counter()
+        self.world = World(self.scenario, component_rng(self.scenario.world.seed, "world"))
+        self._guarded(self._start)
+
+    def advance(
+        self,
+        disturbance_force: np.ndarray = _ZERO,
+        disturbance_torque: np.ndarray = _ZERO,
+    ) -> None:
+        """Fly the decided command for one control period, then decide the next.
+
+        Once the run has ended the world coasts: the period is flown without thrust
+        and nothing more is recorded.
+
+        Parameters
+        ----------
+        disturbance_force : ndarray (3,)
+            External force on the collector over the period, world frame, N.
+        disturbance_torque : ndarray (3,)
+            External torque on the collector over the period, world frame, N·m.
+        """
+        if self.ended:
+            self.world.step(
+                WorldInputs(
+                    disturbance_force=disturbance_force, disturbance_torque=disturbance_torque
                 )
+            )
+            return
+        self._guarded(self._advance, disturbance_force, disturbance_torque)
+
+    def close(self) -> dict[str, Any]:
+        """End the run, close the world, write the records; return the summary."""
+        if not self.ended:
+            self._end("stopped", "closed before the end")
+        self.summary = self._summary(wallclock.perf_counter() - self._started)
+        self.world.close()
+        if self.info.out_dir is not None:
+            self.recorder.write(self.summary, dump_scenario(self.scenario))
+            write_plots(
+                self.info.out_dir, self.scenario, self.recorder.telemetry(), self.recorder.events
+            )
         self._hook("dcsim_run_end", run=self.info, summary=self.summary)
         return self.summary
 
     # ------------------------------------------------------------------ loop
-    def _loop(self, started: float) -> None:
-        world, scenario, laps = self.world, self.scenario, self.laps
-        period = world.control_period
-        mission = Mission(scenario, world, self.plugins, self._event)
+    def _guarded(self, step: Callable[..., None], *args: Any) -> None:
+        """Call ``step``; turn the ways a run ends into :attr:`status`."""
+        try:
+            step(*args)
+        except _RunEnded as end:
+            self._end(end.status, end.reason)
+        except PluginFailure as failure:
+            self._end("failed", str(failure))
+            self._event(
+                "plugin_failed", role=failure.role, plugin=failure.plugin, error=str(failure.error)
+            )
+        except HookFailure as failure:
+            self._end("failed", str(failure))
+
+    def _end(self, status: str, reason: str) -> None:
+        self.status, self.reason = status, reason
+
+    def _start(self) -> None:
+        world = self.world
+        self._hook("dcsim_run_start", run=self.info)
+        self.mission = Mission(self.scenario, world, self.plugins, self._event)
         call_plugin(self.plugins, "localiser", "reset", self._prior(), 0.0)
         call_plugin(self.plugins, "controller", "reset", world.robot_spec())
-        cargo = world.carried_ids()
-        targets = int(world.field.is_target.sum())
-        last_progress = -np.inf
-        laps.start()
-        while True:
-            t = world.time
-            tracks, ranges = world.object_tracks(), world.beacon_ranges()
-            laps.lap("sensors")
-            if t > 0:
-                call_plugin(self.plugins, "localiser", "predict", world.motion_input(), period)
-            call_plugin(self.plugins, "localiser", "update", ranges)
-            estimate: LocationEstimate = call_plugin(self.plugins, "localiser", "estimate")
-            laps.lap("localiser")
-            reference = mission.tick(t, estimate, tracks)
-            laps.lap("mission")
-            if world.carried_ids() != cargo:  # a grab or a release changed the mass
-                cargo = world.carried_ids()
-                call_plugin(self.plugins, "controller", "reset", world.robot_spec())
-            obstacles = tuple(tr for tr in tracks if tr.kind.value == "obstacle")
-            surroundings = Surroundings(obstacles, scenario.mission.safety_distance)
-            command = call_plugin(
-                self.plugins, "controller", "command", t, estimate, reference, surroundings
-            )
-            laps.lap("controller")
-            self._record(t, estimate, mission.mode.name, command.force)
-            delivered = world.field.count(ObjectStatus.DELIVERED)
-            self._check_stop(t, delivered, targets, started)
-            laps.lap("recording")
-            collisions = world.step(WorldInputs(force=command.force, torque=command.torque))
-            laps.lap("world")
-            for collision in collisions:
-                self._event(
-                    "collision",
-                    at=collision.time,
-                    object=collision.object_id,
-                    body=collision.body,
-                    penetration=collision.penetration,
-                )
-                if scenario.stop.on_collision:
-                    self._record_final(mission.mode.name)
-                    raise _RunEnded("stopped", f"collision with object {collision.object_id}")
-            wall = wallclock.perf_counter()
-            if self.progress is not None and wall - last_progress > 0.25:
-                last_progress = wall
-                self.progress(
-                    world.time, scenario.world.duration, mission.mode.name, delivered, targets
-                )
-            laps.lap("recording")
+        self._cargo = world.carried_ids()
+        self._targets = int(world.field.is_target.sum())
+        self.laps.start()
+        self._decide()
 
-    def _check_stop(self, t: float, delivered: int, targets: int, started: float) -> None:
+    def _decide(self) -> None:
+        """Sense, localise, run the mission and the controller at the current time."""
+        world, laps, plugins = self.world, self.laps, self.plugins
+        t = world.time
+        tracks, ranges = world.object_tracks(), world.beacon_ranges()
+        laps.lap("sensors")
+        if t > 0:
+            call_plugin(plugins, "localiser", "predict", world.motion_input(), world.control_period)
+        call_plugin(plugins, "localiser", "update", ranges)
+        estimate: LocationEstimate = call_plugin(plugins, "localiser", "estimate")
+        self.estimate = estimate
+        laps.lap("localiser")
+        reference = self.mission.tick(t, estimate, tracks)
+        laps.lap("mission")
+        if world.carried_ids() != self._cargo:  # a grab or a release changed the mass
+            self._cargo = world.carried_ids()
+            call_plugin(plugins, "controller", "reset", world.robot_spec())
+        obstacles = tuple(tr for tr in tracks if tr.kind.value == "obstacle")
+        surroundings = Surroundings(obstacles, self.scenario.mission.safety_distance)
+        self._command = call_plugin(
+            plugins, "controller", "command", t, estimate, reference, surroundings
+        )
+        laps.lap("controller")
+        self._record(t, estimate, self.mission.mode.name, self._command.force)
+        self._check_stop(t)
+        laps.lap("recording")
+
+    def _advance(self, disturbance_force: np.ndarray, disturbance_torque: np.ndarray) -> None:
+        inputs = WorldInputs(
+            force=self._command.force,
+            torque=self._command.torque,
+            disturbance_force=disturbance_force,
+            disturbance_torque=disturbance_torque,
+        )
+        collisions = self.world.step(inputs)
+        self.laps.lap("world")
+        for collision in collisions:
+            self._event(
+                "collision",
+                at=collision.time,
+                object=collision.object_id,
+                body=collision.body,
+                penetration=collision.penetration,
+            )
+            if self.scenario.stop.on_collision:
+                self._record_final(self.mission.mode.name)
+                raise _RunEnded("stopped", f"collision with object {collision.object_id}")
+        self._decide()
+
+    def _report_progress(self) -> None:
+        world = self.world
+        self.progress(
+            world.time,
+            self.scenario.world.duration,
+            self.mission.mode.name,
+            world.field.count(ObjectStatus.DELIVERED),
+            self._targets,
+        )
+
+    def _check_stop(self, t: float) -> None:
         stop = self.scenario.stop
-        if stop.on_all_delivered and targets and delivered == targets:
+        delivered = self.world.field.count(ObjectStatus.DELIVERED)
+        if stop.on_all_delivered and self._targets and delivered == self._targets:
             raise _RunEnded("completed", "all targets delivered")
         if t >= self.scenario.world.duration - 1e-9:
             raise _RunEnded("completed", "duration reached")
         if (
             stop.max_wall_time is not None
-            and wallclock.perf_counter() - started > stop.max_wall_time
+            and wallclock.perf_counter() - self._started > stop.max_wall_time
         ):
             raise _RunEnded("stopped", f"wall-time limit of {stop.max_wall_time:g} s reached")
 
@@ -265,7 +363,7 @@ class Runner:
         except Exception as error:  # a hook implementation's own bug
             raise HookFailure(f"hook {name} raised: {type(error).__name__}: {error}") from error
 
-    def _summary(self, status: str, reason: str, wall: float) -> dict[str, Any]:
+    def _summary(self, wall: float) -> dict[str, Any]:
         world = self.world
         telemetry = self.recorder.telemetry()
         converged = (
@@ -279,8 +377,8 @@ class Runner:
         gaps = telemetry["nearest_obstacle"] if len(self.recorder.rows) else np.zeros(0)
         sim_time = world.time
         return {
-            "status": status,
-            "reason": reason,
+            "status": self.status,
+            "reason": self.reason,
             "scenario": self.scenario.name,
             "seed": self.scenario.world.seed,
             "sim_time_s": sim_time,
