@@ -108,6 +108,8 @@ class Runner:
         The localiser's estimate at the current time.
     mode : Mode or None
         The mission mode decided for the current control period.
+    outputs : dict of str to object
+        The world's outputs (:meth:`World.outputs`) at the current time.
     """
 
     def __init__(
@@ -127,6 +129,7 @@ class Runner:
         self.status: str | None = None
         self.reason = ""
         self.estimate: LocationEstimate | None = None
+        self.outputs: dict[str, Any] = {}
         self.summary: dict[str, Any] = {}
         self.laps = LapTimer()
         self._command = Command()
@@ -191,6 +194,7 @@ class Runner:
                     disturbance_force=disturbance_force, disturbance_torque=disturbance_torque
                 )
             )
+            self.outputs = self.world.outputs()
             return
         self._guarded(self._advance, disturbance_force, disturbance_torque)
 
@@ -319,7 +323,7 @@ class Runner:
 
     # ------------------------------------------------------------------ records
     def _record(self, t: float, estimate: LocationEstimate, mode: str, force: np.ndarray) -> None:
-        out = self.world.outputs()
+        out = self.outputs = self.world.outputs()
         row: dict[str, Any] = {"time": t}
         row.update(zip(("x", "y", "z"), out["position"], strict=True))
         row.update(zip(("vx", "vy", "vz"), out["velocity"], strict=True))

@@ -22,6 +22,7 @@ passes the client id, so several worlds live side by side in one process.
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -166,6 +167,8 @@ class World:
         )
         self.field = ObjectField(build_objects(scenario))
         self._client = connect_direct()
+        # A world dropped without close() (an FMU reset does that) still disconnects.
+        self._disconnect = weakref.finalize(self, pb.disconnect, physicsClientId=self._client)
         self._state_cache: tuple[int, tuple[np.ndarray, ...]] | None = None
         pb.setTimeStep(self.physics_step, physicsClientId=self._client)
         self.collector = self._create_collector()
@@ -635,7 +638,7 @@ class World:
     def close(self) -> None:
         """Disconnect from PyBullet; the world cannot be used afterwards."""
         if self._client is not None:
-            pb.disconnect(physicsClientId=self._client)
+            self._disconnect()
             self._client = None
 
     def __enter__(self) -> World:

@@ -1,0 +1,225 @@
+"""FMI 2.0 co-simulation FMUs read and driven through fmpy, by variable name."""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Iterable, Mapping
+from ctypes import byref
+from pathlib import Path
+from typing import Any
+
+from dcsim.errors import DcsimError
+
+_STATUS = ("OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING")
+_TYPES = {"Real": float, "Integer": int, "Boolean": bool, "Enumeration": int}
+
+
+class FmuError(DcsimError):
+    """An FMU cannot be used as asked: not FMI 2.0 co-simulation, or an unknown variable."""
+
+
+class FmuDescription:
+    """The model description of an FMI 2.0 co-simulation FMU, for checking variables.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.fmu`` file.
+
+    Attributes
+    ----------
+    path : Path
+        The FMU file.
+    model : fmpy.model_description.ModelDescription
+        The parsed description.
+    variables : dict of str to fmpy ScalarVariable
+        Its variables by name.
+
+    Raises
+    ------
+    FmuError
+        If there is no such file, or it is not an FMI 2.0 FMU with co-simulation.
+    """
+
+    def __init__(self, path: str | Path) -> None:
+        from fmpy import read_model_description
+
+        self.path = Path(path)
+        if not self.path.is_file():
+            raise FmuError(f"no FMU file at {self.path}")
+        try:
+            self.model = read_model_description(str(self.path))
+        except Exception as error:  # fmpy raises plain exceptions for broken files
+            raise FmuError(f"{self.path} is not a readable FMU: {error}") from error
+        if self.model.fmiVersion != "2.0" or self.model.coSimulation is None:
+            raise FmuError(f"{self.path} is not an FMI 2.0 co-simulation FMU")
+        self.variables = {v.name: v for v in self.model.modelVariables}
+
+    def variable(self, name: str, causality: Iterable[str] = (), types: Iterable[str] = ()) -> Any:
+        """The variable ``name``, checked to have one of ``causality`` and ``types``.
+
+        Parameters
+        ----------
+        name : str
+            Variable name.
+        causality : iterable of str
+            Allowed causalities (``input``, ``output``, ``parameter``...); any if empty.
+        types : iterable of str
+            Allowed FMI types (``Real``, ``Integer``, ``Boolean``...); any if empty.
+
+        Raises
+        ------
+        FmuError
+            If there is no such variable, or its causality or type is not allowed.
+        """
+        found = self.variables.get(name)
+        if found is None:
+            known = ", ".join(sorted(self.variables)) or "none"
+            raise FmuError(f"{self.path.name} has no variable {name!r} (it has: {known})")
+        allowed, kinds = tuple(causality), tuple(types)
+        if allowed and found.causality not in allowed:
+            raise FmuError(
+                f"{self.path.name}: {name!r} is a {found.causality}, not a {' or '.join(allowed)}"
+            )
+        if kinds and found.type not in kinds:
+            raise FmuError(
+                f"{self.path.name}: {name!r} is of type {found.type}, not {' or '.join(kinds)}"
+            )
+        return found
+
+    def names(self, causality: str) -> list[str]:
+        """Names of the variables of one causality (``input``, ``output``, ``parameter``)."""
+        return [n for n, v in self.variables.items() if v.causality == causality]
+
+
+class FmuInstance:
+    """An FMI 2.0 co-simulation FMU, instantiated and stepped by variable name.
+
+    The FMU's log messages are kept in :attr:`messages`; a failed FMI call raises
+    ``fmpy.fmi1.FMICallException`` (its ``status`` says which).
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.fmu`` file.
+    instance_name : str
+        Name of the instance (appears in the FMU's log).
+
+    Attributes
+    ----------
+    path : Path
+        The FMU file.
+    description : FmuDescription
+        Its model description.
+    messages : list of (str, str)
+        ``(status, message)`` of every log message the FMU sent.
+
+    Raises
+    ------
+    FmuError
+        If the file is not an FMI 2.0 FMU with a co-simulation interface.
+    """
+
+    def __init__(self, path: str | Path, instance_name: str = "dcsim") -> None:
+        from fmpy import extract
+        from fmpy.fmi2 import FMU2Slave
+
+        self.description = FmuDescription(path)
+        self.path = self.description.path
+        self.messages: list[tuple[str, str]] = []
+        self._unzipped = extract(str(self.path))
+        self._callbacks = self._logging_callbacks()
+        self._fmu = FMU2Slave(
+            guid=self.description.model.guid,
+            unzipDirectory=self._unzipped,
+            modelIdentifier=self.description.model.coSimulation.modelIdentifier,
+            instanceName=instance_name,
+        )
+        self._fmu.instantiate(callbacks=self._callbacks, loggingOn=True)
+        self._instantiated = True
+
+    def _logging_callbacks(self) -> Any:
+        from fmpy import calloc, free
+        from fmpy.fmi2 import (
+            fmi2CallbackAllocateMemoryTYPE,
+            fmi2CallbackFreeMemoryTYPE,
+            fmi2CallbackFunctions,
+            fmi2CallbackLoggerTYPE,
+        )
+        from fmpy.logging import addLoggerProxy
+
+        def log(component: Any, instance: bytes, status: int, category: bytes, message: bytes):
+            label = _STATUS[status] if 0 <= status < len(_STATUS) else str(status)
+            self.messages.append((label, message.decode("utf-8", "replace")))
+
+        callbacks = fmi2CallbackFunctions()
+        callbacks.logger = fmi2CallbackLoggerTYPE(log)
+        callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        addLoggerProxy(byref(callbacks))
+        return callbacks
+
+    # ------------------------------------------------------------------ variables
+    def set(self, values: Mapping[str, float | int | bool]) -> None:
+        """Set variables by name (each converted to its FMI type)."""
+        groups: dict[str, tuple[list[int], list[Any]]] = {}
+        for name, value in values.items():
+            variable = self.description.variable(name)
+            refs, vals = groups.setdefault(variable.type, ([], []))
+            refs.append(variable.valueReference)
+            vals.append(_TYPES[variable.type](value))
+        for kind, (refs, vals) in groups.items():
+            setter = {"Real": self._fmu.setReal, "Boolean": self._fmu.setBoolean}.get(
+                kind, self._fmu.setInteger
+            )
+            setter(refs, vals)
+
+    def get(self, names: Iterable[str]) -> dict[str, float | int | bool]:
+        """Values of variables by name."""
+        names = list(names)
+        out: dict[str, float | int | bool] = {}
+        by_type: dict[str, list[str]] = {}
+        for name in names:
+            by_type.setdefault(self.description.variable(name).type, []).append(name)
+        for kind, group in by_type.items():
+            getter = {"Real": self._fmu.getReal, "Boolean": self._fmu.getBoolean}.get(
+                kind, self._fmu.getInteger
+            )
+            refs = [self.description.variables[n].valueReference for n in group]
+            out.update(zip(group, getter(refs), strict=True))
+        return {name: out[name] for name in names}
+
+    # ------------------------------------------------------------------ lifecycle
+    def initialise(
+        self, start_time: float = 0.0, start_values: Mapping[str, float | int | bool] = {}
+    ) -> None:
+        """Set start values, then set up the experiment and initialise at ``start_time``."""
+        self._fmu.setupExperiment(startTime=start_time)
+        self._fmu.enterInitializationMode()
+        self.set(start_values)
+        self._fmu.exitInitializationMode()
+
+    def step(self, time: float, step_size: float) -> None:
+        """One ``fmi2DoStep`` from ``time`` over ``step_size`` seconds."""
+        self._fmu.doStep(currentCommunicationPoint=time, communicationStepSize=step_size)
+
+    def terminate(self) -> None:
+        """``fmi2Terminate``."""
+        self._fmu.terminate()
+
+    def reset(self) -> None:
+        """``fmi2Reset``: back to the state after instantiation."""
+        self._fmu.reset()
+
+    def close(self) -> None:
+        """Free the instance and delete the unzipped FMU."""
+        if self._instantiated:
+            self._instantiated = False
+            self._fmu.freeInstance()
+            shutil.rmtree(self._unzipped, ignore_errors=True)
+
+    def __enter__(self) -> FmuInstance:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

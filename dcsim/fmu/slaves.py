@@ -1,0 +1,363 @@
+"""FMI 2.0 co-simulation slaves (pythonfmu) over dcsim's runner and world.
+
+An exported FMU carries a tiny script defining a subclass of :class:`ClosedLoopSlave` or
+:class:`PlantSlave`, and the resolved scenario as the resource ``scenario.yaml``. The
+slaves are thin adapters: the closed-loop one drives the :class:`~dcsim.runner.Runner`
+that ``dcsim run`` uses, the plant one a :class:`~dcsim.world.World`.
+
+Time. The world advances in whole control periods (``world.control_period``). A
+``doStep`` from ``t`` to ``t + h`` flies every control period that ends at or before
+``t + h``; outputs are the state at the last period boundary reached. With ``h`` a
+multiple of the period the FMU is exact; otherwise it samples and holds (a step shorter
+than the period may advance nothing), and a warning is logged once.
+
+Errors. A NaN or infinite input is refused: the setter logs an error naming the
+variable, and every ``doStep`` returns ``fmi2Discard`` (the state left as it was) until
+a finite value is set. Parameters that make the scenario invalid, and a failure while
+stepping (a plugin raising in the closed loop), are logged as errors and every later
+``doStep`` returns ``fmi2Discard``. No Python exception leaves a slave (see
+:meth:`_ScenarioSlave._guard`).
+"""
+
+from __future__ import annotations
+
+import gc
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pythonfmu import Boolean, DefaultExperiment, Fmi2Causality, Fmi2Slave, Integer, Real
+from pythonfmu.enums import Fmi2Initial, Fmi2Status, Fmi2Variability
+
+from dcsim.fmu.variables import CLOSED_LOOP, DEFAULT_BEACONS, FmuVariable, plant_variables
+from dcsim.runner import Runner
+from dcsim.runsetup import prepare_run
+from dcsim.scenario import Scenario, load_scenario
+from dcsim.scenario.model import point_to_cartesian
+from dcsim.seeding import component_rng
+from dcsim.world import World, WorldInputs
+
+SCENARIO_RESOURCE = "scenario.yaml"
+"""Name of the resolved scenario among an FMU's resources."""
+
+_NAMESPACES: list[dict[str, Any]] = []
+
+
+def keep_namespace(namespace: dict[str, Any]) -> None:
+    """Hold one more reference to an FMU slave module's namespace.
+
+    pythonfmu 0.7 runs the slave module's source again at every ``fmi2Instantiate`` and
+    then releases a reference to the module's namespace that it does not own. A module
+    whose namespace has few other references (a short generated script) is freed after
+    the first instance and the second one fails with a garbled error. A slave module
+    calls this at its top level, which those runs execute too, so every run leaves one
+    reference more and the namespace lives on.
+    """
+    _NAMESPACES.append(namespace)
+
+
+_RUN_STATUS = {None: 0, "completed": 1, "stopped": 2, "failed": 3}
+_FMI_TYPES = {float: Real, int: Integer, bool: Boolean}
+
+
+class _ScenarioSlave(Fmi2Slave):
+    """What both slaves share: the scenario, parameters, inputs and stepping in periods.
+
+    Subclasses set :attr:`variables` and implement ``_open``, ``_advance``,
+    ``_outputs`` and ``_close``.
+    """
+
+    variables: list[FmuVariable] = []
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.scenario_path = Path(self.resources) / SCENARIO_RESOURCE
+        self.scenario: Scenario = load_scenario(self.scenario_path)
+        self.author = "dcsim"
+        self.description = f"dcsim scenario {self.scenario.name!r}: {self.scenario.description}"
+        self.default_experiment = DefaultExperiment(
+            start_time=0.0,
+            stop_time=self.scenario.world.duration,
+            step_size=self.scenario.world.control_period,
+        )
+        self.values: dict[str, Any] = self._initial_values()
+        self._refused: dict[str, float] = {}
+        self._start_time = 0.0
+        self._periods = 0
+        self._period = self.scenario.world.control_period
+        self._warned_step = False
+        self._open_now = False
+        self._failure: str | None = None
+        for variable in self.variables:
+            self.register_variable(self._fmi_variable(variable))
+
+    # ------------------------------------------------------------------ variables
+    def _initial_values(self) -> dict[str, Any]:
+        """Start values: parameters from the scenario, the state at t = 0, zeros."""
+        values: dict[str, Any] = {v.name: v.type(0) for v in self.variables}
+        values["seed"] = self.scenario.world.seed
+        robot = self.scenario.robot
+        for name in ("mass", "max_force", "max_torque", "max_speed", "sensor_range"):
+            values[f"robot.{name}"] = float(getattr(robot, name))
+        self._put_vector(values, "position", point_to_cartesian(robot.initial.position))
+        self._put_vector(values, "velocity", np.asarray(robot.initial.velocity, dtype=float))
+        values["attitude.w"] = 1.0
+        return values
+
+    @staticmethod
+    def _put_vector(values: dict[str, Any], name: str, vector: np.ndarray) -> None:
+        for axis, value in zip(("x", "y", "z", "w"), vector, strict=False):
+            values[f"{name}.{axis}"] = float(value)
+
+    def _vector(self, name: str) -> np.ndarray:
+        return np.array([self.values[f"{name}.{axis}"] for axis in ("x", "y", "z")])
+
+    def _fmi_variable(self, variable: FmuVariable) -> Any:
+        cls = _FMI_TYPES[variable.type]
+        name = variable.name
+        getter = lambda: self.values[name]  # noqa: E731
+        if variable.causality == "output":
+            variability = Fmi2Variability.continuous if cls is Real else Fmi2Variability.discrete
+            return cls(
+                name,
+                causality=Fmi2Causality.output,
+                variability=variability,
+                initial=Fmi2Initial.exact,
+                description=variable.description,
+                getter=getter,
+            )
+        if variable.causality == "parameter":
+            return cls(
+                name,
+                causality=Fmi2Causality.parameter,
+                variability=Fmi2Variability.fixed,
+                description=variable.description,
+                getter=getter,
+                setter=lambda value: self._set_parameter(name, value),
+            )
+        return cls(
+            name,
+            causality=Fmi2Causality.input,
+            variability=Fmi2Variability.continuous,
+            description=variable.description,
+            getter=getter,
+            setter=lambda value: self._set_input(name, value),
+        )
+
+    def _set_parameter(self, name: str, value: Any) -> None:
+        if self._open_now:
+            self.log(f"parameter {name} cannot change after initialisation", Fmi2Status.error)
+            return
+        self.values[name] = value
+
+    def _set_input(self, name: str, value: float) -> None:
+        if not math.isfinite(value):
+            self._refused[name] = value
+            self.log(f"input {name} = {value} refused: inputs must be finite", Fmi2Status.error)
+            return
+        self._refused.pop(name, None)
+        self.values[name] = float(value)
+
+    def _overrides(self) -> list[str]:
+        """The parameters as scenario overrides (each parameter name is a scenario key)."""
+        return [
+            f"{v.name}={self.values[v.name]!r}"
+            for v in self.variables
+            if v.causality == "parameter" and v.name != "seed"
+        ]
+
+    # ------------------------------------------------------------------ FMI calls
+    def setup_experiment(
+        self, start_time: float, stop_time: float | None, tolerance: float | None
+    ) -> None:
+        """Remember the start time (the scenario's clock starts at 0 there)."""
+        self._start_time = start_time
+
+    def exit_initialization_mode(self) -> None:
+        """Parameters are final: build the world (and the run) and publish t = 0."""
+        gc.collect()  # a reset drops the previous slave in a reference cycle
+        self._periods = 0
+        self._failure = self._guard(self._open, "cannot start")
+        if self._failure is None:
+            self._open_now = True
+            self._publish()
+
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        """Fly the control periods that end within the step; False refuses the step."""
+        if self._failure is not None:
+            self.log(f"step refused: {self._failure}", Fmi2Status.error)
+            return False
+        if self._refused:
+            names = ", ".join(f"{n} = {v}" for n, v in self._refused.items())
+            self.log(f"step refused: non-finite input {names}", Fmi2Status.error)
+            return False
+        periods = (current_time + step_size - self._start_time) / self._period
+        target = math.floor(periods + 1e-6)
+        if abs(periods - round(periods)) > 1e-6 and not self._warned_step:
+            self._warned_step = True
+            self.log(
+                f"communication step {step_size:g} s is not a multiple of the control period "
+                f"{self._period:g} s: outputs hold the last period boundary",
+                Fmi2Status.warning,
+            )
+        if target < self._periods:
+            self.log(f"cannot step back to t = {current_time + step_size:g} s", Fmi2Status.error)
+            return False
+        self._failure = self._guard(lambda: self._fly(target), "step failed")
+        return self._failure is None and self._healthy()
+
+    def _fly(self, periods: int) -> None:
+        while self._periods < periods:
+            self._advance()
+            self._periods += 1
+        self._publish()
+
+    def terminate(self) -> None:
+        """Close the world."""
+        if self._open_now:
+            self._open_now = False
+            self._guard(self._close, "cannot close")
+
+    def _guard(self, call: Any, what: str) -> str | None:
+        """Call ``call``; log and return the reason if it raises, else None.
+
+        No exception may leave a slave: pythonfmu 0.7 answers one with ``fmi2Fatal`` and
+        releases the slave's Python objects twice when the instance is freed afterwards,
+        which crashes the importing process.
+        """
+        try:
+            call()
+        except Exception as error:
+            reason = f"{what}: {type(error).__name__}: {error}"
+            self.log(reason, Fmi2Status.error)
+            return reason
+        return None
+
+    def _publish(self) -> None:
+        """Copy the current outputs into the FMU's variables."""
+        values, out = self.values, self._outputs()
+        for name in ("position", "velocity", "attitude", "angular_velocity"):
+            self._put_vector(values, name, out[name])
+        values["collisions"] = int(out["collisions"])
+        values["fuel_used"] = float(out["fuel_used"])
+        values["delta_v"] = float(out["delta_v"])
+        self._publish_more(out)
+
+    def _publish_more(self, out: dict[str, Any]) -> None:
+        """Outputs only one kind of slave has."""
+
+    def _healthy(self) -> bool:
+        return True
+
+    def _open(self) -> None:
+        raise NotImplementedError
+
+    def _advance(self) -> None:
+        raise NotImplementedError
+
+    def _outputs(self) -> dict[str, Any]:
+        raise NotImplementedError
+
+    def _close(self) -> None:
+        raise NotImplementedError
+
+
+class ClosedLoopSlave(_ScenarioSlave):
+    """The whole scenario (world, localiser, planners, controller, mission) as an FMU.
+
+    Each control period is one :meth:`Runner.advance` with the disturbance inputs; the
+    outputs at a period boundary equal the telemetry row ``dcsim run`` records there.
+    """
+
+    variables = CLOSED_LOOP
+
+    def _open(self) -> None:
+        setup = prepare_run(self.scenario_path, self._overrides(), seed=self.values["seed"])
+        self.runner = Runner(setup)
+        self.runner.open()
+        self._reported_failure = False
+
+    def _advance(self) -> None:
+        self.runner.advance(self._vector("disturbance_force"), self._vector("disturbance_torque"))
+
+    def _outputs(self) -> dict[str, Any]:
+        return self.runner.outputs
+
+    def _publish_more(self, out: dict[str, Any]) -> None:
+        runner, values = self.runner, self.values
+        values["mode"] = int(runner.mode)
+        values["captured"] = int(out["captured"])
+        values["delivered"] = int(out["delivered"])
+        values["localisation_error"] = float(
+            np.linalg.norm(out["position"] - runner.estimate.position)
+        )
+        values["run_status"] = _RUN_STATUS[runner.status]
+
+    def _healthy(self) -> bool:
+        if self.runner.status != "failed":
+            return True
+        if not self._reported_failure:
+            self._reported_failure = True
+            self.log(f"run failed: {self.runner.reason}", Fmi2Status.error)
+        return False
+
+    def _close(self) -> None:
+        self.runner.close()
+
+
+class PlantSlave(_ScenarioSlave):
+    """The world alone as an FMU: force and torque in, true state and sensors out.
+
+    Attributes
+    ----------
+    nearest_beacons : int
+        K, how many nearest beacons' ranges are output (a class attribute set at export).
+    """
+
+    nearest_beacons = DEFAULT_BEACONS
+
+    def __init__(self, **kwargs: Any) -> None:
+        self.variables = plant_variables(self.nearest_beacons)
+        super().__init__(**kwargs)
+
+    def _initial_values(self) -> dict[str, Any]:
+        values = super()._initial_values()
+        values["mass"] = float(self.scenario.robot.mass)
+        for k in range(1, self.nearest_beacons + 1):
+            values[f"beacon[{k}].id"] = -1
+        return values
+
+    def _open(self) -> None:
+        scenario = load_scenario(
+            self.scenario_path, [*self._overrides(), f"world.seed={self.values['seed']}"]
+        )
+        self.world = World(scenario, component_rng(scenario.world.seed, "world"))
+        self._collided = False
+
+    def _advance(self) -> None:
+        inputs = WorldInputs(force=self._vector("force"), torque=self._vector("torque"))
+        self._collided |= bool(self.world.step(inputs))
+
+    def _outputs(self) -> dict[str, Any]:
+        return self.world.outputs()
+
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        """Step as the base class does; the collision flag covers this step only."""
+        self._collided = False
+        return super().do_step(current_time, step_size)
+
+    def _publish_more(self, out: dict[str, Any]) -> None:
+        world, values = self.world, self.values
+        values["mass"] = float(out["mass"])
+        values["nearest_obstacle"] = float(out["nearest_obstacle_distance"])
+        values["tracked"] = len(world.object_tracks())
+        values["collision"] = self._collided
+        ranges = sorted(world.beacon_ranges(), key=lambda r: r.range)
+        for k in range(1, self.nearest_beacons + 1):
+            found = ranges[k - 1] if k <= len(ranges) else None
+            values[f"beacon[{k}].id"] = found.beacon_id if found else -1
+            values[f"beacon[{k}].range"] = found.range if found else 0.0
+
+    def _close(self) -> None:
+        self.world.close()
