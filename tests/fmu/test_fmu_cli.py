@@ -1,0 +1,49 @@
+"""`dcsim fmu export` and `dcsim fmu cosim` from the console script."""
+
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+from fmpy.validation import validate_fmu
+
+
+def test_export_writes_a_valid_fmu_of_either_kind(dcsim_cli, tmp_path):
+    for args, name in (([], "closed.fmu"), (["--plant-only", "--beacons", "2"], "plant.fmu")):
+        done = dcsim_cli("fmu", "export", "-o", str(tmp_path / name), *args)
+        assert done.returncode == 0, done.stderr
+        assert validate_fmu(str(tmp_path / name)) == []
+
+
+def test_export_reports_a_bad_override_or_name_without_a_traceback(dcsim_cli, tmp_path):
+    done = dcsim_cli("fmu", "export", "-o", str(tmp_path / "x.fmu"), "--set", "robot.mass=-1")
+    assert done.returncode == 2 and "robot.mass" in done.stderr
+    assert "Traceback" not in done.stderr
+    done = dcsim_cli("fmu", "export", "-o", str(tmp_path / "x.zip"))
+    assert done.returncode == 2 and ".fmu" in done.stderr
+    assert not list(tmp_path.glob("x.*"))
+
+
+def test_cosim_flies_the_plant_to_the_controllers_reference(dcsim_cli, tmp_path, plant_fmu, pd_fmu):
+    done = dcsim_cli(
+        "fmu", "cosim", str(plant_fmu), "--controller", str(pd_fmu), "--stop", "80",
+        "--set", "controller:reference.position.x=5",
+        "--set", "controller:reference.position.y=-3",
+        "--out", str(tmp_path / "out"),
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert "connected to the plant: force.x, force.y, force.z" in done.stdout
+    with (tmp_path / "out" / "results.csv").open() as handle:
+        rows = list(csv.DictReader(handle))
+    assert len(rows) == 801 and float(rows[-1]["time"]) == 80.0
+    final = np.array([float(rows[-1][f"plant.position.{a}"]) for a in "xyz"])
+    assert np.allclose(final, [5.0, -3.0, 0.0], atol=0.01)
+    assert (tmp_path / "out" / "results.png").stat().st_size > 10_000
+
+
+def test_cosim_refuses_fmus_that_share_no_signal(dcsim_cli, tmp_path, plant_fmu):
+    done = dcsim_cli("fmu", "cosim", str(plant_fmu), "--controller", str(plant_fmu))
+    assert done.returncode == 2 and "share no signal" in done.stderr
+    done = dcsim_cli("fmu", "cosim", str(plant_fmu), "--controller", str(plant_fmu),
+                     "--set", "nowhere=1")  # fmt: skip
+    assert done.returncode == 2 and "plant:NAME=VALUE" in done.stderr
