@@ -455,6 +455,33 @@ def bench_controllers_command(
         click.echo(f"plot: {plot_path}")
 
 
+@bench_group.command("fmu")
+@click.argument("scenario", required=False, type=click.Path(dir_okay=False, path_type=Path))
+@click.option(
+    "--duration",
+    type=click.FloatRange(min=1.0),
+    default=300.0,
+    show_default=True,
+    help="Simulated seconds per measurement.",
+)
+@click.option(
+    "--repeats", type=click.IntRange(min=1), default=3, show_default=True, help="Measurements."
+)
+def bench_fmu_command(scenario: Path | None, duration: float, repeats: int) -> None:
+    """Closed-loop FMU in fmpy against dcsim run: wall time per control tick.
+
+    SCENARIO (default: the packaged one) is exported as a closed-loop FMU and flown
+    natively and through the FMU, alternately, REPEATS times each. Prints a Markdown
+    table for docs/benchmarks.md.
+    """
+    from dcsim.bench.fmu import bench_fmu, markdown_table
+
+    result = bench_fmu(
+        scenario, duration, repeats, progress=lambda line: click.echo(line, err=True)
+    )
+    click.echo(markdown_table(result))
+
+
 @cli.group("fmu")
 def fmu_group() -> None:
     """FMI 2.0 co-simulation: export scenarios as FMUs, couple FMUs (docs/fmu.md)."""

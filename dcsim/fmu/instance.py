@@ -137,6 +137,7 @@ class FmuInstance:
         )
         self._fmu.instantiate(callbacks=self._callbacks, loggingOn=True)
         self._instantiated = True
+        self._get_plans: dict[tuple[str, ...], list[tuple[Any, list[int], list[str]]]] = {}
 
     def _logging_callbacks(self) -> Any:
         from fmpy import calloc, free
@@ -176,18 +177,29 @@ class FmuInstance:
 
     def get(self, names: Iterable[str]) -> dict[str, float | int | bool]:
         """Values of variables by name."""
-        names = list(names)
+        names = tuple(names)
+        plan = self._get_plans.get(names)
+        if plan is None:
+            plan = self._get_plans[names] = self._get_plan(names)
         out: dict[str, float | int | bool] = {}
+        for getter, refs, group in plan:
+            out.update(zip(group, getter(refs), strict=True))
+        return {name: out[name] for name in names}
+
+    def _get_plan(self, names: tuple[str, ...]) -> list[tuple[Any, list[int], list[str]]]:
+        """Per FMI type: the getter, the value references and the names to read."""
         by_type: dict[str, list[str]] = {}
         for name in names:
             by_type.setdefault(self.description.variable(name).type, []).append(name)
-        for kind, group in by_type.items():
-            getter = {"Real": self._fmu.getReal, "Boolean": self._fmu.getBoolean}.get(
-                kind, self._fmu.getInteger
+        getters = {"Real": self._fmu.getReal, "Boolean": self._fmu.getBoolean}
+        return [
+            (
+                getters.get(kind, self._fmu.getInteger),
+                [self.description.variables[n].valueReference for n in group],
+                group,
             )
-            refs = [self.description.variables[n].valueReference for n in group]
-            out.update(zip(group, getter(refs), strict=True))
-        return {name: out[name] for name in names}
+            for kind, group in by_type.items()
+        ]
 
     # ------------------------------------------------------------------ lifecycle
     def initialise(

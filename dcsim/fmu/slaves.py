@@ -116,6 +116,8 @@ class _ScenarioSlave(Fmi2Slave):
     def _fmi_variable(self, variable: FmuVariable) -> Any:
         cls = _FMI_TYPES[variable.type]
         name = variable.name
+        unit = f" [{variable.unit}]" if variable.unit else ""
+        description = f"{variable.description}{unit}"
         getter = lambda: self.values[name]  # noqa: E731
         if variable.causality == "output":
             variability = Fmi2Variability.continuous if cls is Real else Fmi2Variability.discrete
@@ -124,7 +126,7 @@ class _ScenarioSlave(Fmi2Slave):
                 causality=Fmi2Causality.output,
                 variability=variability,
                 initial=Fmi2Initial.exact,
-                description=variable.description,
+                description=description,
                 getter=getter,
             )
         if variable.causality == "parameter":
@@ -132,7 +134,7 @@ class _ScenarioSlave(Fmi2Slave):
                 name,
                 causality=Fmi2Causality.parameter,
                 variability=Fmi2Variability.fixed,
-                description=variable.description,
+                description=description,
                 getter=getter,
                 setter=lambda value: self._set_parameter(name, value),
             )
@@ -140,7 +142,7 @@ class _ScenarioSlave(Fmi2Slave):
             name,
             causality=Fmi2Causality.input,
             variability=Fmi2Variability.continuous,
-            description=variable.description,
+            description=description,
             getter=getter,
             setter=lambda value: self._set_input(name, value),
         )

@@ -172,4 +172,6 @@ def write_reference(path: Path) -> bool:
 
 
 if __name__ == "__main__":
-    write_reference(Path(sys.argv[1]))
+    target = Path(sys.argv[1] if len(sys.argv) > 1 else "docs/fmu.md")
+    changed = write_reference(target)
+    print(f"{target}: {'updated' if changed else 'already up to date'}")

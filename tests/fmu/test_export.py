@@ -86,6 +86,19 @@ def test_variables_are_those_documented(closed_loop_fmu, plant_fmu):
         assert described == {v.name: (v.causality, types[v.type]) for v in table}
 
 
+def test_docs_list_the_variables():
+    from pathlib import Path
+
+    from dcsim.docgen import block
+    from dcsim.fmu import variables as v
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "fmu.md").read_text()
+    stale = "docs/fmu.md is stale: run `make docs`"
+    assert block(text, v.BEGIN_CLOSED, v.END_CLOSED) == v.variables_table(v.CLOSED_LOOP), stale
+    plant = v.variables_table(v.plant_variables(v.DEFAULT_BEACONS))
+    assert block(text, v.BEGIN_PLANT, v.END_PLANT) == plant, stale
+
+
 def test_simulate_fmu_runs_both_variants(closed_loop_fmu, plant_fmu, native_run):
     closed = simulate_fmu(str(closed_loop_fmu), stop_time=20.0, step_size=PERIOD)
     assert closed["time"][-1] == pytest.approx(20.0)
