@@ -30,7 +30,13 @@ import numpy as np
 from pythonfmu import Boolean, DefaultExperiment, Fmi2Causality, Fmi2Slave, Integer, Real
 from pythonfmu.enums import Fmi2Initial, Fmi2Status, Fmi2Variability
 
-from dcsim.fmu.variables import CLOSED_LOOP, DEFAULT_BEACONS, FmuVariable, plant_variables
+from dcsim.fmu.variables import (
+    CLOSED_LOOP,
+    DEFAULT_BEACONS,
+    PARAMETERS,
+    FmuVariable,
+    plant_variables,
+)
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
 from dcsim.scenario import Scenario, load_scenario
@@ -98,8 +104,9 @@ class _ScenarioSlave(Fmi2Slave):
         values: dict[str, Any] = {v.name: v.type(0) for v in self.variables}
         values["seed"] = self.scenario.world.seed
         robot = self.scenario.robot
-        for name in ("mass", "max_force", "max_torque", "max_speed", "sensor_range"):
-            values[f"robot.{name}"] = float(getattr(robot, name))
+        for variable in PARAMETERS:
+            if variable.name.startswith("robot."):
+                values[variable.name] = float(getattr(robot, variable.name.removeprefix("robot.")))
         self._put_vector(values, "position", point_to_cartesian(robot.initial.position))
         self._put_vector(values, "velocity", np.asarray(robot.initial.velocity, dtype=float))
         values["attitude.w"] = 1.0
