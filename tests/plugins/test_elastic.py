@@ -6,7 +6,13 @@ import textwrap
 
 import numpy as np
 import pytest
-from dcsim_plugins.elastic import ElasticController, perpendicular_repulsion, repulsion
+from dcsim_plugins.elastic import (
+    ElasticController,
+    braking_limit,
+    early_dodge,
+    perpendicular_repulsion,
+    repulsion,
+)
 
 from dcsim.api import (
     LinearMotion,
@@ -96,7 +102,7 @@ def test_a_slow_obstacle_pushes_away_and_aside_rather_than_perpendicular():
 
 
 def test_desired_velocity_is_attraction_plus_the_pushes_of_closing_obstacles():
-    plugin = controller(gain=0.1, repulsion_gain=0.5)
+    plugin = controller(gain=0.1, repulsion_gain=0.5, lookahead=0.0, brake_fraction=0.0)
     reference = Reference(time=0.0, position=[2.0, 0.0, 0.0])
     estimate = at([0.0, 0.0, 0.0], velocity=[0.3, 0.0, 0.0])
     attraction = np.array([0.2, 0.0, 0.0])  # 0.1/s x 2 m
@@ -116,6 +122,82 @@ def test_desired_velocity_is_attraction_plus_the_pushes_of_closing_obstacles():
     np.testing.assert_allclose(
         plugin.desired_velocity(0.0, estimate, reference, receding), attraction
     )
+
+
+def test_the_early_dodge_widens_a_foreseen_miss_and_leaves_a_clear_pass_alone():
+    planned = np.array([0.3, 0.0, 0.0])
+    still = np.zeros((1, 3))
+    sphere = np.array([4.0])
+    # 1 m beside the line, closest approach in 33 s: one pass adds (4 - 1) m / 33 s along
+    # the miss vector, across the relative velocity, on the side the collector already misses.
+    beside = np.array([[-10.0, -1.0, 0.0]])  # D, obstacle to collector
+    once = early_dodge(beside, still, sphere, planned, 0.5, 60.0, 4.0)
+    assert once[1] < 0 and once[2] == 0
+    first = early_dodge(beside, still, sphere, planned, 0.5, 60.0, 4.0)  # deterministic
+    np.testing.assert_allclose(once, first)
+    relative = -planned
+    t_star = 10.0 * 0.3 / 0.09
+    one_pass = planned + np.array([0.0, -1.0, 0.0]) * 3.0 / t_star
+    assert np.dot(one_pass - planned, relative) == pytest.approx(0.0)
+    assert np.linalg.norm(once - planned) >= np.linalg.norm(one_pass - planned) - 1e-12
+    # Passing clear (miss 5 m > 4 m), beyond the horizon, or behind: no dodge.
+    for away in ([-10.0, -5.0, 0.0], [-30.0, -1.0, 0.0], [10.0, -1.0, 0.0]):
+        np.testing.assert_allclose(
+            early_dodge(np.array([away]), still, sphere, planned, 0.5, 60.0, 4.0), planned
+        )
+
+
+def test_a_dead_on_dodge_takes_the_thesis_candidate():
+    planned = np.array([0.3, 0.05, 0.0])
+    dodged = early_dodge(
+        np.array([[-10.0, 0.0, 0.0]]), np.zeros((1, 3)), np.array([4.0]), planned, 0.5, 60.0, 4.0
+    )
+    assert np.linalg.norm(dodged - planned) > 0.05
+    assert dodged[1] > planned[1]  # the side the attraction leans to (eq. 5.2)
+
+
+def test_the_braking_limit_slows_the_approach_and_escapes_a_creeping_obstacle():
+    still = np.zeros((1, 3))
+    keep = np.array([3.0])
+    a, lag = 0.02, 4.0
+    # 1 m outside the kept distance, flying straight at a static obstacle at 0.5 m/s.
+    limited = braking_limit(
+        np.array([[-4.0, 0.0, 0.0]]), still, keep, np.array([0.5, 0.1, 0.0]), 0.5, a, lag, 0.2
+    )
+    stoppable = a * (-lag + np.sqrt(lag**2 + 2 * 1.0 / a))
+    assert limited[0] == pytest.approx(stoppable)
+    assert limited[1] == pytest.approx(0.1)  # the sideways part is left alone
+    # Far away: untouched.
+    far = braking_limit(
+        np.array([[-40.0, 0.0, 0.0]]), still, keep, np.array([0.5, 0.0, 0.0]), 0.5, a, lag, 0.2
+    )
+    np.testing.assert_allclose(far, [0.5, 0.0, 0.0])
+    # At rest, an obstacle creeping in at 5 cm/s and 0.5 m inside the kept distance: the
+    # collector moves straight away, faster than the obstacle comes.
+    creeping = braking_limit(
+        np.array([[0.0, 2.5, 0.0]]),
+        np.array([[0.0, 0.05, 0.0]]),
+        keep,
+        np.zeros(3),
+        0.5,
+        a,
+        lag,
+        0.2,
+    )
+    np.testing.assert_allclose(creeping, [0.0, 0.05 + 0.2 * 0.5, 0.0])
+
+
+def test_the_braking_limit_heeds_every_obstacle_at_once():
+    keep = np.array([3.0, 3.0])
+    away = np.array([[-3.5, 0.0, 0.0], [0.0, -3.2, 0.0]])  # one ahead, one beside
+    velocities = np.array([[0.0, 0.0, 0.0], [0.0, 0.04, 0.0]])  # the one beside creeps in
+    a, lag = 0.02, 4.0
+    out = braking_limit(away, velocities, keep, np.array([0.5, 0.0, 0.0]), 0.5, a, lag, 0.2)
+    normals = away / np.linalg.norm(away, axis=1)[:, None]
+    gaps = np.linalg.norm(away, axis=1) - keep
+    allowed = a * (-lag + np.sqrt(lag**2 + 2 * gaps / a))
+    receding = np.einsum("ij,ij->i", out - velocities, normals)
+    assert np.all(receding >= -allowed - 1e-9)
 
 
 def test_drop_speed_limits_the_desired_velocity():
