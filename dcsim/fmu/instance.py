@@ -135,7 +135,12 @@ class FmuInstance:
             modelIdentifier=self.description.model.coSimulation.modelIdentifier,
             instanceName=instance_name,
         )
-        self._fmu.instantiate(callbacks=self._callbacks, loggingOn=True)
+        try:
+            self._fmu.instantiate(callbacks=self._callbacks, loggingOn=True)
+        except Exception as error:  # fmpy raises a bare Exception; the log says why
+            shutil.rmtree(self._unzipped, ignore_errors=True)
+            said = "; ".join(message for _, message in self.messages) or str(error)
+            raise FmuError(f"{self.path.name} cannot be instantiated: {said}") from error
         self._instantiated = True
         self._get_plans: dict[tuple[str, ...], list[tuple[Any, list[int], list[str]]]] = {}
 
@@ -170,10 +175,7 @@ class FmuInstance:
             refs.append(variable.valueReference)
             vals.append(_TYPES[variable.type](value))
         for kind, (refs, vals) in groups.items():
-            setter = {"Real": self._fmu.setReal, "Boolean": self._fmu.setBoolean}.get(
-                kind, self._fmu.setInteger
-            )
-            setter(refs, vals)
+            self._method("set", kind)(refs, vals)
 
     def get(self, names: Iterable[str]) -> dict[str, float | int | bool]:
         """Values of variables by name."""
@@ -191,15 +193,18 @@ class FmuInstance:
         by_type: dict[str, list[str]] = {}
         for name in names:
             by_type.setdefault(self.description.variable(name).type, []).append(name)
-        getters = {"Real": self._fmu.getReal, "Boolean": self._fmu.getBoolean}
         return [
             (
-                getters.get(kind, self._fmu.getInteger),
+                self._method("get", kind),
                 [self.description.variables[n].valueReference for n in group],
                 group,
             )
             for kind, group in by_type.items()
         ]
+
+    def _method(self, action: str, kind: str) -> Any:
+        """fmpy's ``getReal``, ``setInteger``... for an FMI type (enumerations as Integer)."""
+        return getattr(self._fmu, f"{action}{kind if kind in ('Real', 'Boolean') else 'Integer'}")
 
     # ------------------------------------------------------------------ lifecycle
     def initialise(

@@ -10,7 +10,7 @@ from fmpy.validation import validate_fmu
 
 from dcsim.errors import ScenarioError
 from dcsim.fmu.export import export_fmu
-from dcsim.fmu.instance import FmuInstance
+from dcsim.fmu.instance import FmuError, FmuInstance
 from dcsim.fmu.variables import CLOSED_LOOP, plant_variables
 from dcsim.mission import Mode
 from dcsim.runner import Runner
@@ -275,3 +275,17 @@ def test_export_refuses_a_bad_scenario_or_file_name(tmp_path):
     with pytest.raises(ValueError, match=r"\.fmu"):
         export_fmu(None, tmp_path / "x.zip")
     assert not list(tmp_path.iterdir())
+
+
+def test_an_fmu_that_cannot_start_is_reported_with_its_reason(closed_loop_fmu, tmp_path):
+    import zipfile
+
+    broken = tmp_path / "broken.fmu"
+    with zipfile.ZipFile(closed_loop_fmu) as source, zipfile.ZipFile(broken, "w") as target:
+        for item in source.infolist():
+            data = source.read(item)
+            if item.filename == "resources/scenario.yaml":
+                data = b"world: [unclosed"
+            target.writestr(item, data)
+    with pytest.raises(FmuError, match="(?s)cannot be instantiated: .*not valid YAML"):
+        FmuInstance(broken)
