@@ -30,7 +30,8 @@ Geometry
     :func:`spherical_to_cartesian`, :func:`quaternion_between`, :func:`rotate`, :func:`unit`,
     :func:`clip_norm`.
 FMUs (FMI 2.0 co-simulation, through fmpy)
-    :class:`FmuDescription`, :class:`FmuInstance`, :class:`FmuError`.
+    :class:`FmuDescription`, :class:`FmuInstance`, :class:`FmuError`,
+    :class:`FmuCallError`.
 Registry and hooks
     :data:`hookimpl`, :class:`PluginRegistry`.
 Errors
@@ -47,7 +48,7 @@ from dcsim.errors import (
     PluginParameterError,
     ScenarioError,
 )
-from dcsim.fmu.instance import FmuDescription, FmuError, FmuInstance
+from dcsim.fmu.instance import FmuCallError, FmuDescription, FmuError, FmuInstance
 from dcsim.geometry import clip_norm, quaternion_between, rotate, spherical_to_cartesian, unit
 from dcsim.hookspecs import hookimpl
 from dcsim.interfaces import PLUGIN_KINDS, Controller, Localiser, PathPlanner, Plugin, TaskPlanner
@@ -90,6 +91,7 @@ from dcsim.plancost import leg_delta_v, legs_delta_v, plan_cost, plan_delta_v, p
 from dcsim.registry import PluginRegistry
 
 __all__ = [
+    "FmuCallError",
     "FmuDescription",
     "FmuError",
     "FmuInstance",

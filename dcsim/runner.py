@@ -149,7 +149,11 @@ class Runner:
 
     # ------------------------------------------------------------------ public
     def run(self) -> dict[str, Any]:
-        """Run to the end; return the summary (also written to ``summary.json``)."""
+        """Run to the end; return the summary (also written to ``summary.json``).
+
+        Whatever ends the run — a stop rule, a failing plugin, Ctrl-C or a bug — the
+        records made so far are written; an unexpected exception is raised again after.
+        """
         last_progress = -np.inf
         try:
             self.open()
@@ -161,8 +165,15 @@ class Runner:
                     self._report_progress()
                 self.laps.lap("recording")
         except KeyboardInterrupt:
+            if self.world is None:
+                raise
             self._end("stopped", "interrupted")
             self._event("interrupted")
+        except BaseException as error:
+            if self.world is not None:
+                self._end("failed", f"{type(error).__name__}: {error}")
+                self.close()
+            raise
         return self.close()
 
     def open(self) -> None:

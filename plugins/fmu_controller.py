@@ -19,7 +19,9 @@ Signals a mapping can take (world frame, SI units):
   ``safety_distance`` (m).
 
 Command components an FMU output can give: ``force.x|y|z`` (N), ``torque.x|y|z`` (N·m);
-those not mapped are zero.
+those not mapped are zero, and the command is clipped to the robot's force and torque
+limits. A call earlier than the start of the last step (a new run) resets the FMU and
+initialises it again.
 
 Mappings. ``inputs`` maps FMU input names to signal names and ``outputs`` maps command
 components to FMU output names. Left empty, they connect by equal names (an FMU with an
@@ -47,6 +49,7 @@ from dcsim.api import (
     Reference,
     RobotSpec,
     Surroundings,
+    clip_norm,
     hookimpl,
     quantity,
 )
@@ -197,9 +200,16 @@ class FmuController(Controller):
         reference: Reference,
         surroundings: Surroundings,
     ) -> Command:
-        """Set the FMU's inputs, step it over one control period, read the command."""
+        """Set the FMU's inputs, step it over one control period, read the command.
+
+        The FMU's force and torque are clipped to the robot's limits. A time earlier than
+        the last step's start begins a new run: the FMU is reset and initialised again.
+        """
         step = self.params.step_size
-        if self.next_time is not None and abs(time - self.next_time) > 1e-6 * step:
+        if self.next_time is not None and time < self.next_time - step * (1 + 1e-6):
+            self.fmu.reset()  # earlier than the last step's start: a new run
+            self.fmu.initialise(start_values=self.params.parameters)
+        elif self.next_time is not None and abs(time - self.next_time) > 1e-6 * step:
             raise FmuError(
                 f"called at t = {time:g} s, expected {self.next_time:g} s: set step_size "
                 f"to the scenario's control period"
@@ -211,8 +221,10 @@ class FmuController(Controller):
         values = self.fmu.get(self.outputs.values())
         command = {c: values[name] for c, name in self.outputs.items()}
         return Command(
-            force=[command.get(f"force.{a}", 0.0) for a in AXES],
-            torque=[command.get(f"torque.{a}", 0.0) for a in AXES],
+            force=clip_norm([command.get(f"force.{a}", 0.0) for a in AXES], self.robot.max_force),
+            torque=clip_norm(
+                [command.get(f"torque.{a}", 0.0) for a in AXES], self.robot.max_torque
+            ),
         )
 
 

@@ -105,14 +105,17 @@ def cosimulate(
     Raises
     ------
     FmuError
-        If a file is not a usable FMU or the two share no signal.
-    fmpy.fmi1.FMICallException
-        If an FMU refuses a step (its log messages say why).
+        If a file is not a usable FMU, the two share no signal, or the stop time is not
+        a whole number of steps.
+    FmuCallError
+        If an FMU refuses a call (with what it logged).
     """
     if step_size <= 0 or stop_time <= 0:
         raise FmuError("stop time and step size must be positive")
+    steps = round(stop_time / step_size)
+    if steps < 1 or abs(steps * step_size - stop_time) > 1e-9 * stop_time:
+        raise FmuError(f"stop time {stop_time:g} s is not a multiple of the step {step_size:g} s")
     start_values = start_values or {}
-    steps = int(round(stop_time / step_size))
     with (
         FmuInstance(plant_path, "plant") as plant,
         FmuInstance(controller_path, "controller") as controller,

@@ -15,7 +15,34 @@ _TYPES = {"Real": float, "Integer": int, "Boolean": bool, "Enumeration": int}
 
 
 class FmuError(DcsimError):
-    """An FMU cannot be used as asked: not FMI 2.0 co-simulation, or an unknown variable."""
+    """An FMU cannot be used as asked: a file that is not an FMI 2.0 co-simulation FMU, a
+    variable it does not have or not of the kind needed, two FMUs that do not fit, or a
+    call the FMU refused."""
+
+
+class FmuCallError(FmuError):
+    """An FMI call returned an error status.
+
+    Attributes
+    ----------
+    function : str
+        The FMI function, e.g. ``fmi2DoStep``.
+    status : int
+        Its status: 2 discard, 3 error, 4 fatal.
+    messages : list of (str, str)
+        What the FMU logged during the call.
+    """
+
+    def __init__(self, path: Path, function: str, status: int, messages: list) -> None:
+        label = _STATUS[status] if 0 <= status < len(_STATUS) else str(status)
+        said = "; ".join(message for _, message in messages) or "no message"
+        super().__init__(f"{path.name}: {function} returned {label}: {said}")
+        self.function, self.status, self.messages = function, status, messages
+
+
+def _a(word: str) -> str:
+    """``word`` with its indefinite article."""
+    return f"{'an' if word[0] in 'aeiou' else 'a'} {word}"
 
 
 class FmuDescription:
@@ -79,7 +106,8 @@ class FmuDescription:
         allowed, kinds = tuple(causality), tuple(types)
         if allowed and found.causality not in allowed:
             raise FmuError(
-                f"{self.path.name}: {name!r} is a {found.causality}, not a {' or '.join(allowed)}"
+                f"{self.path.name}: {name!r} is {_a(found.causality)}, "
+                f"not {' or '.join(_a(c) for c in allowed)}"
             )
         if kinds and found.type not in kinds:
             raise FmuError(
@@ -129,15 +157,16 @@ class FmuInstance:
         self.messages: list[tuple[str, str]] = []
         self._unzipped = extract(str(self.path))
         self._callbacks = self._logging_callbacks()
-        self._fmu = FMU2Slave(
-            guid=self.description.model.guid,
-            unzipDirectory=self._unzipped,
-            modelIdentifier=self.description.model.coSimulation.modelIdentifier,
-            instanceName=instance_name,
-        )
+        self._instantiated = False
         try:
+            self._fmu = FMU2Slave(
+                guid=self.description.model.guid,
+                unzipDirectory=self._unzipped,
+                modelIdentifier=self.description.model.coSimulation.modelIdentifier,
+                instanceName=instance_name,
+            )
             self._fmu.instantiate(callbacks=self._callbacks, loggingOn=True)
-        except Exception as error:  # fmpy raises a bare Exception; the log says why
+        except Exception as error:  # fmpy raises bare exceptions; the log says why
             shutil.rmtree(self._unzipped, ignore_errors=True)
             said = "; ".join(message for _, message in self.messages) or str(error)
             raise FmuError(f"{self.path.name} cannot be instantiated: {said}") from error
@@ -167,18 +196,32 @@ class FmuInstance:
 
     # ------------------------------------------------------------------ variables
     def set(self, values: Mapping[str, float | int | bool]) -> None:
-        """Set variables by name (each converted to its FMI type)."""
+        """Set inputs and parameters by name (each value converted to its FMI type).
+
+        Raises
+        ------
+        FmuError
+            If a name is not an input or a parameter of the FMU.
+        FmuCallError
+            If the FMU refuses the values.
+        """
         groups: dict[str, tuple[list[int], list[Any]]] = {}
         for name, value in values.items():
-            variable = self.description.variable(name)
+            variable = self.description.variable(name, ("input", "parameter"))
             refs, vals = groups.setdefault(variable.type, ([], []))
             refs.append(variable.valueReference)
             vals.append(_TYPES[variable.type](value))
         for kind, (refs, vals) in groups.items():
-            self._method("set", kind)(refs, vals)
+            self._call(self._method("set", kind), refs, vals)
 
     def get(self, names: Iterable[str]) -> dict[str, float | int | bool]:
-        """Values of variables by name."""
+        """Values of variables by name, in the order asked.
+
+        Raises
+        ------
+        FmuError
+            If the FMU has no variable of a name.
+        """
         names = tuple(names)
         plan = self._get_plans.get(names)
         if plan is None:
@@ -208,25 +251,51 @@ class FmuInstance:
 
     # ------------------------------------------------------------------ lifecycle
     def initialise(
-        self, start_time: float = 0.0, start_values: Mapping[str, float | int | bool] = {}
+        self, start_time: float = 0.0, start_values: Mapping[str, float | int | bool] | None = None
     ) -> None:
-        """Set start values, then set up the experiment and initialise at ``start_time``."""
-        self._fmu.setupExperiment(startTime=start_time)
-        self._fmu.enterInitializationMode()
-        self.set(start_values)
-        self._fmu.exitInitializationMode()
+        """Set up the experiment at ``start_time``, set start values, initialise.
+
+        Raises
+        ------
+        FmuCallError
+            If the FMU refuses a step of it.
+        """
+        self._call(self._fmu.setupExperiment, startTime=start_time)
+        self._call(self._fmu.enterInitializationMode)
+        self.set(start_values or {})
+        self._call(self._fmu.exitInitializationMode)
 
     def step(self, time: float, step_size: float) -> None:
-        """One ``fmi2DoStep`` from ``time`` over ``step_size`` seconds."""
-        self._fmu.doStep(currentCommunicationPoint=time, communicationStepSize=step_size)
+        """One ``fmi2DoStep`` from ``time`` over ``step_size`` seconds.
+
+        Raises
+        ------
+        FmuCallError
+            If the FMU refuses the step (``status`` 2, discard: it did not advance).
+        """
+        self._call(
+            self._fmu.doStep, currentCommunicationPoint=time, communicationStepSize=step_size
+        )
 
     def terminate(self) -> None:
         """``fmi2Terminate``."""
-        self._fmu.terminate()
+        self._call(self._fmu.terminate)
 
     def reset(self) -> None:
         """``fmi2Reset``: back to the state after instantiation."""
-        self._fmu.reset()
+        self._call(self._fmu.reset)
+
+    def _call(self, function: Any, *args: Any, **kwargs: Any) -> None:
+        """Call an fmpy method; turn a failed status into :class:`FmuCallError`."""
+        from fmpy.fmi1 import FMICallException
+
+        logged = len(self.messages)
+        try:
+            function(*args, **kwargs)
+        except FMICallException as error:
+            raise FmuCallError(
+                self.path, error.function, error.status, self.messages[logged:]
+            ) from None
 
     def close(self) -> None:
         """Free the instance and delete the unzipped FMU."""

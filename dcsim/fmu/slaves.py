@@ -63,6 +63,10 @@ def keep_namespace(namespace: dict[str, Any]) -> None:
     _NAMESPACES.append(namespace)
 
 
+class _RunFailed(Exception):
+    """The closed-loop run failed (a plugin or a hook raised); the message says how."""
+
+
 _RUN_STATUS = {None: 0, "completed": 1, "stopped": 2, "failed": 3}
 _FMI_TYPES = {float: Real, int: Integer, bool: Boolean}
 
@@ -187,10 +191,13 @@ class _ScenarioSlave(Fmi2Slave):
         """Parameters are final: build the world (and the run) and publish t = 0."""
         gc.collect()  # a reset drops the previous slave in a reference cycle
         self._periods = 0
-        self._failure = self._guard(self._open, "cannot start")
-        if self._failure is None:
-            self._open_now = True
-            self._publish()
+        self._failure = self._guard(self._start, "cannot start")
+
+    def _start(self) -> None:
+        self._open()
+        self._open_now = True
+        self._healthy()
+        self._publish()
 
     def do_step(self, current_time: float, step_size: float) -> bool:
         """Fly the control periods that end within the step; False refuses the step."""
@@ -214,12 +221,13 @@ class _ScenarioSlave(Fmi2Slave):
             self.log(f"cannot step back to t = {current_time + step_size:g} s", Fmi2Status.error)
             return False
         self._failure = self._guard(lambda: self._fly(target), "step failed")
-        return self._failure is None and self._healthy()
+        return self._failure is None
 
     def _fly(self, periods: int) -> None:
         while self._periods < periods:
             self._advance()
             self._periods += 1
+        self._healthy()
         self._publish()
 
     def terminate(self) -> None:
@@ -238,7 +246,8 @@ class _ScenarioSlave(Fmi2Slave):
         try:
             call()
         except Exception as error:
-            reason = f"{what}: {type(error).__name__}: {error}"
+            kind = "run failed" if isinstance(error, _RunFailed) else type(error).__name__
+            reason = f"{what}: {kind}: {error}"
             self.log(reason, Fmi2Status.error)
             return reason
         return None
@@ -256,8 +265,8 @@ class _ScenarioSlave(Fmi2Slave):
     def _publish_more(self, out: dict[str, Any]) -> None:
         """Outputs only one kind of slave has."""
 
-    def _healthy(self) -> bool:
-        return True
+    def _healthy(self) -> None:
+        """Raise :class:`_RunFailed` (caught by :meth:`_guard`) if the model has failed."""
 
     def _open(self) -> None:
         raise NotImplementedError
@@ -285,7 +294,6 @@ class ClosedLoopSlave(_ScenarioSlave):
         setup = prepare_run(self.scenario_path, self._overrides(), seed=self.values["seed"])
         self.runner = Runner(setup)
         self.runner.open()
-        self._reported_failure = False
 
     def _advance(self) -> None:
         self.runner.advance(self._vector("disturbance_force"), self._vector("disturbance_torque"))
@@ -303,13 +311,10 @@ class ClosedLoopSlave(_ScenarioSlave):
         )
         values["run_status"] = _RUN_STATUS[runner.status]
 
-    def _healthy(self) -> bool:
-        if self.runner.status != "failed":
-            return True
-        if not self._reported_failure:
-            self._reported_failure = True
-            self.log(f"run failed: {self.runner.reason}", Fmi2Status.error)
-        return False
+    def _healthy(self) -> None:
+        if self.runner.status == "failed":
+            self.values["run_status"] = _RUN_STATUS["failed"]
+            raise _RunFailed(self.runner.reason)
 
     def _close(self) -> None:
         self.runner.close()

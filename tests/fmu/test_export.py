@@ -5,12 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from fmpy import simulate_fmu
-from fmpy.fmi1 import FMICallException
 from fmpy.validation import validate_fmu
 
 from dcsim.errors import ScenarioError
 from dcsim.fmu.export import export_fmu
-from dcsim.fmu.instance import FmuError, FmuInstance
+from dcsim.fmu.instance import FmuCallError, FmuError, FmuInstance
 from dcsim.fmu.variables import CLOSED_LOOP, plant_variables
 from dcsim.mission import Mode
 from dcsim.runner import Runner
@@ -174,7 +173,7 @@ def test_non_finite_input_gets_an_error_status_and_a_message(closed_loop_fmu, ba
     fmu.step(0.0, PERIOD)
     before = fmu_row(fmu)
     fmu.set({"disturbance_force.y": bad})
-    with pytest.raises(FMICallException) as refused:
+    with pytest.raises(FmuCallError) as refused:
         fmu.step(PERIOD, PERIOD)
     assert refused.value.status == 2  # fmi2Discard: the step was not taken
     assert ("ERROR", f"input disturbance_force.y = {bad} refused: inputs must be finite") in (
@@ -204,7 +203,7 @@ def test_a_bad_parameter_is_logged_and_every_step_refused(closed_loop_fmu):
     errors = [m for status, m in fmu.messages if status == "ERROR"]
     assert len(errors) == 1 and errors[0].startswith("cannot start") and "robot.mass" in errors[0]
     for _ in range(2):
-        with pytest.raises(FMICallException) as refused:
+        with pytest.raises(FmuCallError) as refused:
             fmu.step(0.0, PERIOD)
         assert refused.value.status == 2
     fmu.terminate()
@@ -289,3 +288,40 @@ def test_an_fmu_that_cannot_start_is_reported_with_its_reason(closed_loop_fmu, t
             target.writestr(item, data)
     with pytest.raises(FmuError, match="(?s)cannot be instantiated: .*not valid YAML"):
         FmuInstance(broken)
+
+
+def _slave_of_default_scenario(tmp_path):
+    """The closed-loop slave itself, in this process, on the default scenario."""
+    from dcsim.fmu.slaves import SCENARIO_RESOURCE, ClosedLoopSlave
+    from dcsim.registry import PluginRegistry
+    from dcsim.scenario import dump_scenario
+
+    resolved = load_scenario(None, registry=PluginRegistry.discover())
+    (tmp_path / SCENARIO_RESOURCE).write_text(dump_scenario(resolved))
+    return ClosedLoopSlave(instance_name="test", resources=str(tmp_path))
+
+
+@pytest.mark.parametrize("fails_at", [0.0, 1.0])
+def test_a_failing_plugin_is_logged_and_refuses_steps_without_raising(
+    tmp_path, monkeypatch, fails_at
+):
+    from dcsim_plugins.pd import PDController
+
+    original = PDController.command
+
+    def command(self, time, *args):
+        if time >= fails_at:
+            raise RuntimeError("controller broke")
+        return original(self, time, *args)
+
+    monkeypatch.setattr(PDController, "command", command)
+    slave = _slave_of_default_scenario(tmp_path)
+    slave.setup_experiment(0.0, None, None)
+    slave.exit_initialization_mode()
+    steps = [slave.do_step(k * PERIOD, PERIOD) for k in range(15)]
+    first_refused = max(round(fails_at / PERIOD) - 1, 0)  # step k ends at (k + 1) PERIOD
+    assert steps == [True] * first_refused + [False] * (15 - first_refused)
+    messages = [log.msg for log in slave.log_queue]
+    assert any("run failed" in m and "controller broke" in m for m in messages)
+    assert slave.values["run_status"] == 3
+    slave.terminate()

@@ -59,12 +59,12 @@ def test_example_pd_fmu_flies_the_default_mission_like_pd(pd_fmu):
     "params, message",
     [
         ({"inputs": {"position.q": "position.x"}}, "has no variable 'position.q'"),
-        ({"inputs": {"force.x": "position.x"}}, "'force.x' is a output, not a input"),
+        ({"inputs": {"force.x": "position.x"}}, "'force.x' is an output, not an input"),
         ({"inputs": {"position.x": "altitude"}}, "unknown dcsim signal 'altitude'"),
-        ({"outputs": {"force.x": "position.x"}}, "'position.x' is a input, not a output"),
+        ({"outputs": {"force.x": "position.x"}}, "'position.x' is an input, not an output"),
         ({"outputs": {"thrust.x": "force.x"}}, "unknown command component 'thrust.x'"),
         ({"parameters": {"gain": 2.0}}, "has no variable 'gain'"),
-        ({"parameters": {"mass": 2.0}}, "'mass' is a input, not a parameter"),
+        ({"parameters": {"mass": 2.0}}, "'mass' is an input, not a parameter"),
     ],
 )
 def test_mappings_are_checked_against_the_model_description(pd_fmu, params, message):
@@ -85,3 +85,22 @@ def test_a_step_size_unlike_the_control_period_fails_the_run_clearly(pd_fmu):
     summary, _ = fly(with_fmu(pd_fmu, step_size=0.2))
     assert summary["status"] == "failed"
     assert "set step_size to the scenario's control period" in summary["reason"]
+
+
+def test_the_command_is_clipped_and_a_new_run_restarts_the_fmu(example_controller):
+    from dcsim.api import LocationEstimate, Reference, RobotSpec, Surroundings
+    from dcsim_plugins.fmu_controller import SIGNALS
+
+    # The FMU's own force limit fed with the mass (100): only the plugin can clip to 5 N.
+    inputs = {n: n for n in SIGNALS if n.startswith(("position", "velocity", "reference"))}
+    inputs.update(mass="mass", speed_limit="speed_limit", max_force="mass")
+    controller = example_controller({"inputs": inputs, "parameters": {"bandwidth": 5.0}})
+    controller.reset(RobotSpec(mass=100.0, radius=0.5, max_force=5.0, max_torque=0.5,
+                               max_speed=0.5))  # fmt: skip
+    far = Reference(time=0.0, position=[100.0, 0.0, 0.0])
+    here = LocationEstimate(time=0.0, position=[0.0, 0.0, 0.0], velocity=[0.0, 0.0, 0.0])
+    forces = [controller.command(0.1 * k, here, far, Surroundings(())).force for k in range(3)]
+    assert [np.linalg.norm(f) for f in forces] == pytest.approx([5.0] * 3)
+    restarted = controller.command(0.0, here, far, Surroundings(()))  # a new run
+    assert np.allclose(restarted.force, forces[0])
+    assert controller.next_time == pytest.approx(0.1)
