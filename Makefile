@@ -23,7 +23,7 @@ run: $(STAMP)
 docs: $(STAMP)
 	$(BIN)/python -m dcsim.scenario.reference docs/scenarios.md
 	$(BIN)/python -m dcsim.testing.reference docs/plugins.md
-	$(BIN)/python -m dcsim.fmu.variables docs/fmu.md
+	$(BIN)/python -m dcsim.fmu.reference docs/fmu.md
 
 clean:
 	rm -rf $(VENV) build *.egg-info

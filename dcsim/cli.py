@@ -393,6 +393,13 @@ def bench_task_planners_command(
     help="Fields (and world seeds) flown by every controller.",
 )
 @click.option(
+    "--first-seed",
+    type=click.IntRange(min=0),
+    default=0,
+    show_default=True,
+    help="Seed of the first field (seeds FIRST to FIRST + N - 1).",
+)
+@click.option(
     "--controllers",
     default="elastic,pd",
     show_default=True,
@@ -420,6 +427,7 @@ def bench_task_planners_command(
 )
 def bench_controllers_command(
     seeds: int,
+    first_seed: int,
     controllers: str,
     workers: int,
     overrides: tuple[str, ...],
@@ -444,7 +452,7 @@ def bench_controllers_command(
     runs = bench_controllers(
         scenario,
         names,
-        seeds,
+        range(first_seed, first_seed + seeds),
         overrides,
         workers,
         progress=lambda line: click.echo(line, err=True),
@@ -504,9 +512,7 @@ def fmu_group() -> None:
 @click.option(
     "--beacons",
     type=click.IntRange(min=1),
-    default=4,
-    show_default=True,
-    help="With --plant-only: how many nearest beacons' ranges to output.",
+    help="With --plant-only: how many nearest beacons' ranges to output.  [default: 4]",
 )
 @click.option(
     "--set",
@@ -519,7 +525,7 @@ def fmu_export_command(
     scenario: Path | None,
     out: Path,
     plant_only: bool,
-    beacons: int,
+    beacons: int | None,
     overrides: tuple[str, ...],
 ) -> None:
     """Build an FMI 2.0 co-simulation FMU of SCENARIO (default: the packaged one).
@@ -530,9 +536,13 @@ def fmu_export_command(
     dcsim installed.
     """
     from dcsim.fmu.export import export_fmu
+    from dcsim.fmu.variables import DEFAULT_BEACONS
 
     if out.suffix != ".fmu":
         raise click.BadParameter("the file must end in .fmu", param_hint="--out")
+    if beacons is not None and not plant_only:
+        raise click.BadParameter("only the plant FMU outputs beacon ranges", param_hint="--beacons")
+    beacons = DEFAULT_BEACONS if beacons is None else beacons
     path = export_fmu(scenario, out, plant_only, overrides, beacons, registry=_registry())
     kind = "plant-only" if plant_only else "closed-loop"
     click.echo(f"{kind} FMU written to {path}")
@@ -613,7 +623,9 @@ def _start_values(settings: tuple[str, ...]) -> dict[str, dict[str, float]]:
         try:
             values[fmu][name] = float(text)
         except ValueError:
-            raise click.BadParameter(f"{setting!r}: {text!r} is not a number") from None
+            raise click.BadParameter(
+                f"{setting!r}: {text!r} is not a number", param_hint="--set"
+            ) from None
     return values
 
 

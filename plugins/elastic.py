@@ -281,6 +281,7 @@ def early_dodge(
     lookahead: float,
     dodge_time: float,
     along_miss: bool = True,
+    passes: int = _DODGE_PASSES,
 ) -> np.ndarray:
     """The planned velocity with a dodge for every foreseen contact (departure 4), m/s.
 
@@ -300,15 +301,18 @@ def early_dodge(
         Horizon of the prediction and least time a dodge is spread over, s.
     along_miss : bool
         Dodge along the miss vector (else along eq. 5.2's perpendicular candidate).
+    passes : int
+        Passes over the obstacles, each against the velocity the last one left.
 
     Returns
     -------
     ndarray (3,)
     """
-    near = np.linalg.norm(away, axis=1) < sphere + limit * lookahead + 1.0
+    closing = limit + np.linalg.norm(velocities, axis=1)  # fastest closing speed, m/s
+    near = np.linalg.norm(away, axis=1) < sphere + closing * lookahead
     away, velocities, sphere = away[near], velocities[near], sphere[near]
     planned = np.asarray(planned, dtype=float)
-    for _ in range(_DODGE_PASSES):
+    for _ in range(passes):
         relative = velocities - planned  # obstacle relative to the planned velocity
         squared = np.einsum("ij,ij->i", relative, relative)
         t_star = np.einsum("ij,ij->i", away, relative) / np.maximum(squared, 1e-12)
@@ -372,7 +376,8 @@ def braking_limit(
     normal = away / np.maximum(distance, 1e-12)[:, None]
     stoppable = acceleration * (-lag + np.sqrt(lag**2 + 2.0 * np.maximum(gap, 0.0) / acceleration))
     allowed = np.where(gap > 0, stoppable, escape_gain * gap)  # approach speed, m/s
-    watch = np.flatnonzero(gap < limit**2 / (2.0 * acceleration) + limit * lag)
+    closing = limit + np.linalg.norm(velocities, axis=1)  # fastest closing speed, m/s
+    watch = np.flatnonzero(gap < closing**2 / (2.0 * acceleration) + closing * lag)
     planned = np.asarray(planned, dtype=float)
     for _ in range(_BRAKE_PASSES):
         for i in watch:
@@ -445,7 +450,8 @@ class ElasticController(Controller):
         reference: Reference,
         surroundings: Surroundings,
     ) -> np.ndarray:
-        """``M`` of eq. 5.3: attraction plus the repulsions, within the speed limit, m/s."""
+        """``M``: eq. 5.3's attraction plus repulsions, then the early dodge and the braking
+        limit (departures 4 and 5), within the speed limit, m/s."""
         limit = min(self.robot.max_speed, reference.max_speed)
         error = reference.position - estimate.position
         attraction = clip_norm(reference.velocity + self.params.gain * error, limit)

@@ -10,7 +10,7 @@ the mission time.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -102,16 +102,16 @@ def fly(scenario: Path, controller: str, seed: int, overrides: Sequence[str] = (
 def bench_controllers(
     scenario: Path,
     controllers: Sequence[str],
-    seeds: int,
+    seeds: Iterable[int],
     overrides: Sequence[str] = (),
     workers: int = 2,
     progress: Callable[[str], None] = print,
 ) -> list[ControllerRun]:
-    """Fly every controller on ``seeds`` fields, ``workers`` runs at a time."""
+    """Fly every controller on the fields of ``seeds``, ``workers`` runs at a time."""
     with ProcessPoolExecutor(max_workers=workers) as pool:
         jobs = [
             pool.submit(fly, scenario, controller, seed, tuple(overrides))
-            for seed in range(seeds)
+            for seed in seeds
             for controller in controllers
         ]
         runs = []

@@ -47,6 +47,11 @@ class Coupling:
 def couple(plant: FmuInstance, controller: FmuInstance) -> Coupling:
     """Connect equal names; raise if no signal goes either way.
 
+    Returns
+    -------
+    Coupling
+        The names connected each way and the inputs left unfed.
+
     Raises
     ------
     FmuError
@@ -153,7 +158,15 @@ def _sample(
 
 
 def write_csv(results: dict[str, np.ndarray], path: Path) -> None:
-    """Write the results as CSV, one column per signal, floats in round-trip form."""
+    """Write the results as CSV, one column per signal, floats in round-trip form.
+
+    Parameters
+    ----------
+    results : dict of str to ndarray
+        ``time`` and the signals, as :func:`cosimulate` returns them.
+    path : Path
+        CSV file to write (its directory is created).
+    """
     path.parent.mkdir(parents=True, exist_ok=True)
     with path.open("w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
@@ -162,7 +175,15 @@ def write_csv(results: dict[str, np.ndarray], path: Path) -> None:
 
 
 def plot(results: dict[str, np.ndarray], path: Path) -> None:
-    """Plant position and velocity, and the controller's outputs, against time."""
+    """Plant position and velocity, and the controller's outputs, against time.
+
+    Parameters
+    ----------
+    results : dict of str to ndarray
+        ``time`` and the signals, as :func:`cosimulate` returns them.
+    path : Path
+        Image file to write (PNG).
+    """
     from dcsim.bench.figures import pyplot, save
 
     plt = pyplot()

@@ -1,18 +1,15 @@
 """The variables of dcsim's FMUs: name, causality, type, unit and meaning.
 
 The tables here define what the exported FMUs offer; the slaves register exactly these
-variables and ``docs/fmu.md`` lists them (``make docs`` regenerates the list). Vectors
+variables and ``docs/fmu.md`` lists them (:mod:`dcsim.fmu.reference`, ``make docs``). Vectors
 are three (or four) scalar variables named ``name.x``, ``name.y``, ``name.z`` (``.w``
 for a quaternion's scalar part), world frame of the scenario.
 """
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
-from pathlib import Path
 
-from dcsim.docgen import update_block
 from dcsim.mission import Mode
 
 AXES = ("x", "y", "z")
@@ -56,7 +53,8 @@ PARAMETERS = [
     FmuVariable("robot.max_speed", "parameter", float, "m/s", "Speed limit of the collector."),
     FmuVariable("robot.sensor_range", "parameter", float, "m", "Object sensor range."),
 ]
-"""Parameters of both FMUs; each name is also the scenario key it overrides."""
+"""Parameters of both FMUs; ``seed`` overrides ``world.seed``, the others the scenario
+key of their own name."""
 
 _STATE = [
     *_vector("position", "output", "m", "Collector position (true)."),
@@ -93,6 +91,10 @@ CLOSED_LOOP = [
     ),
 ]
 """Variables of the closed-loop FMU (``dcsim fmu export``)."""
+
+
+DEFAULT_BEACONS = 4
+"""How many nearest beacons' ranges the plant FMU outputs unless told otherwise (K)."""
 
 
 def plant_variables(beacons: int) -> list[FmuVariable]:
@@ -143,35 +145,3 @@ def plant_variables(beacons: int) -> list[FmuVariable]:
 
 def _ordinal(k: int) -> str:
     return {1: "1st", 2: "2nd", 3: "3rd"}.get(k, f"{k}th")
-
-
-def variables_table(variables: list[FmuVariable]) -> str:
-    """A Markdown table of ``variables``."""
-    types = {float: "Real", int: "Integer", bool: "Boolean"}
-    lines = ["| name | causality | type | unit | meaning |", "|---|---|---|---|---|"]
-    lines += [
-        f"| `{v.name}` | {v.causality} | {types[v.type]} | {v.unit or '–'} | {v.description} |"
-        for v in variables
-    ]
-    return "\n".join(lines) + "\n"
-
-
-BEGIN_CLOSED = "<!-- begin: closed-loop variables (make docs) -->"
-END_CLOSED = "<!-- end: closed-loop variables -->"
-BEGIN_PLANT = "<!-- begin: plant variables (make docs) -->"
-END_PLANT = "<!-- end: plant variables -->"
-DEFAULT_BEACONS = 4
-"""How many nearest beacons' ranges the plant FMU outputs unless told otherwise (K)."""
-
-
-def write_reference(path: Path) -> bool:
-    """Regenerate both variable tables in ``path``; return True if it changed."""
-    changed = update_block(path, BEGIN_CLOSED, END_CLOSED, variables_table(CLOSED_LOOP))
-    plant = variables_table(plant_variables(DEFAULT_BEACONS))
-    return update_block(path, BEGIN_PLANT, END_PLANT, plant) or changed
-
-
-if __name__ == "__main__":
-    target = Path(sys.argv[1] if len(sys.argv) > 1 else "docs/fmu.md")
-    changed = write_reference(target)
-    print(f"{target}: {'updated' if changed else 'already up to date'}")

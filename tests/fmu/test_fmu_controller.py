@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from dcsim_plugins.fmu_controller import FmuController, FmuControllerParams
+from dcsim_plugins.fmu_controller import SIGNALS, FmuController, FmuControllerParams
 
+from dcsim.api import LocationEstimate, Reference, RobotSpec, Surroundings
 from dcsim.errors import PluginParameterError
 from dcsim.registry import PluginRegistry
 from dcsim.runner import Runner
@@ -88,9 +89,6 @@ def test_a_step_size_unlike_the_control_period_fails_the_run_clearly(pd_fmu):
 
 
 def test_the_command_is_clipped_and_a_new_run_restarts_the_fmu(example_controller):
-    from dcsim.api import LocationEstimate, Reference, RobotSpec, Surroundings
-    from dcsim_plugins.fmu_controller import SIGNALS
-
     # The FMU's own force limit fed with the mass (100): only the plugin can clip to 5 N.
     inputs = {n: n for n in SIGNALS if n.startswith(("position", "velocity", "reference"))}
     inputs.update(mass="mass", speed_limit="speed_limit", max_force="mass")

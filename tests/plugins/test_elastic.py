@@ -132,14 +132,15 @@ def test_the_early_dodge_widens_a_foreseen_miss_and_leaves_a_clear_pass_alone():
     # the miss vector, across the relative velocity, on the side the collector already misses.
     beside = np.array([[-10.0, -1.0, 0.0]])  # D, obstacle to collector
     once = early_dodge(beside, still, sphere, planned, 0.5, 60.0, 4.0)
-    assert once[1] < 0 and once[2] == 0
-    first = early_dodge(beside, still, sphere, planned, 0.5, 60.0, 4.0)  # deterministic
-    np.testing.assert_allclose(once, first)
-    relative = -planned
-    t_star = 10.0 * 0.3 / 0.09
-    one_pass = planned + np.array([0.0, -1.0, 0.0]) * 3.0 / t_star
-    assert np.dot(one_pass - planned, relative) == pytest.approx(0.0)
-    assert np.linalg.norm(once - planned) >= np.linalg.norm(one_pass - planned) - 1e-12
+    assert once[1] < 0 and once[2] == 0  # on the side the collector already misses
+    # Flying the dodged velocity, the straight-line closest approach clears the sphere.
+    relative = -once
+    t_star = beside[0] @ relative / (relative @ relative)
+    assert 0 < t_star < 60.0
+    assert np.linalg.norm(beside[0] - relative * t_star) == pytest.approx(4.0, abs=1e-6)
+    # The first pass alone is (4 - 1) m over the 33 s to the closest approach, along -y.
+    one_pass = early_dodge(beside, still, sphere, planned, 0.5, 60.0, 4.0, passes=1)
+    np.testing.assert_allclose(one_pass, planned + [0.0, -3.0 / (10.0 / 0.3), 0.0])
     # Passing clear (miss 5 m > 4 m), beyond the horizon, or behind: no dodge.
     for away in ([-10.0, -5.0, 0.0], [-30.0, -1.0, 0.0], [10.0, -1.0, 0.0]):
         np.testing.assert_allclose(
