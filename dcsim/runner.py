@@ -38,8 +38,6 @@ from dcsim.seeding import component_rng
 from dcsim.world import World, WorldInputs
 from dcsim.world.objects import ObjectStatus
 
-_ZERO = np.zeros(3)
-
 
 class LapTimer:
     """Wall time spent in each phase of the run loop, s.
@@ -184,8 +182,8 @@ class Runner:
 
     def advance(
         self,
-        disturbance_force: np.ndarray = _ZERO,
-        disturbance_torque: np.ndarray = _ZERO,
+        disturbance_force: np.ndarray | None = None,
+        disturbance_torque: np.ndarray | None = None,
     ) -> None:
         """Fly the decided command for one control period, then decide the next.
 
@@ -194,11 +192,14 @@ class Runner:
 
         Parameters
         ----------
-        disturbance_force : ndarray (3,)
-            External force on the collector over the period, world frame, N.
-        disturbance_torque : ndarray (3,)
+        disturbance_force : ndarray (3,), optional
+            External force on the collector over the period, world frame, N (none if
+            None).
+        disturbance_torque : ndarray (3,), optional
             External torque on the collector over the period, world frame, N·m.
         """
+        disturbance_force = np.zeros(3) if disturbance_force is None else disturbance_force
+        disturbance_torque = np.zeros(3) if disturbance_torque is None else disturbance_torque
         if self.ended:
             self.world.step(
                 WorldInputs(
