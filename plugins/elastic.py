@@ -457,7 +457,11 @@ class ElasticController(Controller):
         attraction = clip_norm(reference.velocity + self.params.gain * error, limit)
         if not surroundings.obstacles:
             return attraction
-        closeness, relative = self._inside(time, estimate, surroundings)
+        centres, velocities, radii = _states(time, surroundings)
+        away = estimate.position - centres  # D
+        closeness, relative = self._inside(
+            away, velocities - estimate.velocity, radii, surroundings
+        )
         chosen = perpendicular_repulsion(closeness, relative, attraction)[2]
         push = repulsion(
             closeness,
@@ -468,20 +472,23 @@ class ElasticController(Controller):
             self.params.slow_obstacle_speed,
         )
         desired = clip_norm(attraction + push.sum(axis=0), limit)
-        return self._dodge_and_brake(time, estimate, surroundings, desired, limit)
+        return self._dodge_and_brake(away, velocities, radii, surroundings, desired, limit)
 
     def _dodge_and_brake(
         self,
-        time: float,
-        estimate: LocationEstimate,
+        away: np.ndarray,
+        velocities: np.ndarray,
+        radii: np.ndarray,
         surroundings: Surroundings,
         desired: np.ndarray,
         limit: float,
     ) -> np.ndarray:
-        """``M`` after the early dodge and the braking limit (departures 4 and 5), m/s."""
+        """``M`` after the early dodge and the braking limit (departures 4 and 5), m/s.
+
+        ``away`` is ``D`` (K, 3), m; ``velocities`` the obstacles' (K, 3), m/s; ``radii``
+        theirs (K,), m.
+        """
         p = self.params
-        centres, velocities, radii = _states(time, surroundings)
-        away = estimate.position - centres  # D
         margin = self.robot.radius + radii
         if p.lookahead > 0:
             sphere = margin + p.dodge_share * surroundings.safety_distance
@@ -502,16 +509,19 @@ class ElasticController(Controller):
         return desired
 
     def _inside(
-        self, time: float, estimate: LocationEstimate, surroundings: Surroundings
+        self,
+        away: np.ndarray,
+        relative: np.ndarray,
+        radii: np.ndarray,
+        surroundings: Surroundings,
     ) -> tuple[np.ndarray, np.ndarray]:
         """Closeness ``D′ − D`` and relative velocity of the obstacles that repel.
 
-        An obstacle repels while the collector is inside its safety sphere and the two
-        are closing; once they separate, pushing on would only cost fuel.
+        ``away`` is ``D`` (K, 3), m; ``relative`` the obstacles' velocities relative to
+        the collector (K, 3), m/s; ``radii`` theirs (K,), m. An obstacle repels while the
+        collector is inside its safety sphere and the two are closing; once they
+        separate, pushing on would only cost fuel.
         """
-        centres, velocities, radii = _states(time, surroundings)
-        relative = velocities - estimate.velocity
-        away = estimate.position - centres  # D
         distance = np.linalg.norm(away, axis=1)
         sphere = surroundings.safety_distance + self.robot.radius + radii
         closing = np.einsum("ij,ij->i", away, relative) > 0
