@@ -538,8 +538,6 @@ def fmu_export_command(
     from dcsim.fmu.export import export_fmu
     from dcsim.fmu.variables import DEFAULT_BEACONS
 
-    if out.suffix != ".fmu":
-        raise click.BadParameter("the file must end in .fmu", param_hint="--out")
     if beacons is not None and not plant_only:
         raise click.BadParameter("only the plant FMU outputs beacon ranges", param_hint="--beacons")
     beacons = DEFAULT_BEACONS if beacons is None else beacons

@@ -157,18 +157,18 @@ def signals(
     }
     for name, vector in vectors.items():
         values.update({f"{name}.{a}": float(v) for a, v in zip(AXES, vector, strict=True)})
-    gaps = [
-        float(np.linalg.norm(track.position - estimate.position)) - track.radius - robot.radius
-        for track in surroundings.obstacles
-    ]
+    obstacles = surroundings.obstacles
+    centres = np.array([track.position for track in obstacles]).reshape(-1, 3)
+    radii = np.array([track.radius for track in obstacles])
+    gaps = np.linalg.norm(centres - estimate.position, axis=1) - radii - robot.radius
     values.update(
         speed_limit=min(robot.max_speed, reference.max_speed),
         mass=robot.mass,
         max_force=robot.max_force,
         max_torque=robot.max_torque,
         radius=robot.radius,
-        obstacles=float(len(surroundings.obstacles)),
-        nearest_gap=min(gaps, default=NO_OBSTACLE_GAP),
+        obstacles=float(len(obstacles)),
+        nearest_gap=float(gaps.min()) if len(gaps) else NO_OBSTACLE_GAP,
         safety_distance=surroundings.safety_distance,
     )
     return values

@@ -45,10 +45,19 @@ class FmuBenchResult:
     fmu: list[float]
 
     @property
+    def native_tick(self) -> float:
+        """Median native wall time per tick, s."""
+        return statistics.median(self.native)
+
+    @property
+    def fmu_tick(self) -> float:
+        """Median FMU wall time per step, s."""
+        return statistics.median(self.fmu)
+
+    @property
     def overhead(self) -> float:
         """The FMU's extra time per tick, in percent of the native tick (medians)."""
-        native = statistics.median(self.native)
-        return 100.0 * (statistics.median(self.fmu) - native) / native
+        return 100.0 * (self.fmu_tick - self.native_tick) / self.native_tick
 
 
 def bench_fmu(
@@ -125,8 +134,7 @@ def _fmu(path: Path, ticks: int) -> float:
 
 def markdown_table(result: FmuBenchResult) -> str:
     """The medians and the overhead as a Markdown table."""
-    native = statistics.median(result.native)
-    fmu = statistics.median(result.fmu)
+    native, fmu = result.native_tick, result.fmu_tick
     return (
         "\n".join(
             [

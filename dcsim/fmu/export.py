@@ -8,6 +8,7 @@ import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
+from dcsim.fmu.instance import FmuError
 from dcsim.fmu.slaves import SCENARIO_RESOURCE
 from dcsim.fmu.variables import DEFAULT_BEACONS
 from dcsim.registry import PluginRegistry
@@ -60,16 +61,16 @@ def export_fmu(
     ------
     ScenarioError
         If the scenario or an override is invalid.
-    ValueError
+    FmuError
         If ``out`` does not end in ``.fmu`` or ``beacons`` < 1.
     """
     from pythonfmu import FmuBuilder  # imported here: only export needs the builder
 
     out = Path(out)
     if out.suffix != ".fmu":
-        raise ValueError(f"the FMU file must end in .fmu: {out}")
+        raise FmuError(f"the FMU file must end in .fmu: {out}")
     if beacons < 1:
-        raise ValueError(f"beacons must be at least 1, got {beacons}")
+        raise FmuError(f"beacons must be at least 1, got {beacons}")
     registry = registry if registry is not None else PluginRegistry.discover()
     resolved = load_scenario(scenario, overrides, registry)
     text = dump_scenario(resolved)

@@ -171,7 +171,9 @@ class FmuInstance:
             said = "; ".join(message for _, message in self.messages) or str(error)
             raise FmuError(f"{self.path.name} cannot be instantiated: {said}") from error
         self._instantiated = True
-        self._get_plans: dict[tuple[str, ...], list[tuple[Any, list[int], list[str]]]] = {}
+        self._plans: dict[
+            tuple[str, tuple[str, ...]], list[tuple[Any, list[int], list[str], type]]
+        ] = {}
 
     def _logging_callbacks(self) -> Any:
         from fmpy import calloc, free
@@ -205,14 +207,8 @@ class FmuInstance:
         FmuCallError
             If the FMU refuses the values.
         """
-        groups: dict[str, tuple[list[int], list[Any]]] = {}
-        for name, value in values.items():
-            variable = self.description.variable(name, ("input", "parameter"))
-            refs, vals = groups.setdefault(variable.type, ([], []))
-            refs.append(variable.valueReference)
-            vals.append(_TYPES[variable.type](value))
-        for kind, (refs, vals) in groups.items():
-            self._call(self._method("set", kind), refs, vals)
+        for setter, refs, group, kind in self._plan("set", tuple(values)):
+            self._call(setter, refs, [kind(values[name]) for name in group])
 
     def get(self, names: Iterable[str]) -> dict[str, float | int | bool]:
         """Values of variables by name, in the order asked.
@@ -223,27 +219,35 @@ class FmuInstance:
             If the FMU has no variable of a name.
         """
         names = tuple(names)
-        plan = self._get_plans.get(names)
-        if plan is None:
-            plan = self._get_plans[names] = self._get_plan(names)
         out: dict[str, float | int | bool] = {}
-        for getter, refs, group in plan:
+        for getter, refs, group, _ in self._plan("get", names):
             out.update(zip(group, getter(refs), strict=True))
         return {name: out[name] for name in names}
 
-    def _get_plan(self, names: tuple[str, ...]) -> list[tuple[Any, list[int], list[str]]]:
-        """Per FMI type: the getter, the value references and the names to read."""
-        by_type: dict[str, list[str]] = {}
-        for name in names:
-            by_type.setdefault(self.description.variable(name).type, []).append(name)
-        return [
-            (
-                self._method("get", kind),
-                [self.description.variables[n].valueReference for n in group],
-                group,
-            )
-            for kind, group in by_type.items()
-        ]
+    def _plan(
+        self, action: str, names: tuple[str, ...]
+    ) -> list[tuple[Any, list[int], list[str], type]]:
+        """Per FMI type: fmpy's method, the value references, the names and the Python type.
+
+        Built once per ``action`` and set of names (a simulation asks the same every
+        step); setting checks that each name is an input or a parameter.
+        """
+        key = (action, names)
+        if key not in self._plans:
+            causality = ("input", "parameter") if action == "set" else ()
+            by_type: dict[str, list[str]] = {}
+            for name in names:
+                by_type.setdefault(self.description.variable(name, causality).type, []).append(name)
+            self._plans[key] = [
+                (
+                    self._method(action, kind),
+                    [self.description.variables[n].valueReference for n in group],
+                    group,
+                    _TYPES[kind],
+                )
+                for kind, group in by_type.items()
+            ]
+        return self._plans[key]
 
     def _method(self, action: str, kind: str) -> Any:
         """fmpy's ``getReal``, ``setInteger``... for an FMI type (enumerations as Integer)."""

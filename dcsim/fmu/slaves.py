@@ -31,9 +31,11 @@ from pythonfmu import Boolean, DefaultExperiment, Fmi2Causality, Fmi2Slave, Inte
 from pythonfmu.enums import Fmi2Initial, Fmi2Status, Fmi2Variability
 
 from dcsim.fmu.variables import (
+    AXES,
     CLOSED_LOOP,
     DEFAULT_BEACONS,
     PARAMETERS,
+    QUATERNION,
     FmuVariable,
     plant_variables,
 )
@@ -118,11 +120,11 @@ class _ScenarioSlave(Fmi2Slave):
 
     @staticmethod
     def _put_vector(values: dict[str, Any], name: str, vector: np.ndarray) -> None:
-        for axis, value in zip(("x", "y", "z", "w"), vector, strict=False):
+        for axis, value in zip(QUATERNION, vector, strict=False):  # x, y, z (and w)
             values[f"{name}.{axis}"] = float(value)
 
     def _vector(self, name: str) -> np.ndarray:
-        return np.array([self.values[f"{name}.{axis}"] for axis in ("x", "y", "z")])
+        return np.array([self.values[f"{name}.{axis}"] for axis in AXES])
 
     def _fmi_variable(self, variable: FmuVariable) -> Any:
         cls = _FMI_TYPES[variable.type]

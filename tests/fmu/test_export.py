@@ -272,7 +272,7 @@ def test_plant_collision_flag_marks_the_step_a_contact_starts(plant_fmu):
 def test_export_refuses_a_bad_scenario_or_file_name(tmp_path):
     with pytest.raises(ScenarioError):
         export_fmu(None, tmp_path / "x.fmu", overrides=["robot.mass=-1"])
-    with pytest.raises(ValueError, match=r"\.fmu"):
+    with pytest.raises(FmuError, match=r"\.fmu"):
         export_fmu(None, tmp_path / "x.zip")
     assert not list(tmp_path.iterdir())
 
