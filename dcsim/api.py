@@ -12,12 +12,16 @@ Plugin kinds
 Parameters
     :class:`PluginParams`, :func:`quantity`.
 Messages
-    :class:`ObjectTrack`, :class:`ObjectKind`, :class:`BeaconRange`, :class:`MotionInput`,
-    :class:`LocationEstimate`, :class:`Prior`, :class:`TaskRequest`, :class:`PlanTask`,
-    :class:`DropVisit`, :class:`Plan`, :class:`DropPoint`, :class:`RobotSpec`,
-    :class:`PathProblem`, :class:`PathState`, :class:`GoalRegion`, :class:`Bounds`,
-    :class:`CostWeights`, :class:`Trajectory`, :class:`NoPath`, :class:`Reference`,
-    :class:`Surroundings`, :class:`Command`, :class:`MoveCommand`.
+    The robot: :class:`RobotState`, :class:`StateEstimate`, :class:`Prior`,
+    :class:`MotionInput`, :class:`Reference`, :class:`Command`, :class:`RobotSpec`.
+    Sensing: :class:`ObjectTrack`, :class:`ObjectKind`, :class:`Shape`, :class:`ShapeKind`,
+    :class:`BeaconRange`, :class:`Observations`, :class:`Surroundings`.
+    Path planning: :class:`PathProblem`, :class:`GoalRegion`, :class:`FrameDynamics`,
+    :class:`FrameKind`, :class:`Bounds`, :class:`CostWeights`, :class:`Trajectory`,
+    :class:`NoPath`.
+    Task planning (debris): :class:`TaskRequest`, :class:`PlanTask`, :class:`DropVisit`,
+    :class:`Plan`, :class:`DropPoint`.
+    Your own messages: :class:`Message`, :func:`message`, :func:`array_field`.
 Motion models
     :class:`MotionModel`, :class:`StaticMotion`, :class:`LinearMotion`,
     :class:`SphericalMotion`, :class:`ClohessyWiltshireMotion`, :func:`mean_motion`.
@@ -28,7 +32,8 @@ Kinematics
     :func:`rest_to_rest_time`, :func:`shortest_leg`, :func:`cruise_speed`.
 Geometry
     :func:`spherical_to_cartesian`, :func:`quaternion_between`, :func:`rotate`, :func:`unit`,
-    :func:`clip_norm`.
+    :func:`clip_norm`, :func:`quaternion_multiply`, :func:`quaternion_conjugate`,
+    :func:`rotation_vector`, :func:`slerp`.
 FMUs (FMI 2.0 co-simulation, through fmpy)
     :class:`FmuDescription`, :class:`FmuInstance`, :class:`FmuError`,
     :class:`FmuCallError`.
@@ -49,7 +54,17 @@ from dcsim.errors import (
     ScenarioError,
 )
 from dcsim.fmu.instance import FmuCallError, FmuDescription, FmuError, FmuInstance
-from dcsim.geometry import clip_norm, quaternion_between, rotate, spherical_to_cartesian, unit
+from dcsim.geometry import (
+    clip_norm,
+    quaternion_between,
+    quaternion_conjugate,
+    quaternion_multiply,
+    rotate,
+    rotation_vector,
+    slerp,
+    spherical_to_cartesian,
+    unit,
+)
 from dcsim.hookspecs import hookimpl
 from dcsim.interfaces import PLUGIN_KINDS, Controller, Localiser, PathPlanner, Plugin, TaskPlanner
 from dcsim.kinematics import cruise_speed, rest_to_rest_time, shortest_leg
@@ -60,23 +75,30 @@ from dcsim.messages import (
     CostWeights,
     DropPoint,
     DropVisit,
+    FrameDynamics,
+    FrameKind,
     GoalRegion,
-    LocationEstimate,
+    Message,
     MotionInput,
-    MoveCommand,
     NoPath,
     ObjectKind,
     ObjectTrack,
+    Observations,
     PathProblem,
-    PathState,
     Plan,
     PlanTask,
     Prior,
     Reference,
     RobotSpec,
+    RobotState,
+    Shape,
+    ShapeKind,
+    StateEstimate,
     Surroundings,
     TaskRequest,
     Trajectory,
+    array_field,
+    message,
 )
 from dcsim.motion import (
     ClohessyWiltshireMotion,
@@ -91,39 +113,49 @@ from dcsim.plancost import leg_delta_v, legs_delta_v, plan_cost, plan_delta_v, p
 from dcsim.registry import PluginRegistry
 
 __all__ = [
-    "FmuCallError",
-    "FmuDescription",
-    "FmuError",
-    "FmuInstance",
-    "PLUGIN_KINDS",
+    "array_field",
     "BeaconRange",
     "Bounds",
+    "clip_norm",
     "ClohessyWiltshireMotion",
     "Command",
     "Controller",
-    "clip_norm",
-    "cruise_speed",
     "CostWeights",
+    "cruise_speed",
     "DcsimError",
     "DropPoint",
     "DropVisit",
     "DuplicatePluginError",
+    "FmuCallError",
+    "FmuDescription",
+    "FmuError",
+    "FmuInstance",
+    "FrameDynamics",
+    "FrameKind",
     "GoalRegion",
+    "hookimpl",
+    "leg_delta_v",
+    "legs_delta_v",
     "LinearMotion",
     "Localiser",
-    "LocationEstimate",
+    "mean_motion",
+    "Message",
+    "message",
     "MotionInput",
     "MotionModel",
-    "MoveCommand",
     "NoPath",
     "ObjectKind",
     "ObjectTrack",
+    "Observations",
     "PathPlanner",
     "PathProblem",
-    "PathState",
     "Plan",
+    "plan_cost",
+    "plan_delta_v",
+    "plan_duration",
     "PlanTask",
     "Plugin",
+    "PLUGIN_KINDS",
     "PluginError",
     "PluginInterfaceError",
     "PluginLoadWarning",
@@ -132,27 +164,28 @@ __all__ = [
     "PluginParams",
     "PluginRegistry",
     "Prior",
+    "quantity",
+    "quaternion_between",
+    "quaternion_conjugate",
+    "quaternion_multiply",
     "Reference",
+    "rest_to_rest_time",
     "RobotSpec",
+    "RobotState",
+    "rotate",
+    "rotation_vector",
     "ScenarioError",
+    "Shape",
+    "ShapeKind",
+    "shortest_leg",
+    "slerp",
+    "spherical_to_cartesian",
     "SphericalMotion",
+    "StateEstimate",
     "StaticMotion",
     "Surroundings",
     "TaskPlanner",
     "TaskRequest",
     "Trajectory",
-    "hookimpl",
-    "leg_delta_v",
-    "legs_delta_v",
-    "mean_motion",
-    "plan_cost",
-    "plan_delta_v",
-    "plan_duration",
-    "quantity",
-    "quaternion_between",
-    "rest_to_rest_time",
-    "rotate",
-    "shortest_leg",
-    "spherical_to_cartesian",
     "unit",
 ]

@@ -87,3 +87,64 @@ def rotate(q: ArrayLike, v: ArrayLike) -> Vector:
     u, w = q[:3], q[3]
     t = 2.0 * np.cross(u, v)
     return v + w * t + np.cross(u, t)
+
+
+def quaternion_multiply(p: ArrayLike, q: ArrayLike) -> Vector:
+    """Hamilton product ``p ⊗ q`` of quaternions ``[x, y, z, w]`` (rotation q, then p)."""
+    p = np.asarray(p, dtype=float)
+    q = np.asarray(q, dtype=float)
+    pv, pw = p[..., :3], p[..., 3:]
+    qv, qw = q[..., :3], q[..., 3:]
+    vector = pw * qv + qw * pv + np.cross(pv, qv)
+    scalar = pw * qw - np.sum(pv * qv, axis=-1, keepdims=True)
+    return np.concatenate([vector, scalar], axis=-1)
+
+
+def quaternion_conjugate(q: ArrayLike) -> Vector:
+    """Conjugate of quaternion ``[x, y, z, w]`` (the inverse rotation for a unit quaternion)."""
+    q = np.asarray(q, dtype=float)
+    return np.concatenate([-q[..., :3], q[..., 3:]], axis=-1)
+
+
+def rotation_vector(q: ArrayLike) -> Vector:
+    """Rotation vector (axis times angle, rad) of unit quaternion ``[x, y, z, w]``.
+
+    The angle is taken in ``[0, π]``: ``q`` and ``−q`` give the same vector.
+    """
+    q = np.asarray(q, dtype=float)
+    q = np.where(q[..., 3:] < 0.0, -q, q)
+    sine = np.linalg.norm(q[..., :3], axis=-1, keepdims=True)
+    angle = 2.0 * np.arctan2(sine, q[..., 3:])
+    scale = np.where(sine > _EPS, angle / np.maximum(sine, _EPS), 2.0)
+    return q[..., :3] * scale
+
+
+def slerp(q0: ArrayLike, q1: ArrayLike, fraction: ArrayLike) -> Vector:
+    """Spherical linear interpolation between unit quaternions, along the shorter arc.
+
+    Parameters
+    ----------
+    q0, q1 : array_like, shape (..., 4)
+        Start and end attitudes ``[x, y, z, w]``.
+    fraction : array_like, shape (...)
+        0 gives ``q0``, 1 gives ``q1``.
+
+    Returns
+    -------
+    ndarray, shape (..., 4)
+        Unit quaternions.
+    """
+    q0 = np.asarray(q0, dtype=float)
+    q1 = np.asarray(q1, dtype=float)
+    s = np.asarray(fraction, dtype=float)[..., None]
+    dot = np.sum(q0 * q1, axis=-1, keepdims=True)
+    q1 = np.where(dot < 0.0, -q1, q1)
+    dot = np.abs(dot)
+    theta = np.arccos(np.clip(dot, -1.0, 1.0))
+    sin_theta = np.sin(theta)
+    near = sin_theta < 1e-9
+    safe = np.where(near, 1.0, sin_theta)
+    w0 = np.where(near, 1.0 - s, np.sin((1.0 - s) * theta) / safe)
+    w1 = np.where(near, s, np.sin(s * theta) / safe)
+    q = w0 * q0 + w1 * q1
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)

@@ -6,6 +6,7 @@ A plugin is a class deriving from one of :class:`Localiser`, :class:`TaskPlanner
 - ``name``: unique within its kind, lower case (``"pd"``, ``"straight-line"``);
 - ``summary``: one line saying what it is;
 - ``Params``: a :class:`~dcsim.params.PluginParams` subclass (defaults, bounds, units);
+- ``robots``: the robot types it supports (``("free-flyer",)`` unless it says otherwise);
 
 and implements its kind's abstract methods. The framework constructs it with validated
 parameters and its own random generator, spawned from the scenario seed, so that a
@@ -24,7 +25,7 @@ import numpy as np
 from dcsim.messages import (
     BeaconRange,
     Command,
-    LocationEstimate,
+    StateEstimate,
     MotionInput,
     NoPath,
     PathProblem,
@@ -59,6 +60,8 @@ class Plugin(ABC):
         One line describing the plugin.
     Params : type of PluginParams
         The parameter model.
+    robots : tuple of str
+        The robot types (``robot.type`` in a scenario) the plugin supports.
     params : PluginParams
         The validated parameters of this instance.
     rng : numpy.random.Generator
@@ -69,6 +72,7 @@ class Plugin(ABC):
     name: ClassVar[str]
     summary: ClassVar[str]
     Params: ClassVar[type[PluginParams]] = PluginParams
+    robots: ClassVar[tuple[str, ...]] = ("free-flyer",)
 
     def __init__(
         self,
@@ -82,11 +86,13 @@ class Plugin(ABC):
 
 
 class Localiser(Plugin):
-    """Estimates the collector's position and velocity from beacon ranges.
+    """Estimates the robot's position and velocity from beacon ranges.
 
     Per control tick the framework calls :meth:`predict` with the motion commanded over
     the last period, then :meth:`update` with the ranges measured now (possibly none),
-    then reads :meth:`estimate`.
+    then reads :meth:`estimate`. The estimate's attitude, angular velocity and joint
+    states are the attitude sensors' and encoders' readings: the runner puts them in
+    before the mission and the controller see the estimate.
     """
 
     kind = "localiser"
@@ -104,7 +110,7 @@ class Localiser(Plugin):
         """Correct the belief with the beacon ranges measured now (may be empty)."""
 
     @abstractmethod
-    def estimate(self) -> LocationEstimate:
+    def estimate(self) -> StateEstimate:
         """Return the current estimate; ``converged`` says whether to trust it."""
 
 
@@ -137,19 +143,20 @@ class PathPlanner(Plugin):
 
 
 class Controller(Plugin):
-    """Turns an estimate and a reference into force and torque commands."""
+    """Turns an estimate and a reference into force, torque and joint-torque commands."""
 
     kind = "controller"
 
     @abstractmethod
     def reset(self, robot: RobotSpec) -> None:
-        """Prepare for a new run of a collector with the limits in ``robot``."""
+        """Prepare for a run of the robot described by ``robot``; called again whenever the
+        robot changes (a grab or a release changes its mass and size)."""
 
     @abstractmethod
     def command(
         self,
         time: float,
-        estimate: LocationEstimate,
+        estimate: StateEstimate,
         reference: Reference,
         surroundings: Surroundings,
     ) -> Command:

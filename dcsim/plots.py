@@ -15,12 +15,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
 import numpy as np  # noqa: E402
 
-from dcsim.mission import Mode  # noqa: E402
 from dcsim.motion import MotionSet  # noqa: E402
 from dcsim.scenario.model import Scenario  # noqa: E402
 from dcsim.world.engine import build_objects  # noqa: E402
-
-_MODES = tuple(mode.name for mode in Mode)
 
 
 def write_plots(
@@ -28,8 +25,25 @@ def write_plots(
     scenario: Scenario,
     telemetry: Mapping[str, np.ndarray],
     events: Sequence[Mapping[str, Any]],
+    modes: Sequence[str],
+    safety_distance: float,
 ) -> list[Path]:
     """Draw ``trajectory.png`` and ``timeline.png`` into ``out_dir/plots``.
+
+    Parameters
+    ----------
+    out_dir : Path
+        The run directory.
+    scenario : Scenario
+        The resolved scenario (objects, drop point).
+    telemetry : mapping of str to ndarray
+        The telemetry columns.
+    events : sequence of mapping
+        The event log.
+    modes : sequence of str
+        The mission's modes, in the order the timeline shows them.
+    safety_distance : float
+        Gap marked on the obstacle-distance panel, m.
 
     Returns
     -------
@@ -42,7 +56,7 @@ def write_plots(
     folder.mkdir(parents=True, exist_ok=True)
     paths = [folder / "trajectory.png", folder / "timeline.png"]
     _trajectory(paths[0], scenario, telemetry, events)
-    _timeline(paths[1], telemetry, scenario.mission.safety_distance)
+    _timeline(paths[1], telemetry, tuple(modes), safety_distance)
     return paths
 
 
@@ -105,7 +119,7 @@ def _trajectory(path: Path, scenario: Scenario, telemetry, events) -> None:
     plt.close(figure)
 
 
-def _timeline(path: Path, telemetry, safety_distance: float) -> None:
+def _timeline(path: Path, telemetry, modes: tuple[str, ...], safety_distance: float) -> None:
     times = telemetry["time"]
     error = np.linalg.norm(
         np.column_stack(
@@ -117,10 +131,10 @@ def _timeline(path: Path, telemetry, safety_distance: float) -> None:
         axis=1,
     )
     converged = telemetry["converged"].astype(bool)
-    modes = np.array([_MODES.index(m) for m in telemetry["mode"]])
+    indices = np.array([modes.index(m) for m in telemetry["mode"]])
     figure, axes = plt.subplots(4, 1, figsize=(11, 9), sharex=True)
-    axes[0].step(times, modes, where="post", color="tab:purple")
-    axes[0].set_yticks(range(len(_MODES)), _MODES, fontsize=7)
+    axes[0].step(times, indices, where="post", color="tab:purple")
+    axes[0].set_yticks(range(len(modes)), modes, fontsize=7)
     axes[0].set_title("Mission mode")
     axes[1].plot(times, telemetry["fuel_used"], color="tab:orange", label="propellant used [kg]")
     twin = axes[1].twinx()

@@ -7,25 +7,32 @@ round-trip form), so the same scenario and seed give byte-identical files.
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
 
-TELEMETRY_COLUMNS = (
+_LEADING_COLUMNS = (
     "time",
     "x", "y", "z", "vx", "vy", "vz",
     "est_x", "est_y", "est_z", "est_vx", "est_vy", "est_vz",
     "qx", "qy", "qz", "qw",
-    "mode", "converged", "carried", "delivered",
-    "fuel_used", "delta_v", "nearest_obstacle",
-    "fx", "fy", "fz",
+    "mode", "converged",
 )  # fmt: skip
-"""Columns of ``telemetry.csv``: time (s); true and estimated position (m) and velocity
-(m/s); attitude quaternion; mission mode; localiser converged (0/1); targets carried
-and delivered; propellant used (kg); delta-v (m/s); surface gap to the nearest obstacle
-(m); commanded thrust (N)."""
+_TRAILING_COLUMNS = ("fuel_used", "delta_v", "nearest_obstacle", "fx", "fy", "fz")
+
+
+def telemetry_columns(mission_columns: Sequence[str]) -> tuple[str, ...]:
+    """Columns of ``telemetry.csv`` for a mission with its own ``mission_columns``.
+
+    Every run records time (s); true and estimated position (m) and velocity (m/s);
+    the attitude quaternion; the mission mode; localiser converged (0/1); then the
+    mission's own columns (the debris mission's: targets carried and delivered); then
+    propellant used (kg), delta-v (m/s), the surface gap to the nearest obstacle (m)
+    and the commanded thrust (N).
+    """
+    return (*_LEADING_COLUMNS, *mission_columns, *_TRAILING_COLUMNS)
 
 
 def _json_value(value: Any) -> Any:
@@ -52,10 +59,13 @@ class Recorder:
     ----------
     out_dir : Path or None
         Run directory; None keeps everything in memory only.
+    columns : sequence of str
+        The telemetry columns (:func:`telemetry_columns`).
     """
 
-    def __init__(self, out_dir: Path | None) -> None:
+    def __init__(self, out_dir: Path | None, columns: Sequence[str]) -> None:
         self.out_dir = out_dir
+        self.columns = tuple(columns)
         self.rows: list[dict[str, Any]] = []
         self.events: list[dict[str, Any]] = []
         self._events_file: IO[str] | None = None
@@ -76,7 +86,7 @@ class Recorder:
 
     def telemetry(self) -> dict[str, np.ndarray]:
         """The telemetry so far as one array per column."""
-        return {c: np.array([r[c] for r in self.rows]) for c in TELEMETRY_COLUMNS}
+        return {c: np.array([r[c] for r in self.rows]) for c in self.columns}
 
     def write(self, summary: Mapping[str, Any], scenario_yaml: str) -> None:
         """Write ``scenario.yaml``, ``telemetry.csv`` and ``summary.json``; close the log."""
@@ -87,9 +97,9 @@ class Recorder:
             return
         (self.out_dir / "scenario.yaml").write_text(scenario_yaml, encoding="utf-8")
         with (self.out_dir / "telemetry.csv").open("w", encoding="utf-8") as out:
-            out.write(",".join(TELEMETRY_COLUMNS) + "\n")
+            out.write(",".join(self.columns) + "\n")
             for row in self.rows:
-                out.write(",".join(_cell(row[c]) for c in TELEMETRY_COLUMNS) + "\n")
+                out.write(",".join(_cell(row[c]) for c in self.columns) + "\n")
         text = json.dumps({k: _json_value(v) for k, v in summary.items()}, indent=2)
         (self.out_dir / "summary.json").write_text(text + "\n", encoding="utf-8")
 

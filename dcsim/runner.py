@@ -1,23 +1,28 @@
 """The run loop: world, localiser, mission, controller, recorded tick by tick.
 
-One control tick (``docs/architecture.md``)::
+One control tick (``docs/architecture.md``), the same for every mission::
 
-    observe (beacon ranges, object tracks, last motion)
+    observations = world.observations()  # ranges, object tracks, attitude, joints
     localiser.predict(motion, dt); localiser.update(ranges); estimate = localiser.estimate()
-    reference = mission.tick(t, estimate, tracks)          # may plan, grab, release
-    command = controller.command(t, estimate, reference, surroundings)
+    estimate += the attitude sensors' and encoders' readings
+    reference = mission.tick(t, estimate, observations)    # may plan, grab, release
+    command = controller.command(t, estimate, reference, mission.surroundings(...))
     record telemetry; fire dcsim_run_step
     world.step(command)                                     # fixed physics sub-steps
 
-Plots are drawn into ``plots/`` of the run directory at the end. A run ends
-``completed`` (every target delivered, or ``world.duration`` reached), ``stopped``
-(a collision with ``stop.on_collision``, ``stop.max_wall_time``, or an interrupt with
-Ctrl-C) or ``failed`` (a plugin or hook raised). Whatever the ending,
+The runner knows no mission: the scenario's ``mission.type`` names the
+:class:`~dcsim.missions.base.Mission`, which declares its plugin roles, its telemetry
+columns, its summary fields and when it is finished. Plots are drawn into ``plots/``
+of the run directory at the end. A run ends ``completed`` (the mission says so, or
+``world.duration`` is reached), ``stopped`` (a collision with ``stop.on_collision``,
+``stop.max_wall_time``, the mission says so, or an interrupt with Ctrl-C) or
+``failed`` (a plugin or hook raised). Whatever the ending,
 the telemetry, events and summary recorded so far are written.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 import time as wallclock
 from collections.abc import Callable
@@ -27,16 +32,19 @@ from typing import Any
 import numpy as np
 
 from dcsim.hookspecs import RunInfo
-from dcsim.messages import Command, LocationEstimate, Prior, Surroundings
-from dcsim.mission import Mission, Mode, PluginFailure, call_plugin
+from dcsim.messages import Command, Observations, Prior, StateEstimate
+from dcsim.missions import Mission, mission_class
 from dcsim.plots import write_plots
-from dcsim.recording import Recorder
+from dcsim.plugin_calls import PluginFailure, call_plugin
+from dcsim.recording import Recorder, telemetry_columns
 from dcsim.runsetup import RunSetup
 from dcsim.scenario import dump_scenario
 from dcsim.scenario.model import point_to_cartesian
 from dcsim.seeding import component_rng
 from dcsim.world import World, WorldInputs
-from dcsim.world.objects import ObjectStatus
+
+Progress = Callable[[float, float, str, str], None]
+"""``progress(sim_time, duration, mode, mission_progress)``: times in s."""
 
 
 class LapTimer:
@@ -92,8 +100,9 @@ class Runner:
     out_dir : Path, optional
         Run directory to write; None records in memory only.
     progress : callable, optional
-        ``progress(sim_time, duration, mode, delivered, targets)``, called about four
-        times a second of wall time by :meth:`run`.
+        ``progress(sim_time, duration, mode, mission_progress)``, called about four
+        times a second of wall time by :meth:`run` (``mission_progress`` is the
+        mission's own few words, e.g. ``delivered 1/4``).
 
     Attributes
     ----------
@@ -102,9 +111,11 @@ class Runner:
     status, reason : str or None, str
         How the run ended (``completed``, ``stopped`` or ``failed``) and why; None
         while it goes on.
-    estimate : LocationEstimate or None
-        The localiser's estimate at the current time.
-    mode : Mode or None
+    mission : Mission or None
+        The scenario's mission, from :meth:`open` on.
+    estimate : StateEstimate or None
+        The estimate at the current time (the localiser's, with the attitude sensors').
+    mode : str or None
         The mission mode decided for the current control period.
     outputs : dict of str to object
         The world's outputs (:meth:`World.outputs`) at the current time.
@@ -114,25 +125,25 @@ class Runner:
         self,
         setup: RunSetup,
         out_dir: Path | None = None,
-        progress: Callable[[float, float, str, int, int], None] | None = None,
+        progress: Progress | None = None,
     ) -> None:
         self.setup = setup
         self.scenario = setup.scenario
         self.plugins = setup.plugins
-        self.recorder = Recorder(out_dir)
+        self.mission_class = mission_class(self.scenario.mission.type)
+        self.recorder = Recorder(out_dir, telemetry_columns(self.mission_class.columns))
         self.info = RunInfo(self.scenario, self.scenario.world.seed, out_dir)
         self.progress = progress
         self.world: World | None = None
         self.mission: Mission | None = None
         self.status: str | None = None
         self.reason = ""
-        self.estimate: LocationEstimate | None = None
+        self.estimate: StateEstimate | None = None
         self.outputs: dict[str, Any] = {}
         self.summary: dict[str, Any] = {}
         self.laps = LapTimer()
         self._command = Command()
-        self._cargo: list[int] = []
-        self._targets = 0
+        self._robot_changes = 0
         self._started = 0.0
 
     @property
@@ -141,7 +152,7 @@ class Runner:
         return self.status is not None
 
     @property
-    def mode(self) -> Mode | None:
+    def mode(self) -> str | None:
         """The mission mode decided for the current control period."""
         return None if self.mission is None else self.mission.mode
 
@@ -219,7 +230,12 @@ class Runner:
         if self.info.out_dir is not None:
             self.recorder.write(self.summary, dump_scenario(self.scenario))
             write_plots(
-                self.info.out_dir, self.scenario, self.recorder.telemetry(), self.recorder.events
+                self.info.out_dir,
+                self.scenario,
+                self.recorder.telemetry(),
+                self.recorder.events,
+                self.mission_class.modes,
+                self.mission.safety_distance,
             )
         self._hook("dcsim_run_end", run=self.info, summary=self.summary)
         return self.summary
@@ -245,11 +261,10 @@ class Runner:
     def _start(self) -> None:
         world = self.world
         self._hook("dcsim_run_start", run=self.info)
-        self.mission = Mission(self.scenario, world, self.plugins, self._event)
+        self.mission = self.mission_class(self.scenario, world, self.plugins, self._event)
         call_plugin(self.plugins, "localiser", "reset", self._prior(), 0.0)
         call_plugin(self.plugins, "controller", "reset", world.robot_spec())
-        self._cargo = world.carried_ids()
-        self._targets = int(world.field.is_target.sum())
+        self._robot_changes = world.robot_changes
         self.laps.start()
         self._decide()
 
@@ -257,26 +272,25 @@ class Runner:
         """Sense, localise, run the mission and the controller at the current time."""
         world, laps, plugins = self.world, self.laps, self.plugins
         t = world.time
-        tracks, ranges = world.object_tracks(), world.beacon_ranges()
+        observations = world.observations()
         laps.lap("sensors")
         if t > 0:
             call_plugin(plugins, "localiser", "predict", world.motion_input(), world.control_period)
-        call_plugin(plugins, "localiser", "update", ranges)
-        estimate: LocationEstimate = call_plugin(plugins, "localiser", "estimate")
+        call_plugin(plugins, "localiser", "update", list(observations.ranges))
+        estimate = _with_readings(call_plugin(plugins, "localiser", "estimate"), observations)
         self.estimate = estimate
         laps.lap("localiser")
-        reference = self.mission.tick(t, estimate, tracks)
+        reference = self.mission.tick(t, estimate, observations)
         laps.lap("mission")
-        if world.carried_ids() != self._cargo:  # a grab or a release changed the mass
-            self._cargo = world.carried_ids()
+        if world.robot_changes != self._robot_changes:  # a grab or a release
+            self._robot_changes = world.robot_changes
             call_plugin(plugins, "controller", "reset", world.robot_spec())
-        obstacles = tuple(tr for tr in tracks if tr.kind.value == "obstacle")
-        surroundings = Surroundings(obstacles, self.scenario.mission.safety_distance)
+        surroundings = self.mission.surroundings(observations)
         self._command = call_plugin(
             plugins, "controller", "command", t, estimate, reference, surroundings
         )
         laps.lap("controller")
-        self._record(t, estimate, self.mission.mode.name, self._command.force)
+        self._record(t, estimate, self.mission.mode, self._command.force)
         self._check_stop(t)
         laps.lap("recording")
 
@@ -298,25 +312,23 @@ class Runner:
                 penetration=collision.penetration,
             )
             if self.scenario.stop.on_collision:
-                self._record_final(self.mission.mode.name)
+                self._record_final(self.mission.mode)
                 raise _RunEnded("stopped", f"collision with object {collision.object_id}")
         self._decide()
 
     def _report_progress(self) -> None:
-        world = self.world
         self.progress(
-            world.time,
+            self.world.time,
             self.scenario.world.duration,
-            self.mission.mode.name,
-            world.field.count(ObjectStatus.DELIVERED),
-            self._targets,
+            self.mission.mode,
+            self.mission.progress(),
         )
 
     def _check_stop(self, t: float) -> None:
         stop = self.scenario.stop
-        delivered = self.world.field.count(ObjectStatus.DELIVERED)
-        if stop.on_all_delivered and self._targets and delivered == self._targets:
-            raise _RunEnded("completed", "all targets delivered")
+        finished = self.mission.finished()
+        if finished is not None:
+            raise _RunEnded(*finished)
         if t >= self.scenario.world.duration - 1e-9:
             raise _RunEnded("completed", "duration reached")
         if (
@@ -334,7 +346,7 @@ class Runner:
         return Prior(position, initial.position_sigma, velocity, initial.velocity_sigma)
 
     # ------------------------------------------------------------------ records
-    def _record(self, t: float, estimate: LocationEstimate, mode: str, force: np.ndarray) -> None:
+    def _record(self, t: float, estimate: StateEstimate, mode: str, force: np.ndarray) -> None:
         out = self.outputs = self.world.outputs()
         row: dict[str, Any] = {"time": t}
         row.update(zip(("x", "y", "z"), out["position"], strict=True))
@@ -342,11 +354,9 @@ class Runner:
         row.update(zip(("est_x", "est_y", "est_z"), estimate.position, strict=True))
         row.update(zip(("est_vx", "est_vy", "est_vz"), estimate.velocity, strict=True))
         row.update(zip(("qx", "qy", "qz", "qw"), out["attitude"], strict=True))
+        row.update(mode=mode, converged=int(estimate.converged))
+        row.update(self.mission.telemetry())
         row.update(
-            mode=mode,
-            converged=int(estimate.converged),
-            carried=out["carried"],
-            delivered=out["delivered"],
             fuel_used=out["fuel_used"],
             delta_v=out["delta_v"],
             nearest_obstacle=out["nearest_obstacle_distance"],
@@ -358,7 +368,7 @@ class Runner:
     def _record_final(self, mode: str) -> None:
         """Record the state reached by the last step (the run ends after it)."""
         last = self.recorder.rows[-1]
-        estimate = LocationEstimate(
+        estimate = StateEstimate(
             time=self.world.time,
             position=[last["est_x"], last["est_y"], last["est_z"]],
             velocity=[last["est_vx"], last["est_vy"], last["est_vz"]],
@@ -396,14 +406,12 @@ class Runner:
             "status": self.status,
             "reason": self.reason,
             "scenario": self.scenario.name,
+            "mission": self.mission_class.type,
             "seed": self.scenario.world.seed,
             "sim_time_s": sim_time,
             "wall_time_s": wall,
             "real_time_factor": sim_time / wall if wall > 0 else None,
-            "targets": int(world.field.is_target.sum()),
-            "captured": world.field.count(ObjectStatus.CARRIED)
-            + world.field.count(ObjectStatus.DELIVERED),
-            "delivered": world.field.count(ObjectStatus.DELIVERED),
+            **self.mission.summary_fields(telemetry),
             "collisions": len(world.collisions),
             "fuel_used_kg": world.fuel_used,
             "delta_v_mps": world.delta_v,
@@ -414,18 +422,29 @@ class Runner:
         }
 
 
-def terminal_progress(stream: Any = None) -> Callable[[float, float, str, int, int], None] | None:
+def _with_readings(estimate: StateEstimate, observations: Observations) -> StateEstimate:
+    """The localiser's estimate with the attitude sensors' and encoders' readings."""
+    return dataclasses.replace(
+        estimate,
+        attitude=observations.attitude,
+        angular_velocity=observations.angular_velocity,
+        joint_positions=observations.joint_positions,
+        joint_velocities=observations.joint_velocities,
+    )
+
+
+def terminal_progress(stream: Any = None) -> Progress | None:
     """A progress line for an interactive terminal, or None when output is piped."""
     stream = stream or sys.stderr
     if not stream.isatty():
         return None
 
-    def show(sim_time: float, duration: float, mode: str, delivered: int, targets: int) -> None:
+    def show(sim_time: float, duration: float, mode: str, mission_progress: str) -> None:
         fraction = min(sim_time / duration, 1.0)
         bar = "#" * int(30 * fraction)
         stream.write(
             f"\r[{bar:<30}] {100 * fraction:5.1f}%  t = {sim_time:7.1f} s  "
-            f"{mode:<12}  delivered {delivered}/{targets} "
+            f"{mode:<12}  {mission_progress} "
         )
         stream.flush()
 

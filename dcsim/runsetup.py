@@ -6,7 +6,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from dcsim.interfaces import PLUGIN_KINDS, Plugin
+from dcsim.interfaces import Plugin
 from dcsim.registry import PluginRegistry, RegisteredPlugin
 from dcsim.scenario import Scenario, load_scenario
 from dcsim.seeding import component_rng
@@ -21,8 +21,9 @@ class RunSetup:
     scenario : Scenario
         The resolved scenario (plugin parameters with defaults filled in).
     plugins : dict of str to Plugin
-        The constructed plugin of each role (``localiser``, ``task_planner``,
-        ``path_planner``, ``controller``), each with its own random generator.
+        The constructed plugin of each role the scenario's mission uses (``localiser``,
+        ``task_planner``, ``path_planner``, ``controller``), each with its own random
+        generator.
     sources : dict of str to RegisteredPlugin
         Where each role's plugin came from.
     registry : PluginRegistry
@@ -89,7 +90,10 @@ def build_run(scenario: Scenario, registry: PluginRegistry) -> RunSetup:
     PluginError
         If a plugin is unknown or its parameters are invalid.
     """
-    sources = {role: registry.get(role, getattr(scenario, role).plugin) for role in PLUGIN_KINDS}
+    from dcsim.missions import mission_class  # missions load the world engine
+
+    roles = mission_class(scenario.mission.type).roles
+    sources = {role: registry.get(role, getattr(scenario, role).plugin) for role in roles}
     plugins = {
         role: entry.cls(getattr(scenario, role).params, component_rng(scenario.world.seed, role))
         for role, entry in sources.items()

@@ -1,6 +1,7 @@
 """dcsim's built-in plugins, registered through the ``dcsim`` entry-point group.
 
-Each module implements one plugin with dcsim's public API (:mod:`dcsim.api`) only, and
-exposes it through the ``dcsim_plugin_classes`` hook, exactly as a third-party
-package would.
+One subpackage per kind (``localisers``, ``task_planners``, ``path_planners``,
+``controllers``). Each plugin module uses dcsim's public API (:mod:`dcsim.api`) only
+and exposes its class through the ``dcsim_plugin_classes`` hook, exactly as a
+third-party package would.
 """

@@ -1,4 +1,4 @@
-"""Messages: immutability, value equality, shapes, and the Move conversion."""
+"""Messages: immutability, value equality, shapes, and the general state contracts."""
 
 from __future__ import annotations
 
@@ -6,15 +6,21 @@ import dataclasses
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation, Slerp
 
 from dcsim.api import (
     BeaconRange,
     Command,
+    GoalRegion,
     LinearMotion,
-    LocationEstimate,
-    MoveCommand,
     ObjectKind,
     ObjectTrack,
+    Reference,
+    RobotSpec,
+    RobotState,
+    Shape,
+    ShapeKind,
+    StateEstimate,
     Trajectory,
     quaternion_between,
     rotate,
@@ -39,8 +45,12 @@ def test_messages_copy_their_inputs_and_compare_by_value():
 
 
 def test_shapes_are_checked():
-    with pytest.raises(ValueError, match=r"covariance must have shape \(6, 6\)"):
-        LocationEstimate(time=0.0, position=[0, 0, 0], covariance=np.eye(3))
+    with pytest.raises(ValueError, match=r"covariance must have shape \(-1, -1\)"):
+        StateEstimate(time=0.0, position=[0, 0, 0], covariance=np.ones(6))
+    with pytest.raises(ValueError, match="covariance must be square, got 3×4"):
+        StateEstimate(time=0.0, position=[0, 0, 0], covariance=np.ones((3, 4)))
+    with pytest.raises(ValueError, match=r"force must have shape \(3,\)"):
+        Command(force=[1.0, 2.0])
 
 
 def test_track_prediction_uses_its_motion_or_constant_velocity():
@@ -66,21 +76,6 @@ def test_quaternion_between_rotates_a_onto_b(a, b):
     np.testing.assert_allclose(rotated, np.asarray(b, float) / np.linalg.norm(b), atol=1e-12)
 
 
-def test_move_command_converts_to_a_force_within_the_limit():
-    heading = [1.0, 0.0, 0.0]
-    move = MoveCommand(rotation=quaternion_between(heading, [0, 1, 0]), speed=0.5)
-    np.testing.assert_allclose(move.desired_velocity(heading), [0.0, 0.5, 0.0], atol=1e-12)
-    gentle = move.to_command(
-        heading, velocity=[0, 0.4, 0], mass=100.0, max_force=50.0, response_time=2.0
-    )
-    np.testing.assert_allclose(gentle.force, [0.0, 5.0, 0.0], atol=1e-9)
-    hard = move.to_command(
-        heading, velocity=[0, -1, 0], mass=100.0, max_force=10.0, response_time=1.0
-    )
-    assert np.linalg.norm(hard.force) == pytest.approx(10.0)
-    assert hard.force[1] > 0
-
-
 def test_trajectory_samples_linearly_and_holds_at_the_ends():
     trajectory = Trajectory(
         times=[0, 10], positions=[[0, 0, 0], [10, 0, 0]], velocities=[[2, 0, 0], [0, 0, 0]]
@@ -91,3 +86,115 @@ def test_trajectory_samples_linearly_and_holds_at_the_ends():
     position, velocity = trajectory.sample(20.0)
     np.testing.assert_allclose(position, [10, 0, 0])
     np.testing.assert_allclose(velocity, [0, 0, 0])
+
+
+def test_robot_state_checks_its_attitude_and_joints():
+    state = RobotState(
+        time=1.0,
+        position=[1, 2, 3],
+        velocity=[0.1, 0.2, 0.3],
+        angular_velocity=[0.01, 0.02, 0.03],
+        joint_positions=[0.5, -0.5],
+        joint_velocities=[1.0, 2.0],
+    )
+    np.testing.assert_array_equal(
+        state.generalised_velocity, [0.1, 0.2, 0.3, 0.01, 0.02, 0.03, 1.0, 2.0]
+    )
+    assert RobotState().joint_positions.shape == (0,)
+    with pytest.raises(ValueError, match="attitude must be a unit quaternion, its norm is 2"):
+        RobotState(attitude=[0, 0, 0, 2])
+    with pytest.raises(ValueError, match="2 joint positions but 1 joint velocities"):
+        RobotState(joint_positions=[0.0, 0.0], joint_velocities=[0.0])
+
+
+def test_an_estimate_is_a_robot_state_with_covariance():
+    estimate = StateEstimate(time=2.0, position=[1, 0, 0], converged=True)
+    assert isinstance(estimate, RobotState)
+    np.testing.assert_array_equal(estimate.covariance, np.eye(6))
+    np.testing.assert_array_equal(estimate.attitude, [0, 0, 0, 1])
+
+
+def test_reference_attitude_is_optional_and_command_carries_joint_torques():
+    free = Reference(time=0.0, position=[0, 0, 0])
+    assert free.attitude is None
+    held = Reference(time=0.0, position=[0, 0, 0], attitude=[0, 0, 1, 0])
+    np.testing.assert_array_equal(held.attitude, [0, 0, 1, 0])
+    assert held != free
+    with pytest.raises(ValueError, match=r"attitude must have shape \(4,\)"):
+        Reference(time=0.0, position=[0, 0, 0], attitude=[0, 0, 1])
+    command = Command(joint_torques=[1.0, -2.0, 3.0])
+    assert command.joint_torques.shape == (3,)
+    assert Command().joint_torques.shape == (0,)
+
+
+def test_robot_spec_holds_inertia_and_joint_limits():
+    spec = RobotSpec(mass=10.0, inertia=np.diag([1.0, 2.0, 3.0]), radius=1.0)
+    assert spec.joint_position_limits.shape == (0, 2)
+    assert spec.model is None
+    with pytest.raises(ValueError, match=r"inertia must have shape \(3, 3\)"):
+        RobotSpec(mass=10.0, inertia=[1.0, 2.0, 3.0])
+
+
+def test_shapes_know_their_bounding_radius_and_tracks_default_to_spheres():
+    box = Shape(ShapeKind.BOX, half_extents=[1.0, 2.0, 2.0])
+    assert box.bounding_radius == pytest.approx(3.0)
+    cylinder = Shape(ShapeKind.CYLINDER, radius=3.0, height=8.0)
+    assert cylinder.bounding_radius == pytest.approx(5.0)
+    track = ObjectTrack(1, ObjectKind.OBSTACLE, 0.0, [0, 0, 0], [0, 0, 0], radius=2.0)
+    assert track.shape == Shape(ShapeKind.SPHERE, radius=2.0)
+    boxed = ObjectTrack(2, ObjectKind.OBSTACLE, 0.0, [0, 0, 0], [0, 0, 0], shape=box)
+    assert boxed.radius == pytest.approx(3.0)
+
+
+def test_trajectory_attitude_follows_scipy_slerp():
+    times = np.array([0.0, 2.0, 5.0])
+    rotations = Rotation.from_euler(
+        "xyz", [[0, 0, 0], [40, -30, 120], [170, 10, -60]], degrees=True
+    )
+    trajectory = Trajectory(
+        times=times,
+        positions=np.zeros((3, 3)),
+        velocities=np.zeros((3, 3)),
+        attitudes=rotations.as_quat(),
+    )
+    reference = Slerp(times, rotations)
+    for t in np.linspace(0.0, 5.0, 23):
+        ours = Rotation.from_quat(trajectory.state_at(t).attitude)
+        assert (ours * reference(t).inv()).magnitude() < 1e-9, t
+    np.testing.assert_allclose(trajectory.attitude_at(-1.0), rotations[0].as_quat())
+    np.testing.assert_allclose(trajectory.attitude_at(9.0), rotations[2].as_quat())
+
+
+def test_trajectory_rows_must_match_its_times():
+    with pytest.raises(ValueError, match="forces has 3 rows, expected 2 for 3 times"):
+        Trajectory(
+            times=[0, 1, 2],
+            positions=np.zeros((3, 3)),
+            velocities=np.zeros((3, 3)),
+            forces=np.zeros((3, 3)),
+        )
+    free = Trajectory(times=[0, 1], positions=np.zeros((2, 3)), velocities=np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="leaves the attitude free"):
+        free.attitude_at(0.5)
+    np.testing.assert_array_equal(free.state_at(0.5).attitude, [0, 0, 0, 1])
+
+
+def test_goal_regions_check_position_velocity_time_and_attitude():
+    sphere = GoalRegion(position=[10, 0, 0], tolerance=1.0)
+    assert sphere.contains(RobotState(position=[10.5, 0.5, 0]))
+    assert not sphere.contains(RobotState(position=[11.5, 0, 0]))
+    box = GoalRegion(position=[0, 0, 0], half_extents=[1.0, 2.0, 3.0])
+    assert box.contains(RobotState(position=[0.9, -1.9, 2.9]))
+    assert not box.contains(RobotState(position=[1.1, 0, 0]))
+    slow = GoalRegion(position=[0, 0, 0], tolerance=1.0, velocity_tolerance=0.1)
+    assert not slow.contains(RobotState(velocity=[0.2, 0, 0]))
+    timed = GoalRegion(position=[0, 0, 0], tolerance=1.0, time=10.0, time_tolerance=1.0)
+    assert timed.contains(RobotState(time=10.5)) and not timed.contains(RobotState(time=12.0))
+    turn = Rotation.from_euler("z", 10, degrees=True).as_quat()
+    pointed = GoalRegion(
+        position=[0, 0, 0], tolerance=1.0, attitude=[0, 0, 0, 1], attitude_tolerance=np.radians(15)
+    )
+    assert pointed.contains(RobotState(attitude=turn))
+    assert pointed.contains(RobotState(attitude=-turn))  # the same attitude
+    tight = dataclasses.replace(pointed, attitude_tolerance=np.radians(5))
+    assert not tight.contains(RobotState(attitude=turn))

@@ -12,7 +12,7 @@ import types
 
 import numpy as np
 import pytest
-from dcsim_plugins.trilateration import TrilaterationLocaliser
+from dcsim_plugins.localisers.trilateration import TrilaterationLocaliser
 
 from dcsim.api import Command, Controller, PluginParams, PluginRegistry, hookimpl, quantity
 from dcsim.registry import PluginOrigin

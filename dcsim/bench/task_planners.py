@@ -29,7 +29,7 @@ import numpy as np
 from dcsim.api import (
     DropPoint,
     LinearMotion,
-    LocationEstimate,
+    StateEstimate,
     ObjectKind,
     ObjectTrack,
     Plan,
@@ -85,7 +85,7 @@ def random_request(
         )
     return TaskRequest(
         time=0.0,
-        robot=LocationEstimate(time=0.0, position=[0.0, 0.0, 0.0], converged=True),
+        robot=StateEstimate(time=0.0, position=[0.0, 0.0, 0.0], converged=True),
         targets=tuple(tracks),
         drop_point=DropPoint(StaticMotion(rng.uniform(-DROP_AREA, DROP_AREA, 3)), tolerance=1.0),
         capacity=CAPACITY,

@@ -305,7 +305,7 @@ class ClosedLoopSlave(_ScenarioSlave):
 
     def _publish_more(self, out: dict[str, Any]) -> None:
         runner, values = self.runner, self.values
-        values["mode"] = int(runner.mode)
+        values["mode"] = runner.mission_class.modes.index(runner.mode)
         values["captured"] = int(out["captured"])
         values["delivered"] = int(out["delivered"])
         values["localisation_error"] = float(

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from dcsim.mission import Mode
+from dcsim.missions import DebrisMission
 
 AXES = ("x", "y", "z")
 QUATERNION = ("x", "y", "z", "w")
@@ -66,14 +66,16 @@ _STATE = [
     *_vector("angular_velocity", "output", "rad/s", "Collector angular velocity (true)."),
 ]
 
-_MODES = ", ".join(f"{mode.value} {mode.name}" for mode in Mode)
+_MODES = ", ".join(f"{index} {mode}" for index, mode in enumerate(DebrisMission.modes))
 
 CLOSED_LOOP = [
     *PARAMETERS,
     *_vector("disturbance_force", "input", "N", "External force on the collector."),
     *_vector("disturbance_torque", "input", "N.m", "External torque on the collector."),
     *_STATE,
-    FmuVariable("mode", "output", int, "", f"Mission mode: {_MODES}."),
+    FmuVariable(
+        "mode", "output", int, "", f"Mission mode, its index in the mission's modes (debris: {_MODES})."
+    ),
     FmuVariable("captured", "output", int, "", "Targets grabbed so far (carried or delivered)."),
     FmuVariable("delivered", "output", int, "", "Targets delivered to the drop point."),
     FmuVariable("collisions", "output", int, "", "Collisions so far."),

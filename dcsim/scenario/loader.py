@@ -24,11 +24,10 @@ import yaml
 from pydantic import BaseModel, ValidationError
 
 from dcsim.errors import DcsimError, PluginParameterError, Problem, ScenarioError
-from dcsim.interfaces import PLUGIN_KINDS
 from dcsim.params import describe_error
 from dcsim.registry import PluginRegistry
 from dcsim.scenario.document import KeyPath, ScenarioDocument
-from dcsim.scenario.model import CWMotionSpec, Scenario
+from dcsim.scenario.model import CWMotionSpec, Scenario, scenario_model
 
 DEFAULT_SCENARIO = "default.yaml"
 
@@ -84,10 +83,11 @@ def validate(doc: ScenarioDocument) -> Scenario:
     ScenarioError
         With one problem per invalid value.
     """
+    model = _scenario_model(doc)
     try:
-        scenario = Scenario.model_validate(doc.data)
+        scenario = model.model_validate(doc.data)
     except ValidationError as exc:
-        raise ScenarioError(doc.filename, _schema_problems(doc, exc)) from None
+        raise ScenarioError(doc.filename, _schema_problems(doc, exc, model)) from None
     problems = [doc.problem(path, message) for path, message in _rule_violations(scenario)]
     if problems:
         raise ScenarioError(doc.filename, problems)
@@ -104,9 +104,12 @@ def resolve_plugins(
     ScenarioError
         For unknown or ambiguous plugin names and invalid parameters.
     """
+    from dcsim.missions import mission_class  # missions load the world engine
+
     problems: list[Problem] = []
     resolved: dict[str, Any] = {}
-    for role in PLUGIN_KINDS:
+    robot = scenario.robot.type
+    for role in mission_class(scenario.mission.type).roles:
         choice = getattr(scenario, role)
         try:
             cls = registry.get(role, choice.plugin).cls
@@ -116,6 +119,15 @@ def resolve_plugins(
             continue
         except DcsimError as exc:
             problems.append(doc.problem((role, "plugin"), str(exc)))
+            continue
+        if robot not in cls.robots:
+            problems.append(
+                doc.problem(
+                    (role, "plugin"),
+                    f"{role} plugin '{choice.plugin}' does not support robot type '{robot}' "
+                    f"(it supports: {', '.join(cls.robots)})",
+                )
+            )
             continue
         resolved[role] = choice.model_copy(update={"params": params.model_dump(mode="json")})
     if problems:
@@ -148,14 +160,7 @@ def _rule_violations(scenario: Scenario) -> list[tuple[KeyPath, str]]:
                 f"{robot.propellant_mass:g} kg must be less than robot.mass ({robot.mass:g} kg)",
             )
         )
-    if scenario.mission.reach > robot.grab_distance:
-        found.append(
-            (
-                ("mission", "reach"),
-                f"{scenario.mission.reach:g} m is beyond robot.grab_distance "
-                f"({robot.grab_distance:g} m)",
-            )
-        )
+    found += scenario.mission.violations(scenario)
     if sum(q * q for q in robot.initial.attitude) < 1e-12:
         found.append((("robot", "initial", "attitude"), "the quaternion must not be zero"))
     owners: dict[int, str] = {}
@@ -182,11 +187,39 @@ def _rule_violations(scenario: Scenario) -> list[tuple[KeyPath, str]]:
     return found
 
 
-def _schema_problems(doc: ScenarioDocument, exc: ValidationError) -> list[Problem]:
+def _scenario_model(doc: ScenarioDocument) -> type[Scenario]:
+    """The scenario model of the document's ``mission.type`` (``debris`` if absent).
+
+    Raises
+    ------
+    ScenarioError
+        If no mission has that type.
+    """
+    from dcsim.missions import mission_types  # missions load the world engine
+
+    section = doc.data.get("mission") if isinstance(doc.data, dict) else None
+    mission_type = section.get("type", "debris") if isinstance(section, dict) else "debris"
+    missions = mission_types()
+    if not isinstance(mission_type, str) or mission_type not in missions:
+        known = ", ".join(sorted(missions))
+        raise ScenarioError(
+            doc.filename,
+            [
+                doc.problem(
+                    ("mission", "type"), f"unknown mission type {mission_type!r}; known: {known}"
+                )
+            ],
+        )
+    return scenario_model(missions[mission_type].Settings)
+
+
+def _schema_problems(
+    doc: ScenarioDocument, exc: ValidationError, model: type[Scenario]
+) -> list[Problem]:
     """Turn pydantic errors into problems located at their keys in the document."""
     messages: dict[KeyPath, list[str]] = {}
     for err in exc.errors():
-        path, owner, field = _locate(doc.data, err["loc"])
+        path, owner, field = _locate(doc.data, err["loc"], model)
         exact = bool(err["loc"]) and path[-1:] == (err["loc"][-1],)
         if exact:
             message = describe_error(owner, field, err)
@@ -201,14 +234,16 @@ def _schema_problems(doc: ScenarioDocument, exc: ValidationError) -> list[Proble
     return sorted(found, key=lambda p: (p.line is None, p.line or 0, p.column or 0))
 
 
-def _locate(data: Any, loc: tuple[Any, ...]) -> tuple[KeyPath, type[BaseModel] | None, str | None]:
-    """Follow a pydantic error location through the data and the schema.
+def _locate(
+    data: Any, loc: tuple[Any, ...], root: type[BaseModel]
+) -> tuple[KeyPath, type[BaseModel] | None, str | None]:
+    """Follow a pydantic error location through the data and the schema from ``root``.
 
     Returns the key path in the document (union tags skipped), the model owning the
     last key and that key's name.
     """
     path: list[str | int] = []
-    model: type[BaseModel] | None = Scenario
+    model: type[BaseModel] | None = root
     owner: type[BaseModel] | None = None
     field: str | None = None
     for position, item in enumerate(loc):

@@ -7,10 +7,11 @@ Unknown keys are errors. docs/scenarios.md is generated from these models.
 
 from __future__ import annotations
 
+import functools
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, create_model
 
 from dcsim.geometry import Vector, spherical_to_cartesian
 from dcsim.motion import (
@@ -182,8 +183,11 @@ class InitialStateSpec(Section):
 
 
 class RobotSection(Section):
-    """The debris collector: mass, limits, sensors, grabber."""
+    """The robot: a free flyer (the debris collector) with mass, limits, sensors, grabber."""
 
+    type: Literal["free-flyer"] = Field(
+        "free-flyer", description="The robot type: `free-flyer`, a rigid body with thrusters."
+    )
     mass: float = quantity(100.0, unit="kg", gt=0, description="Initial mass, propellant included.")
     propellant_mass: float = quantity(
         10.0, unit="kg", ge=0, description="Usable propellant (part of mass)."
@@ -264,8 +268,22 @@ class PluginChoice(Section):
     )
 
 
-class MissionSection(Section):
+class MissionSettings(Section):
+    """Base of every mission type's section: ``type`` selects the mission."""
+
+    type: str = Field("debris", description="The mission type (`debris`).")
+
+    def violations(self, scenario: Scenario) -> list[tuple[tuple[str | int, ...], str]]:
+        """Rules between this section and the rest of ``scenario``, as (key path, message)."""
+        return []
+
+
+class DebrisMissionSection(MissionSettings):
     """How the executer flies the debris-collection mission (the thesis's §5.2 and §5.4)."""
+
+    type: Literal["debris"] = Field(
+        "debris", description="The mission type: debris collection (the source thesis)."
+    )
 
     reach: float = quantity(
         0.5,
@@ -314,6 +332,18 @@ class MissionSection(Section):
         description="Fraction of the drop tolerance within which the collector releases its cargo.",
     )
 
+    def violations(self, scenario: Scenario) -> list[tuple[tuple[str | int, ...], str]]:
+        """REACH must be within the grab distance."""
+        grab_distance = scenario.robot.grab_distance
+        if self.reach > grab_distance:
+            return [
+                (
+                    ("mission", "reach"),
+                    f"{self.reach:g} m is beyond robot.grab_distance ({grab_distance:g} m)",
+                )
+            ]
+        return []
+
 
 class StopSection(Section):
     """When a run ends before ``world.duration``."""
@@ -357,8 +387,9 @@ class Scenario(Section):
     controller: PluginChoice = Field(
         default_factory=lambda: PluginChoice(plugin="pd"), description="Controller plugin."
     )
-    mission: MissionSection = Field(
-        default_factory=MissionSection, description="Executer settings."
+    mission: DebrisMissionSection = Field(
+        default_factory=DebrisMissionSection,
+        description="The mission and its settings; `type` selects it (default `debris`).",
     )
     stop: StopSection = Field(default_factory=StopSection, description="Stop rules.")
 
@@ -366,3 +397,22 @@ class Scenario(Section):
     def mean_motion(self) -> float:
         """Mean motion of the reference orbit, rad/s (used by ``cw`` motions)."""
         return self.world.orbit.mean_motion
+
+
+@functools.cache
+def scenario_model(settings: type[MissionSettings]) -> type[Scenario]:
+    """The scenario model whose ``mission`` section is ``settings``.
+
+    Parameters
+    ----------
+    settings : type of MissionSettings
+        A mission type's section (``DebrisMissionSection`` gives :class:`Scenario`).
+    """
+    if settings is DebrisMissionSection:
+        return Scenario
+    return create_model(
+        "Scenario",
+        __base__=Scenario,
+        __doc__=Scenario.__doc__,
+        mission=(settings, Field(description="The mission and its settings.")),
+    )

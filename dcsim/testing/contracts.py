@@ -23,7 +23,7 @@ from dcsim.errors import PluginInterfaceError, PluginParameterError
 from dcsim.interfaces import PLUGIN_KINDS, Controller, Localiser, Plugin
 from dcsim.messages import (
     Command,
-    LocationEstimate,
+    StateEstimate,
     NoPath,
     Plan,
     Reference,
@@ -139,7 +139,7 @@ def _controller_inputs(empty: bool) -> list:
     ticks = []
     for k in range(20):
         t = 0.1 * k
-        estimate = LocationEstimate(
+        estimate = StateEstimate(
             time=t, position=rng.normal(0, 10, 3), velocity=rng.normal(0, 0.2, 3), converged=True
         )
         reference = Reference(time=t, position=rng.normal(0, 10, 3), velocity=rng.normal(0, 0.1, 3))
@@ -327,7 +327,7 @@ def check_no_mutation(plugin_class: type[Plugin]) -> None:
 def _check_output(kind: str, output: Any) -> str | None:
     """Why an output is not of the documented type, shape and finiteness (None if fine)."""
     expected = {
-        "localiser": (LocationEstimate,),
+        "localiser": (StateEstimate,),
         "task_planner": (Plan,),
         "path_planner": (Trajectory, NoPath),
         "controller": (Command,),
@@ -352,8 +352,12 @@ def _check_output(kind: str, output: Any) -> str | None:
     ]
     if not all(np.all(np.isfinite(n)) for n in numbers):
         return f"returned non-finite values: {output!r}"
-    if isinstance(output, LocationEstimate) and abs(np.linalg.norm(output.heading) - 1.0) > 1e-6:
-        return f"heading {output.heading} is not a unit vector"
+    if isinstance(output, StateEstimate):
+        covariance = output.covariance
+        if covariance.shape[0] != covariance.shape[1] or not np.allclose(
+            covariance, covariance.T, rtol=1e-9, atol=1e-12
+        ):
+            return f"covariance is not a symmetric square matrix: {covariance!r}"
     if isinstance(output, Trajectory) and (
         len(output.times) < 2 or np.any(np.diff(output.times) <= 0)
     ):

@@ -7,7 +7,7 @@ import time
 import numpy as np
 
 from dcsim.interfaces import Plugin
-from dcsim.messages import LocationEstimate, NoPath, Reference, Surroundings, Trajectory
+from dcsim.messages import StateEstimate, NoPath, Reference, Surroundings, Trajectory
 from dcsim.testing import problems
 from dcsim.testing.contracts import (
     LOCALISER_ERROR_BOUND,
@@ -22,7 +22,7 @@ from dcsim.testing.contracts import (
 # --------------------------------------------------------------------- localiser
 
 
-def _localise(plugin_class: type[Plugin]) -> tuple[list[LocationEstimate], problems.BeaconProblem]:
+def _localise(plugin_class: type[Plugin]) -> tuple[list[StateEstimate], problems.BeaconProblem]:
     problem = problems.beacon_problem()
     inputs = [
         problem.prior,
@@ -312,7 +312,7 @@ def check_command_limits(plugin_class: type[Plugin]) -> None:
 )
 def check_rest(plugin_class: type[Plugin]) -> None:
     robot = problems.ROBOT
-    estimate = LocationEstimate(time=0.0, position=[3.0, -4.0, 5.0], converged=True)
+    estimate = StateEstimate(time=0.0, position=[3.0, -4.0, 5.0], converged=True)
     reference = Reference(time=0.0, position=[3.0, -4.0, 5.0])
     inputs = [robot, [(0.0, estimate, reference, Surroundings())]]
     command = run_plugin(plugin_class, inputs, "a collector at rest on its reference")[0]
@@ -336,7 +336,7 @@ def check_double_integrator(plugin_class: type[Plugin]) -> None:
     position, velocity = np.array([10.0, -5.0, 3.0]), np.zeros(3)
     reference = Reference(time=0.0, position=[0.0, 0.0, 0.0])
     for k in range(10_000):
-        estimate = LocationEstimate(
+        estimate = StateEstimate(
             time=k * dt, position=position, velocity=velocity, converged=True
         )
         force = plugin.command(k * dt, estimate, reference, Surroundings()).force

@@ -16,14 +16,14 @@ from dcsim.messages import (
     Bounds,
     DropPoint,
     GoalRegion,
-    LocationEstimate,
     MotionInput,
     ObjectKind,
     ObjectTrack,
     PathProblem,
-    PathState,
     Prior,
     RobotSpec,
+    RobotState,
+    StateEstimate,
     TaskRequest,
 )
 from dcsim.motion import LinearMotion, StaticMotion
@@ -39,7 +39,9 @@ BEACONS = np.array(
 )
 """Beacon positions of the standard beacon problem, m."""
 
-ROBOT = RobotSpec(mass=100.0, radius=0.5, max_force=5.0, max_torque=0.5, max_speed=0.5)
+ROBOT = RobotSpec(
+    mass=100.0, inertia=10.0 * np.eye(3), radius=0.5, max_force=5.0, max_torque=0.5, max_speed=0.5
+)
 """The collector of the controller and planner problems."""
 
 
@@ -165,7 +167,7 @@ def task_request(targets: int = 6, time_budget: float = 1.0, capacity: int = 2) 
     )
     return TaskRequest(
         time=100.0,
-        robot=LocationEstimate(time=100.0, position=[0.0, 0.0, 0.0], converged=True),
+        robot=StateEstimate(time=100.0, position=[0.0, 0.0, 0.0], converged=True),
         targets=tracks,
         drop_point=DropPoint(StaticMotion((-5.0, 0.0, 0.0)), tolerance=1.5),
         capacity=capacity,
@@ -179,7 +181,7 @@ def task_request(targets: int = 6, time_budget: float = 1.0, capacity: int = 2) 
 def path_problem(time_budget: float = 1.0) -> PathProblem:
     """The standard path problem: 40 m across a box, obstacles near but off the direct line."""
     return PathProblem(
-        start=PathState(time=0.0, position=[0.0, 0.0, 0.0]),
+        start=RobotState(time=0.0, position=[0.0, 0.0, 0.0]),
         goal=GoalRegion(position=[40.0, 5.0, 0.0], tolerance=1.0),
         obstacles=(
             obstacle_track(1, (20.0, 12.0, 0.0), radius=2.0),

@@ -29,7 +29,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from dcsim.geometry import clip_norm
-from dcsim.messages import BeaconRange, DropPoint, MotionInput, ObjectKind, ObjectTrack, RobotSpec
+from dcsim.messages import (
+    BeaconRange,
+    DropPoint,
+    MotionInput,
+    ObjectKind,
+    ObjectTrack,
+    Observations,
+    RobotSpec,
+)
 from dcsim.scenario.model import Scenario, point_to_cartesian
 from dcsim.world.objects import ObjectField, ObjectStatus, SpaceObject
 from dcsim.world.pybullet_client import connect_direct, pb
@@ -141,6 +149,9 @@ class World:
         Propellant used (kg) and delta-v accumulated (m/s).
     collisions : list of CollisionEvent
         Every collision so far.
+    robot_changes : int
+        How many times the robot's mass or shape changed by a grab or a release (its
+        :meth:`robot_spec` is then new).
     """
 
     def __init__(self, scenario: Scenario, rng: np.random.Generator) -> None:
@@ -175,6 +186,7 @@ class World:
         self._bodies = [self._create_object_body(i) for i in range(len(self.field))]
         self._carried: dict[int, tuple[int, int]] = {}  # object index -> (body, constraint)
         self._protrusion = 0.0  # m, see cargo_protrusion
+        self.robot_changes = 0
         self._contacts: set[tuple[int, int]] = set()
         self._candidates = np.zeros(0, dtype=int)
         self._period_mass = self.assembly_mass()
@@ -268,10 +280,21 @@ class World:
         return self.collector_mass() + carried
 
     def robot_spec(self) -> RobotSpec:
-        """The collector's current mass, limits and bounding radius (cargo included)."""
+        """The collector's current mass, inertia, limits and bounding radius (cargo included).
+
+        The inertia is the collector body's own, as PyBullet holds it, about its centre
+        of mass in the body frame.
+        """
         r = self.robot
-        radius = r.radius + self.cargo_protrusion()
-        return RobotSpec(self.assembly_mass(), radius, r.max_force, r.max_torque, r.max_speed)
+        inertia = pb.getDynamicsInfo(self.collector, -1, physicsClientId=self._client)[2]
+        return RobotSpec(
+            mass=self.assembly_mass(),
+            inertia=np.diag(inertia),
+            radius=r.radius + self.cargo_protrusion(),
+            max_force=r.max_force,
+            max_torque=r.max_torque,
+            max_speed=r.max_speed,
+        )
 
     def carried_ids(self) -> list[int]:
         """Ids of the targets on board."""
@@ -542,6 +565,20 @@ class World:
             for obj in (self.field.objects[i],)
         ]
 
+    def observations(self) -> Observations:
+        """Every sensor's reading now: beacon ranges, object tracks, attitude and rate.
+
+        The star tracker and the gyros are noise-free.
+        """
+        _, _, attitude, angular_velocity = self.collector_state()
+        return Observations(
+            time=self.time,
+            ranges=tuple(self.beacon_ranges()),
+            tracks=tuple(self.object_tracks()),
+            attitude=attitude,
+            angular_velocity=angular_velocity,
+        )
+
     def motion_input(self) -> MotionInput:
         """Mean thrust acceleration applied over the last control period."""
         return MotionInput(acceleration=self._last_acceleration)
@@ -602,6 +639,7 @@ class World:
         pb.changeConstraint(constraint, maxForce=_CONSTRAINT_FORCE, physicsClientId=self._client)
         self._carried[index] = (body, constraint)
         self._protrusion = self._measure_protrusion()
+        self.robot_changes += 1
         self._bodies[index] = body
         self.field.status[index] = ObjectStatus.CARRIED
         self._contacts = {pair for pair in self._contacts if pair[0] != index}
@@ -629,6 +667,7 @@ class World:
             delivered.append(self.field.objects[index].id)
         self._carried.clear()
         self._protrusion = 0.0
+        self.robot_changes += 1
         pb.changeDynamics(
             self.collector, -1, mass=self.collector_mass(), physicsClientId=self._client
         )

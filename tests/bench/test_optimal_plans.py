@@ -11,7 +11,7 @@ from dcsim.api import (
     DropPoint,
     DropVisit,
     LinearMotion,
-    LocationEstimate,
+    StateEstimate,
     ObjectKind,
     ObjectTrack,
     Plan,
@@ -34,7 +34,7 @@ def make_request(positions, velocities=None, capacity=2, drop=(-3.0, 1.0, 0.0), 
     )
     return TaskRequest(
         time=0.0,
-        robot=LocationEstimate(time=0.0, position=[0.0, 0.0, 0.0], converged=True),
+        robot=StateEstimate(time=0.0, position=[0.0, 0.0, 0.0], converged=True),
         targets=tracks,
         drop_point=DropPoint(StaticMotion(drop), tolerance=1.0),
         capacity=capacity,

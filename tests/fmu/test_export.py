@@ -11,7 +11,7 @@ from dcsim.errors import ScenarioError
 from dcsim.fmu.export import export_fmu
 from dcsim.fmu.instance import FmuCallError, FmuError, FmuInstance
 from dcsim.fmu.variables import CLOSED_LOOP, plant_variables
-from dcsim.mission import Mode
+from dcsim.missions import DebrisMission
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
 from dcsim.scenario import load_scenario
@@ -54,7 +54,7 @@ def telemetry_row(telemetry: dict[str, np.ndarray], i: int) -> dict[str, float]:
     true = np.array([telemetry[c][i] for c in ("x", "y", "z")])
     estimate = np.array([telemetry[c][i] for c in ("est_x", "est_y", "est_z")])
     row["localisation_error"] = float(np.linalg.norm(true - estimate))
-    row["mode"] = int(Mode[telemetry["mode"][i]])
+    row["mode"] = DebrisMission.modes.index(telemetry["mode"][i])
     return row
 
 
@@ -306,7 +306,7 @@ def _slave_of_default_scenario(tmp_path):
 def test_a_failing_plugin_is_logged_and_refuses_steps_without_raising(
     tmp_path, monkeypatch, fails_at
 ):
-    from dcsim_plugins.pd import PDController
+    from dcsim_plugins.controllers.pd import PDController
 
     original = PDController.command
 

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from dcsim_plugins.fmu_controller import SIGNALS, FmuController, FmuControllerParams
+from dcsim_plugins.controllers.fmu_controller import SIGNALS, FmuController, FmuControllerParams
 
-from dcsim.api import LocationEstimate, Reference, RobotSpec, Surroundings
+from dcsim.api import Reference, RobotSpec, StateEstimate, Surroundings
 from dcsim.errors import PluginParameterError
 from dcsim.registry import PluginRegistry
 from dcsim.runner import Runner
@@ -93,10 +93,10 @@ def test_the_command_is_clipped_and_a_new_run_restarts_the_fmu(example_controlle
     inputs = {n: n for n in SIGNALS if n.startswith(("position", "velocity", "reference"))}
     inputs.update(mass="mass", speed_limit="speed_limit", max_force="mass")
     controller = example_controller({"inputs": inputs, "parameters": {"bandwidth": 5.0}})
-    controller.reset(RobotSpec(mass=100.0, radius=0.5, max_force=5.0, max_torque=0.5,
+    controller.reset(RobotSpec(mass=100.0, inertia=10.0 * np.eye(3), radius=0.5, max_force=5.0, max_torque=0.5,
                                max_speed=0.5))  # fmt: skip
     far = Reference(time=0.0, position=[100.0, 0.0, 0.0])
-    here = LocationEstimate(time=0.0, position=[0.0, 0.0, 0.0], velocity=[0.0, 0.0, 0.0])
+    here = StateEstimate(time=0.0, position=[0.0, 0.0, 0.0], velocity=[0.0, 0.0, 0.0])
     forces = [controller.command(0.1 * k, here, far, Surroundings(())).force for k in range(3)]
     assert [np.linalg.norm(f) for f in forces] == pytest.approx([5.0] * 3)
     restarted = controller.command(0.0, here, far, Surroundings(()))  # a new run

@@ -6,8 +6,9 @@ import textwrap
 
 import numpy as np
 import pytest
-from dcsim_plugins.elastic import (
+from dcsim_plugins.controllers.elastic import (
     ElasticController,
+    MoveCommand,
     braking_limit,
     early_dodge,
     perpendicular_repulsion,
@@ -16,19 +17,22 @@ from dcsim_plugins.elastic import (
 
 from dcsim.api import (
     LinearMotion,
-    LocationEstimate,
     ObjectKind,
     ObjectTrack,
     Reference,
     RobotSpec,
+    StateEstimate,
     Surroundings,
+    quaternion_between,
     rotate,
     unit,
 )
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
 
-ROBOT = RobotSpec(mass=100.0, radius=0.5, max_force=5.0, max_torque=0.5, max_speed=0.5)
+ROBOT = RobotSpec(
+    mass=100.0, inertia=10.0 * np.eye(3), radius=0.5, max_force=5.0, max_torque=0.5, max_speed=0.5
+)
 
 
 def controller(**params):
@@ -50,7 +54,7 @@ def obstacle(position, velocity=(0.0, 0.0, 0.0), radius=1.0, obstacle_id=9):
 
 
 def at(position, velocity=(0.0, 0.0, 0.0)):
-    return LocationEstimate(time=0.0, position=position, velocity=velocity, converged=True)
+    return StateEstimate(time=0.0, position=position, velocity=velocity, converged=True)
 
 
 # --------------------------------------------------------------------- equations
@@ -267,3 +271,18 @@ def test_elastic_flies_round_what_pd_flies_into(tmp_path, case, obstacle_at, obs
     assert elastic["collisions"] == 0, case
     assert elastic["delivered"] == 1, case
     assert elastic["min_obstacle_distance_m"] > 0.5, case
+
+
+def test_move_command_converts_to_a_force_within_the_limit():
+    heading = [1.0, 0.0, 0.0]
+    move = MoveCommand(rotation=quaternion_between(heading, [0, 1, 0]), speed=0.5)
+    np.testing.assert_allclose(move.desired_velocity(heading), [0.0, 0.5, 0.0], atol=1e-12)
+    gentle = move.to_command(
+        heading, velocity=[0, 0.4, 0], mass=100.0, max_force=50.0, response_time=2.0
+    )
+    np.testing.assert_allclose(gentle.force, [0.0, 5.0, 0.0], atol=1e-9)
+    hard = move.to_command(
+        heading, velocity=[0, -1, 0], mass=100.0, max_force=10.0, response_time=1.0
+    )
+    assert np.linalg.norm(hard.force) == pytest.approx(10.0)
+    assert hard.force[1] > 0

@@ -6,8 +6,8 @@ import dataclasses
 
 import numpy as np
 import pytest
-from dcsim_plugins.ga import GeneticTaskPlanner
-from dcsim_plugins.ga_population import (
+from dcsim_plugins.task_planners.ga import GeneticTaskPlanner
+from dcsim_plugins.task_planners.ga_population import (
     Population,
     evaluate,
     greedy_crossover,
@@ -16,12 +16,12 @@ from dcsim_plugins.ga_population import (
     repair_runs,
     swap_mutation,
 )
-from dcsim_plugins.ga_problem import PlanModel, TaskProblem
+from dcsim_plugins.task_planners.ga_problem import PlanModel, TaskProblem
 
 from dcsim.api import (
     DropPoint,
     LinearMotion,
-    LocationEstimate,
+    StateEstimate,
     ObjectKind,
     ObjectTrack,
     StaticMotion,
@@ -56,7 +56,7 @@ def track(target_id, position, velocity=(0.0, 0.0, 0.0)):
 def request(targets, capacity=2, carried=0, budget=1.0):
     return TaskRequest(
         time=0.0,
-        robot=LocationEstimate(time=0.0, position=[0.0, 0.0, 0.0], converged=True),
+        robot=StateEstimate(time=0.0, position=[0.0, 0.0, 0.0], converged=True),
         targets=tuple(targets),
         drop_point=DropPoint(StaticMotion((-5.0, 0.0, 0.0)), tolerance=1.0),
         capacity=capacity,

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from dcsim_plugins.ekf import EKFLocaliser
-from dcsim_plugins.sspf import ScatteredParticleLocaliser, SSPFParams, thesis_probability
-from dcsim_plugins.ukf import UKFLocaliser
+from dcsim_plugins.localisers.ekf import EKFLocaliser
+from dcsim_plugins.localisers.sspf import ScatteredParticleLocaliser, SSPFParams, thesis_probability
+from dcsim_plugins.localisers.ukf import UKFLocaliser
 
 from dcsim.api import BeaconRange, MotionInput, Prior
 from dcsim.testing import problems

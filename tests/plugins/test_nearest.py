@@ -6,12 +6,12 @@ import dataclasses
 
 import numpy as np
 import pytest
-from dcsim_plugins.nearest import NearestTaskPlanner
+from dcsim_plugins.task_planners.nearest import NearestTaskPlanner
 
 from dcsim.api import (
     DropPoint,
     LinearMotion,
-    LocationEstimate,
+    StateEstimate,
     ObjectKind,
     ObjectTrack,
     StaticMotion,
@@ -30,7 +30,7 @@ def track(target_id, position, velocity=(0, 0, 0), time=0.0):
 def request(targets, capacity=3, carried=0, time=0.0, speed=1.0, drop=(0.0, 0.0, 0.0)):
     return TaskRequest(
         time=time,
-        robot=LocationEstimate(time=time, position=[0, 0, 0], converged=True),
+        robot=StateEstimate(time=time, position=[0, 0, 0], converged=True),
         targets=tuple(targets),
         drop_point=DropPoint(StaticMotion(drop), tolerance=1.0),
         capacity=capacity,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from dcsim_plugins.straight_line import StraightLinePlanner
+from dcsim_plugins.path_planners.straight_line import StraightLinePlanner
 
 from dcsim.api import (
     Bounds,
@@ -14,7 +14,7 @@ from dcsim.api import (
     ObjectKind,
     ObjectTrack,
     PathProblem,
-    PathState,
+    RobotState,
     Trajectory,
 )
 
@@ -33,7 +33,7 @@ def obstacle(obstacle_id, position, velocity=(0, 0, 0), radius=1.0):
 
 def problem(goal=(20, 0, 0), obstacles=(), goal_time=None, **kwargs):
     return PathProblem(
-        start=PathState(time=0.0, position=[0, 0, 0]),
+        start=RobotState(time=0.0, position=[0, 0, 0]),
         goal=GoalRegion(position=goal, tolerance=0.5, time=goal_time),
         obstacles=tuple(obstacles),
         robot_radius=0.5,
@@ -74,7 +74,7 @@ def test_trapezoid_respects_the_acceleration_limit_and_ends_at_rest():
 
 def test_moving_goal_is_met_at_its_time_with_its_velocity():
     moving = PathProblem(
-        start=PathState(time=5.0, position=[0, 0, 0]),
+        start=RobotState(time=5.0, position=[0, 0, 0]),
         goal=GoalRegion(position=[30, 10, 0], tolerance=0.5, velocity=[0, 0.2, 0], time=65.0),
         robot_radius=0.5,
         max_speed=1.0,

@@ -1,6 +1,6 @@
 """A controller that imports the world engine: it could read ground truth."""
 
-from dcsim_plugins.pd import PDController
+from dcsim_plugins.controllers.pd import PDController
 
 from dcsim.api import Command, hookimpl
 from dcsim.world import World  # noqa: F401  (the offence under test)

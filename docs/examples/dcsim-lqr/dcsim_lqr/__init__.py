@@ -15,7 +15,7 @@ import numpy as np
 from dcsim.api import (
     Command,
     Controller,
-    LocationEstimate,
+    StateEstimate,
     PluginParams,
     Reference,
     RobotSpec,
@@ -63,7 +63,7 @@ class LQRController(Controller):
     def command(
         self,
         time: float,
-        estimate: LocationEstimate,
+        estimate: StateEstimate,
         reference: Reference,
         surroundings: Surroundings,
     ) -> Command:

@@ -19,8 +19,8 @@ Each particle is a position and a velocity (its heading and speed). Every step:
    axis, shrinking as the cloud converges), and if its error grew since the last step
    (it is heading the wrong way) its heading is drawn again at random, its speed kept.
 
-The estimate is the particles' mean (heading: the mean velocity's direction, the second
-improvement of §6.3.2). As in the thesis it is published as converged only once the mean
+The estimate is the particles' mean (the direction of travel is the mean velocity's,
+the second improvement of §6.3.2). As in the thesis it is published as converged only once the mean
 particle error is at most ``max_error``. Particles start from the prior (Gaussian) or,
 as in the thesis, on concentric shells (``shell_radii`` around ``shell_centre``). Every
 step is vectorised over the particles.
@@ -36,13 +36,12 @@ import numpy as np
 from dcsim.api import (
     BeaconRange,
     Localiser,
-    LocationEstimate,
+    StateEstimate,
     MotionInput,
     PluginParams,
     Prior,
     hookimpl,
     quantity,
-    unit,
 )
 
 
@@ -140,7 +139,6 @@ class ScatteredParticleLocaliser(Localiser):
         self.errors = np.full(n, np.inf)
         self.mean_error = np.inf
         self.time = time
-        self.heading = unit(prior.velocity)
 
     def predict(self, motion: MotionInput, dt: float) -> None:
         """Apply the commanded motion to every particle."""
@@ -224,17 +222,15 @@ class ScatteredParticleLocaliser(Localiser):
         centred = states - weights @ states
         return (centred * weights[:, None]).T @ centred
 
-    def estimate(self) -> LocationEstimate:
+    def estimate(self) -> StateEstimate:
         """The particles' weighted mean and covariance."""
         weights = self.weights
         position, velocity = weights @ self.positions, weights @ self.velocities
         covariance = self._covariance(weights)
-        self.heading = unit(velocity, fallback=self.heading)
-        return LocationEstimate(
+        return StateEstimate(
             time=self.time,
             position=position,
             velocity=velocity,
-            heading=self.heading,
             covariance=0.5 * (covariance + covariance.T),
             converged=self.mean_error <= self.params.max_error,
         )

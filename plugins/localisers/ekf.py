@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from typing import Literal
 
 import numpy as np
-from dcsim_plugins.range_models import (
+from dcsim_plugins.localisers.range_models import (
     beacon_arrays,
     least_squares_fix,
     predicted_ranges,
@@ -28,13 +28,12 @@ from filterpy.kalman import ExtendedKalmanFilter
 from dcsim.api import (
     BeaconRange,
     Localiser,
-    LocationEstimate,
+    StateEstimate,
     MotionInput,
     PluginParams,
     Prior,
     hookimpl,
     quantity,
-    unit,
 )
 
 
@@ -68,7 +67,6 @@ class EKFLocaliser(Localiser):
         self.filter.P = np.diag([prior.position_sigma**2] * 3 + [prior.velocity_sigma**2] * 3)
         self.time = time
         self.started = self.params.initialise == "prior"
-        self.heading = unit(prior.velocity)
 
     def predict(self, motion: MotionInput, dt: float) -> None:
         """Propagate with the commanded acceleration over ``dt`` s."""
@@ -109,17 +107,15 @@ class EKFLocaliser(Localiser):
         self.filter.P[:3, :3] = covariance
         self.started = True
 
-    def estimate(self) -> LocationEstimate:
+    def estimate(self) -> StateEstimate:
         """The filter's mean and covariance."""
         state = self.filter.x.ravel()
         covariance = 0.5 * (self.filter.P + self.filter.P.T)
-        self.heading = unit(state[3:], fallback=self.heading)
         spread = float(np.sqrt(np.linalg.eigvalsh(covariance[:3, :3]).max()))
-        return LocationEstimate(
+        return StateEstimate(
             time=self.time,
             position=state[:3],
             velocity=state[3:],
-            heading=self.heading,
             covariance=covariance,
             converged=self.started and spread <= self.params.convergence_sigma,
         )

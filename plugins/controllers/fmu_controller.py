@@ -44,7 +44,7 @@ from dcsim.api import (
     FmuDescription,
     FmuError,
     FmuInstance,
-    LocationEstimate,
+    StateEstimate,
     PluginParams,
     Reference,
     RobotSpec,
@@ -141,7 +141,7 @@ def connect(
 
 def signals(
     time: float,
-    estimate: LocationEstimate,
+    estimate: StateEstimate,
     reference: Reference,
     surroundings: Surroundings,
     robot: RobotSpec,
@@ -196,7 +196,7 @@ class FmuController(Controller):
     def command(
         self,
         time: float,
-        estimate: LocationEstimate,
+        estimate: StateEstimate,
         reference: Reference,
         surroundings: Surroundings,
     ) -> Command:

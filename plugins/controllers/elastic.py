@@ -17,7 +17,7 @@ Every control period the controller computes a desired velocity and tracks it:
    safety sphere. Only obstacles the collector is closing on repel: once the two
    separate, pushing on would only cost fuel.
 3. ``M = V_robot + Σ F`` (eq. 5.3), at most the speed limit, is published as the
-   thesis's Move message (:class:`dcsim.api.MoveCommand`: the rotation from the current
+   thesis's Move message (:class:`MoveCommand`: the rotation from the current
    heading onto ``M`` and the speed ``|M|``) and flown by a velocity loop,
    ``F = m (M − v) / response_time`` within the thrust limit.
 
@@ -95,16 +95,19 @@ import numpy as np
 from dcsim.api import (
     Command,
     Controller,
-    LocationEstimate,
-    MoveCommand,
+    Message,
     PluginParams,
     Reference,
     RobotSpec,
+    StateEstimate,
     Surroundings,
+    array_field,
     clip_norm,
     hookimpl,
+    message,
     quantity,
     quaternion_between,
+    rotate,
     unit,
 )
 
@@ -112,6 +115,58 @@ _PARALLEL = 1e-9  # |C| |V| (m²/s) below which C × V is taken to vanish
 _DODGE_PASSES = 3  # passes over the obstacles when adding the dodges
 _BRAKE_PASSES = 3  # passes over the obstacles when enforcing the braking limit
 _DEAD_ON = 0.05  # m: predicted miss below which the dodge takes eq. 5.2's candidate
+
+
+@message
+class MoveCommand(Message):
+    """The thesis's Move message: turn the heading by a rotation, then fly at a speed.
+
+    Attributes
+    ----------
+    rotation : ndarray (4,)
+        Unit quaternion ``[x, y, z, w]`` taking the current heading onto the commanded
+        direction of flight.
+    speed : float
+        Commanded speed along that direction, m/s.
+    """
+
+    rotation: np.ndarray = array_field(shape=(4,))
+    speed: float = 0.0
+
+    def desired_velocity(self, heading: np.ndarray) -> np.ndarray:
+        """The commanded velocity (m/s) for a collector whose heading is ``heading``."""
+        return self.speed * unit(rotate(self.rotation, unit(heading)))
+
+    def to_command(
+        self,
+        heading: np.ndarray,
+        velocity: np.ndarray,
+        mass: float,
+        max_force: float,
+        response_time: float,
+    ) -> Command:
+        """Convert to the force that reaches the commanded velocity.
+
+        Parameters
+        ----------
+        heading : array_like (3,)
+            Current heading (direction the rotation starts from).
+        velocity : array_like (3,)
+            Current velocity, m/s.
+        mass : float
+            Current mass, kg.
+        max_force : float
+            Thrust limit, N; the force is scaled down to it.
+        response_time : float
+            Time constant of the velocity loop, s.
+
+        Returns
+        -------
+        Command
+            ``F = m (v_cmd − v) / response_time``, limited to ``max_force``; no torque.
+        """
+        force = mass * (self.desired_velocity(heading) - np.asarray(velocity)) / response_time
+        return Command(force=clip_norm(force, max_force))
 
 
 class ElasticParams(PluginParams):
@@ -402,7 +457,7 @@ class ElasticController(Controller):
     def move(
         self,
         time: float,
-        estimate: LocationEstimate,
+        estimate: StateEstimate,
         reference: Reference,
         surroundings: Surroundings,
     ) -> MoveCommand:
@@ -412,7 +467,7 @@ class ElasticController(Controller):
     def command(
         self,
         time: float,
-        estimate: LocationEstimate,
+        estimate: StateEstimate,
         reference: Reference,
         surroundings: Surroundings,
     ) -> Command:
@@ -429,7 +484,7 @@ class ElasticController(Controller):
     def _move(
         self,
         time: float,
-        estimate: LocationEstimate,
+        estimate: StateEstimate,
         reference: Reference,
         surroundings: Surroundings,
     ) -> tuple[MoveCommand, np.ndarray]:
@@ -446,7 +501,7 @@ class ElasticController(Controller):
     def desired_velocity(
         self,
         time: float,
-        estimate: LocationEstimate,
+        estimate: StateEstimate,
         reference: Reference,
         surroundings: Surroundings,
     ) -> np.ndarray:

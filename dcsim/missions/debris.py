@@ -1,4 +1,4 @@
-"""The debris-collection mission: the executer state machine of the source thesis.
+"""The ``debris`` mission: the executer state machine of the source thesis.
 
 Modes (the thesis's §2.2.1 and §5.2)::
 
@@ -18,7 +18,7 @@ from __future__ import annotations
 import dataclasses
 import enum
 from collections import deque
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
@@ -27,23 +27,26 @@ from dcsim.geometry import unit
 from dcsim.interfaces import Plugin
 from dcsim.messages import (
     DropVisit,
+    FrameDynamics,
+    FrameKind,
     GoalRegion,
-    LocationEstimate,
     NoPath,
     ObjectKind,
     ObjectTrack,
+    Observations,
     PathProblem,
-    PathState,
     Plan,
     PlanTask,
     Reference,
+    RobotState,
+    StateEstimate,
     TaskRequest,
     Trajectory,
 )
-from dcsim.scenario.model import Scenario
+from dcsim.missions.base import Emit, Mission
+from dcsim.scenario.model import DebrisMissionSection, Scenario
 from dcsim.world import World
-
-Emit = Callable[..., None]
+from dcsim.world.objects import ObjectStatus
 
 
 #: Gap kept between carried cargo and a target being approached, m.
@@ -65,36 +68,7 @@ class Mode(enum.IntEnum):
 _INSTANT = {Mode.DEVISE_PLAN, Mode.SELECT_NEXT, Mode.GRAB}
 
 
-class PluginFailure(Exception):
-    """A plugin raised during a run.
-
-    Attributes
-    ----------
-    role : str
-        The role of the plugin (``localiser``, ``controller``...).
-    plugin : str
-        The plugin's name.
-    method : str
-        The method that raised.
-    """
-
-    def __init__(self, role: str, plugin: str, method: str, error: BaseException) -> None:
-        self.role, self.plugin, self.method, self.error = role, plugin, method, error
-        super().__init__(
-            f"{role} plugin '{plugin}' raised in {method}(): {type(error).__name__}: {error}"
-        )
-
-
-def call_plugin(plugins: dict[str, Plugin], role: str, method: str, *args: Any) -> Any:
-    """Call ``plugins[role].method(*args)``, wrapping any exception in :class:`PluginFailure`."""
-    plugin = plugins[role]
-    try:
-        return getattr(plugin, method)(*args)
-    except Exception as error:  # a plugin's own bug ends the run, recorded
-        raise PluginFailure(role, plugin.name, method, error) from error
-
-
-class Mission:
+class DebrisMission(Mission):
     """The executer: turns estimates and tracks into references and world service calls.
 
     Parameters
@@ -103,21 +77,27 @@ class Mission:
         The resolved scenario (mission settings, robot limits).
     world : World
         Provides the grab and release services and the drop point.
-    plugins : dict
-        The task planner and path planner under their roles.
+    plugins : mapping of str to Plugin
+        The plugin of each role in :attr:`roles`.
     emit : callable
         ``emit(event_name, **data)`` records an event.
     """
 
+    type = "debris"
+    summary = "collect drifting targets and deliver them to a drop point (the source thesis)"
+    Settings = DebrisMissionSection
+    roles = ("localiser", "task_planner", "path_planner", "controller")
+    modes = tuple(mode.name for mode in Mode)
+    columns = ("carried", "delivered")
+    column_doc = "targets carried and delivered"
+    settings: DebrisMissionSection
+
     def __init__(
-        self, scenario: Scenario, world: World, plugins: dict[str, Plugin], emit: Emit
+        self, scenario: Scenario, world: World, plugins: Mapping[str, Plugin], emit: Emit
     ) -> None:
-        self.settings = scenario.mission
+        super().__init__(scenario, world, plugins, emit)
         self.robot = scenario.robot
-        self.world = world
-        self.plugins = plugins
-        self.emit = emit
-        self.mode = Mode.LOCALIZE
+        self.state = Mode.LOCALIZE
         self.known: dict[int, ObjectTrack] = {}
         self.planned: set[int] = set()
         self.steps: deque[PlanTask | DropVisit] = deque()
@@ -140,29 +120,72 @@ class Mission:
         }
 
     # ------------------------------------------------------------------ tick
+    @property
+    def mode(self) -> str:
+        """The executer's mode (a :class:`Mode` name)."""
+        return self.state.name
+
+    @property
+    def safety_distance(self) -> float:
+        """The thesis's SAFETY_DISTANCE, m."""
+        return self.settings.safety_distance
+
     def tick(
-        self, time: float, estimate: LocationEstimate, tracks: Sequence[ObjectTrack]
+        self, time: float, estimate: StateEstimate, observations: Observations
     ) -> Reference:
         """Advance the state machine at ``time`` and return the reference to track."""
         self.time = time
         self.estimate = estimate
-        self.visible = {t.id: t for t in tracks}
+        self.visible = {t.id: t for t in observations.tracks}
         self.known.update(self.visible)
         for _ in range(len(Mode) + 2):
-            before = self.mode
+            before = self.state
             reference = self._step()
-            if self.mode is before or self.mode not in _INSTANT:
+            if self.state is before or self.state not in _INSTANT:
                 return reference
         return reference
 
+    def telemetry(self) -> dict[str, Any]:
+        """Targets carried and delivered now."""
+        return {
+            "carried": len(self.world.carried_ids()),
+            "delivered": self.world.field.count(ObjectStatus.DELIVERED),
+        }
+
+    def progress(self) -> str:
+        """Targets delivered out of all."""
+        field = self.world.field
+        return f"delivered {field.count(ObjectStatus.DELIVERED)}/{int(field.is_target.sum())}"
+
+    def finished(self) -> tuple[str, str] | None:
+        """Completed once every target is delivered, if the stop rules say so."""
+        field = self.world.field
+        targets = int(field.is_target.sum())
+        if (
+            self.scenario.stop.on_all_delivered
+            and targets
+            and field.count(ObjectStatus.DELIVERED) == targets
+        ):
+            return "completed", "all targets delivered"
+        return None
+
+    def summary_fields(self, telemetry: Mapping[str, np.ndarray]) -> dict[str, Any]:
+        """Targets, and how many were captured and delivered."""
+        field = self.world.field
+        return {
+            "targets": int(field.is_target.sum()),
+            "captured": field.count(ObjectStatus.CARRIED) + field.count(ObjectStatus.DELIVERED),
+            "delivered": field.count(ObjectStatus.DELIVERED),
+        }
+
     def _go(self, mode: Mode, reason: str) -> None:
-        if mode is not self.mode:
-            self.emit("mode", previous=self.mode.name, mode=mode.name, reason=reason)
-            self.mode = mode
+        if mode is not self.state:
+            self.emit("mode", previous=self.state.name, mode=mode.name, reason=reason)
+            self.state = mode
             self.hold = None
 
     def _step(self) -> Reference:
-        return self._handlers[self.mode]()
+        return self._handlers[self.state]()
 
     # ------------------------------------------------------------------ helpers
     def _free_targets(self) -> list[ObjectTrack]:
@@ -177,6 +200,12 @@ class Mission:
             self.settings.acceleration_fraction * self.robot.max_force / self.world.assembly_mass()
         )
 
+    def _frame(self) -> FrameDynamics:
+        """The free dynamics of the world's frame, for the path planner."""
+        if self.scenario.world.frame == "lvlh":
+            return FrameDynamics(FrameKind.CLOHESSY_WILTSHIRE, self.scenario.mean_motion)
+        return FrameDynamics(FrameKind.INERTIAL)
+
     def _holding(self) -> Reference:
         if self.hold is None:
             self.hold = np.array(self.estimate.position)
@@ -187,16 +216,24 @@ class Mission:
 
     def _plan_path(self, goal: GoalRegion, max_speed: float | None = None) -> Trajectory | None:
         """Ask the path planner for a way to ``goal`` at up to ``max_speed`` (the robot's)."""
+        estimate = self.estimate
         problem = PathProblem(
-            start=PathState(self.time, self.estimate.position, self.estimate.velocity),
+            start=RobotState(
+                self.time,
+                estimate.position,
+                estimate.attitude,
+                estimate.velocity,
+                estimate.angular_velocity,
+            ),
             goal=goal,
             obstacles=self._obstacles(),
+            frame=self._frame(),
             robot_radius=self.world.robot_spec().radius,
             max_speed=self.robot.max_speed if max_speed is None else max_speed,
             max_acceleration=self._max_acceleration(),
             time_budget=self.settings.planning_budget,
         )
-        result = call_plugin(self.plugins, "path_planner", "plan", problem)
+        result = self.call("path_planner", "plan", problem)
         if isinstance(result, NoPath):
             self.emit("no_path", reason=result.reason)
             self.retry_at = self.time + self.settings.path_retry
@@ -239,7 +276,7 @@ class Mission:
             max_acceleration=self._max_acceleration(),
             time_budget=self.settings.planning_budget,
         )
-        plan: Plan = call_plugin(self.plugins, "task_planner", "plan", request)
+        plan: Plan = self.call("task_planner", "plan", request)
         self.planned = {t.id for t in targets}
         self.steps = deque(_ordered_steps(plan))
         self.emit(

@@ -19,13 +19,12 @@ from scipy.optimize import least_squares
 from dcsim.api import (
     BeaconRange,
     Localiser,
-    LocationEstimate,
+    StateEstimate,
     MotionInput,
     PluginParams,
     Prior,
     hookimpl,
     quantity,
-    unit,
 )
 
 
@@ -63,7 +62,6 @@ class TrilaterationLocaliser(Localiser):
         self._variance = np.concatenate(
             [np.full(3, prior.position_sigma**2), np.full(3, prior.velocity_sigma**2)]
         )
-        self._heading = unit(self._velocity)
         self._last_fix_time: float | None = None
 
     def predict(self, motion: MotionInput, dt: float) -> None:
@@ -92,7 +90,6 @@ class TrilaterationLocaliser(Localiser):
             self._velocity = self._velocity + beta * residual / elapsed
             self._variance = _steady_state_variance(fix_variance, alpha, beta, elapsed)
         self._last_fix_time = self._time
-        self._heading = unit(self._velocity, fallback=self._heading)
 
     def _fix(self, ranges: Sequence[BeaconRange]) -> tuple[np.ndarray, np.ndarray] | None:
         """Least-squares position and its per-axis variance, or None if not trustworthy."""
@@ -116,13 +113,12 @@ class TrilaterationLocaliser(Localiser):
             return None
         return fit.x, variance
 
-    def estimate(self) -> LocationEstimate:
+    def estimate(self) -> StateEstimate:
         """The filtered position and velocity with a diagonal covariance."""
-        return LocationEstimate(
+        return StateEstimate(
             time=self._time,
             position=self._position,
             velocity=self._velocity,
-            heading=self._heading,
             covariance=np.diag(np.minimum(self._variance, 1e12)),
             converged=self._last_fix_time is not None,
         )

@@ -8,8 +8,8 @@ linearised.
 from __future__ import annotations
 
 import numpy as np
-from dcsim_plugins.ekf import EKFLocaliser, EKFParams
-from dcsim_plugins.range_models import (
+from dcsim_plugins.localisers.ekf import EKFLocaliser, EKFParams
+from dcsim_plugins.localisers.range_models import (
     predicted_ranges,
     process_noise,
     transition,

@@ -19,7 +19,7 @@ import numpy as np
 from dcsim.api import (
     Command,
     Controller,
-    LocationEstimate,
+    StateEstimate,
     PluginParams,
     Reference,
     RobotSpec,
@@ -79,7 +79,7 @@ class PDController(Controller):
     def command(
         self,
         time: float,
-        estimate: LocationEstimate,
+        estimate: StateEstimate,
         reference: Reference,
         surroundings: Surroundings,
     ) -> Command:

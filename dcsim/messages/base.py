@@ -1,0 +1,96 @@
+"""The machinery every message shares: frozen dataclasses with read-only array fields.
+
+A message is a frozen dataclass deriving from :class:`Message`; its array fields are
+declared with :func:`array_field`, converted to read-only float arrays and checked for
+shape on construction. Two messages are equal when all their fields are (arrays
+compared element-wise).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields
+from typing import Any, TypeVar
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+T = TypeVar("T", bound=type)
+
+
+def array_field(
+    shape: tuple[int, ...] = (3,), default: ArrayLike | None = None, optional: bool = False
+) -> Any:
+    """Declare a message field holding a read-only float array.
+
+    Parameters
+    ----------
+    shape : tuple of int
+        Required shape; ``-1`` accepts any length along that axis.
+    default : array_like, optional
+        Default value; omit for a required field.
+    optional : bool
+        If true the field may be None (its default unless ``default`` is given), meaning
+        "not given"; otherwise None is rejected.
+    """
+    metadata = {"shape": shape, "optional": optional}
+    if default is None:
+        return field(default=None, metadata=metadata) if optional else field(metadata=metadata)
+    value = np.asarray(default, dtype=float)
+    frozen, default_shape = tuple(value.ravel()), value.shape
+    return field(
+        default_factory=lambda: np.array(frozen).reshape(default_shape), metadata=metadata
+    )
+
+
+_ARRAY_FIELDS: dict[type, tuple[tuple[str, tuple[int, ...], bool], ...]] = {}
+
+
+def _array_fields(cls: type) -> tuple[tuple[str, tuple[int, ...], bool], ...]:
+    """Names, shapes and optionality of a message class's array fields (cached per class)."""
+    found = _ARRAY_FIELDS.get(cls)
+    if found is None:
+        found = tuple(
+            (f.name, f.metadata["shape"], f.metadata["optional"])
+            for f in fields(cls)
+            if "shape" in f.metadata
+        )
+        _ARRAY_FIELDS[cls] = found
+    return found
+
+
+class Message:
+    """Base of every message: converts array fields and compares by value."""
+
+    def __post_init__(self) -> None:
+        for name, shape, optional in _array_fields(type(self)):
+            raw = getattr(self, name)
+            if raw is None and optional:
+                continue
+            value = np.array(raw, dtype=float)
+            if value.ndim != len(shape) or any(
+                want not in (-1, got) for want, got in zip(shape, value.shape, strict=True)
+            ):
+                raise ValueError(
+                    f"{type(self).__name__}.{name} must have shape {shape}, got {value.shape}"
+                )
+            value.setflags(write=False)
+            object.__setattr__(self, name, value)
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not type(self):
+            return NotImplemented
+        for f in fields(self):  # type: ignore[arg-type]
+            a, b = getattr(self, f.name), getattr(other, f.name)
+            if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+                if a is None or b is None or not np.array_equal(a, b):
+                    return False
+            elif a != b:
+                return False
+        return True
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+def message(cls: T) -> T:
+    """Class decorator making ``cls`` a frozen message dataclass."""
+    return dataclass(frozen=True, eq=False)(cls)

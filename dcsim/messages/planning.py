@@ -1,0 +1,301 @@
+"""Messages of path planning: the problem a path planner solves and its answers.
+
+Vectors are read-only float arrays in the world frame; times are scenario seconds;
+quaternions are ``[x, y, z, w]``.
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Mapping
+from dataclasses import field
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from dcsim.geometry import Vector, rotation_vector, quaternion_conjugate, quaternion_multiply, slerp
+from dcsim.messages.base import Message, array_field, message
+from dcsim.messages.sensing import ObjectTrack
+from dcsim.messages.state import RobotState
+
+_INF = float("inf")
+
+
+@message
+class GoalRegion(Message):
+    """Where, and optionally how and when, a path must end.
+
+    The position region is a sphere of radius ``tolerance`` about ``position``, or the
+    box ``position ± half_extents`` when ``half_extents`` is given.
+
+    Attributes
+    ----------
+    position : ndarray (3,)
+        Centre of the goal region, m.
+    tolerance : float
+        Radius of a spherical goal region, m.
+    velocity : ndarray (3,)
+        Velocity to match on arrival (e.g. a target's), m/s.
+    time : float or None
+        Required arrival time, s, or None for "as soon as allowed".
+    half_extents : ndarray (3,) or None
+        Half side lengths of a box-shaped region (axis-aligned), m; None for a sphere.
+    attitude : ndarray (4,) or None
+        Attitude to arrive at, or None for any.
+    attitude_tolerance : float
+        Largest rotation angle from ``attitude`` that counts as arrived, rad.
+    velocity_tolerance : float
+        Largest difference from ``velocity`` that counts as arrived, m/s (``inf``: any).
+    time_tolerance : float
+        Largest difference from ``time`` that counts as arrived, s (``inf``: any).
+    """
+
+    position: Vector = array_field()
+    tolerance: float = 0.0
+    velocity: Vector = array_field(default=(0.0, 0.0, 0.0))
+    time: float | None = None
+    half_extents: Vector | None = array_field(optional=True)
+    attitude: Vector | None = array_field(shape=(4,), optional=True)
+    attitude_tolerance: float = _INF
+    velocity_tolerance: float = _INF
+    time_tolerance: float = _INF
+
+    def contains(self, state: RobotState) -> bool:
+        """Whether ``state`` is inside the region and within every tolerance."""
+        offset = state.position - self.position
+        if self.half_extents is None:
+            inside = float(np.linalg.norm(offset)) <= self.tolerance
+        else:
+            inside = bool(np.all(np.abs(offset) <= self.half_extents))
+        if not inside:
+            return False
+        if np.linalg.norm(state.velocity - self.velocity) > self.velocity_tolerance:
+            return False
+        if self.time is not None and abs(state.time - self.time) > self.time_tolerance:
+            return False
+        if self.attitude is not None:
+            error = quaternion_multiply(state.attitude, quaternion_conjugate(self.attitude))
+            return float(np.linalg.norm(rotation_vector(error))) <= self.attitude_tolerance
+        return True
+
+
+@message
+class Bounds(Message):
+    """An axis-aligned box the path must stay in.
+
+    Attributes
+    ----------
+    lower, upper : ndarray (3,)
+        Corners of the box, m.
+    """
+
+    lower: Vector = array_field()
+    upper: Vector = array_field()
+
+    def contains(self, points: ArrayLike) -> np.ndarray:
+        """Whether each point of ``points`` (shape ``(..., 3)``, m) lies in the box."""
+        p = np.asarray(points, dtype=float)
+        return np.all((p >= self.lower) & (p <= self.upper), axis=-1)
+
+
+@message
+class CostWeights(Message):
+    """Weights of a path's cost ``J = w_dv Δv + w_L L + w_T T``.
+
+    Attributes
+    ----------
+    delta_v : float
+        Weight on total delta-v, per m/s.
+    length : float
+        Weight on path length, per m.
+    time : float
+        Weight on duration, per s.
+    """
+
+    delta_v: float = 1.0
+    length: float = 0.0
+    time: float = 0.0
+
+
+class FrameKind(enum.StrEnum):
+    """The dynamics of the frame a path is planned in."""
+
+    INERTIAL = "inertial"
+    CLOHESSY_WILTSHIRE = "clohessy-wiltshire"
+
+
+@message
+class FrameDynamics(Message):
+    """The frame's free motion: force-free, or Clohessy–Wiltshire about a circular orbit.
+
+    Attributes
+    ----------
+    kind : FrameKind
+        Inertial (force-free straight lines) or Clohessy–Wiltshire (LVLH frame: x
+        radial, y along-track, z orbit normal).
+    mean_motion : float
+        Mean motion of the reference orbit, rad/s (Clohessy–Wiltshire only).
+    """
+
+    kind: FrameKind = FrameKind.INERTIAL
+    mean_motion: float = 0.0
+
+
+@message
+class PathProblem(Message):
+    """What a path planner is asked to solve.
+
+    Attributes
+    ----------
+    start : RobotState
+        Initial state (its ``time`` is the start time).
+    goal : GoalRegion
+        Region (and optionally attitude, velocity and time) to reach.
+    obstacles : tuple of ObjectTrack
+        Obstacles with their shape and predicted motion.
+    frame : FrameDynamics
+        The free dynamics of the planning frame.
+    robot_radius : float
+        Radius of the robot's bounding sphere, m.
+    max_speed : float
+        Speed limit, m/s.
+    max_acceleration : float
+        Acceleration the robot can count on, m/s² (``inf`` for impulsive burns).
+    max_delta_v : float
+        Largest total delta-v the path may use, m/s (``inf`` for none).
+    max_angular_rate : float
+        Angular rate limit, rad/s (``inf`` for none).
+    max_angular_acceleration : float
+        Angular acceleration the robot can count on, rad/s² (``inf`` for none).
+    bounds : Bounds or None
+        Box the path must stay in, or None.
+    weights : CostWeights
+        Cost weights.
+    time_budget : float
+        Wall time the planner may spend, s.
+    """
+
+    start: RobotState
+    goal: GoalRegion
+    obstacles: tuple[ObjectTrack, ...] = ()
+    frame: FrameDynamics = field(default_factory=FrameDynamics)
+    robot_radius: float = 0.0
+    max_speed: float = 1.0
+    max_acceleration: float = _INF
+    max_delta_v: float = _INF
+    max_angular_rate: float = _INF
+    max_angular_acceleration: float = _INF
+    bounds: Bounds | None = None
+    weights: CostWeights = field(default_factory=CostWeights)
+    time_budget: float = 1.0
+
+
+@message
+class Trajectory(Message):
+    """A time-stamped reference trajectory.
+
+    Position and velocity are linear between samples; attitude is interpolated by
+    spherical linear interpolation (slerp) and angular velocity linearly.
+
+    Attributes
+    ----------
+    times : ndarray (N,)
+        Strictly increasing sample times, s.
+    positions, velocities : ndarray (N, 3)
+        States at the samples, m and m/s.
+    attitudes : ndarray (N, 4) or None
+        Attitudes at the samples ``[x, y, z, w]``; None leaves the attitude free.
+    angular_velocities : ndarray (N, 3) or None
+        Angular velocities at the samples, rad/s; None for zero.
+    forces, torques : ndarray (N − 1, 3) or None
+        Feed-forward force (N) and torque (N·m) held over each segment, if known.
+    delta_v : float
+        Total delta-v the trajectory needs, including matching the start and goal
+        velocities, m/s.
+    length : float
+        Path length, m.
+    duration : float
+        ``times[-1] - times[0]``, s.
+    statistics : mapping of str to float
+        The planner's figures (e.g. ``nodes_expanded``, ``iterations``).
+    """
+
+    times: Vector = array_field(shape=(-1,))
+    positions: Vector = array_field(shape=(-1, 3))
+    velocities: Vector = array_field(shape=(-1, 3))
+    attitudes: Vector | None = array_field(shape=(-1, 4), optional=True)
+    angular_velocities: Vector | None = array_field(shape=(-1, 3), optional=True)
+    forces: Vector | None = array_field(shape=(-1, 3), optional=True)
+    torques: Vector | None = array_field(shape=(-1, 3), optional=True)
+    delta_v: float = 0.0
+    length: float = 0.0
+    duration: float = 0.0
+    statistics: Mapping[str, float] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        n = len(self.times)
+        for name, rows in (
+            ("positions", n),
+            ("velocities", n),
+            ("attitudes", n),
+            ("angular_velocities", n),
+            ("forces", n - 1),
+            ("torques", n - 1),
+        ):
+            value = getattr(self, name)
+            if value is not None and len(value) != rows:
+                raise ValueError(
+                    f"Trajectory.{name} has {len(value)} rows, expected {rows} for {n} times"
+                )
+
+    def sample(self, t: float) -> tuple[Vector, Vector]:
+        """Reference ``(position, velocity)`` at time ``t`` (s), held at the ends."""
+        position = np.array([np.interp(t, self.times, self.positions[:, k]) for k in range(3)])
+        velocity = np.array([np.interp(t, self.times, self.velocities[:, k]) for k in range(3)])
+        return position, velocity
+
+    def state_at(self, t: float) -> RobotState:
+        """The full reference state at time ``t`` (s), held at the ends."""
+        position, velocity = self.sample(t)
+        attitude = np.array([0.0, 0.0, 0.0, 1.0])
+        angular = np.zeros(3)
+        if self.attitudes is not None:
+            attitude = self.attitude_at(t)
+        if self.angular_velocities is not None:
+            angular = np.array(
+                [np.interp(t, self.times, self.angular_velocities[:, k]) for k in range(3)]
+            )
+        return RobotState(t, position, attitude, velocity, angular)
+
+    def attitude_at(self, t: float) -> Vector:
+        """Attitude at time ``t`` (s) by slerp between the samples, held at the ends.
+
+        Raises
+        ------
+        ValueError
+            If the trajectory has no attitudes.
+        """
+        if self.attitudes is None:
+            raise ValueError("this trajectory leaves the attitude free")
+        times = self.times
+        if t <= times[0] or len(times) == 1:
+            return self.attitudes[0].copy()
+        if t >= times[-1]:
+            return self.attitudes[-1].copy()
+        i = int(np.searchsorted(times, t, side="right")) - 1
+        fraction = (t - times[i]) / (times[i + 1] - times[i])
+        return slerp(self.attitudes[i], self.attitudes[i + 1], fraction)
+
+
+@message
+class NoPath(Message):
+    """A path planner's answer when it finds no path.
+
+    Attributes
+    ----------
+    reason : str
+        Why, in words a user can act on.
+    """
+
+    reason: str

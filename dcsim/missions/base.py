@@ -1,0 +1,122 @@
+"""The mission seam: what a mission must tell the runner, and what the runner gives it.
+
+A :class:`Mission` is the task side of a run (as dm_control splits a task from its
+physics): the runner owns the world, the sensors, the localiser and the controller and
+knows no mission; each control tick it hands the mission the estimate and the
+observations, and the mission answers with the reference the controller tracks. On
+the way it asks its planners, calls world services (grab, release) and reports events.
+The mission also says which plugin roles it uses, which telemetry columns and summary
+fields it adds, and when it is finished.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import numpy as np
+
+from dcsim.interfaces import Plugin
+from dcsim.messages import Observations, Reference, StateEstimate, Surroundings
+from dcsim.plugin_calls import call_plugin
+from dcsim.scenario.model import MissionSettings, Scenario
+
+if TYPE_CHECKING:
+    from dcsim.world import World
+
+Emit = Callable[..., None]
+"""``emit(event_name, **data)`` records an event at the current time."""
+
+
+class Mission(ABC):
+    """Base of every mission type.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The resolved scenario; ``scenario.mission`` is an instance of :attr:`Settings`.
+    world : World
+        The world, for its services (grab, release) and bookkeeping.
+    plugins : mapping of str to Plugin
+        The constructed plugin of each role in :attr:`roles`.
+    emit : callable
+        ``emit(event_name, **data)`` records an event.
+
+    Attributes
+    ----------
+    type : str
+        The ``mission.type`` that selects this mission in a scenario file.
+    summary : str
+        One line saying what the mission is.
+    Settings : type of MissionSettings
+        The scenario's ``mission`` section for this mission.
+    roles : tuple of str
+        Plugin roles the mission uses, in data-flow order.
+    modes : tuple of str
+        The mission's modes; :attr:`mode` is one of them (telemetry records its name,
+        FMU outputs its index).
+    columns : tuple of str
+        The mission's own telemetry columns, recorded after ``mode`` and ``converged``.
+    column_doc : str
+        What the columns hold, with units.
+    """
+
+    type: ClassVar[str]
+    summary: ClassVar[str]
+    Settings: ClassVar[type[MissionSettings]]
+    roles: ClassVar[tuple[str, ...]]
+    modes: ClassVar[tuple[str, ...]]
+    columns: ClassVar[tuple[str, ...]] = ()
+    column_doc: ClassVar[str] = ""
+
+    def __init__(
+        self, scenario: Scenario, world: World, plugins: Mapping[str, Plugin], emit: Emit
+    ) -> None:
+        self.scenario = scenario
+        self.settings = scenario.mission
+        self.world = world
+        self.plugins = plugins
+        self.emit = emit
+
+    # ------------------------------------------------------------------ the tick
+    @property
+    @abstractmethod
+    def mode(self) -> str:
+        """The mode decided for the current control period (one of :attr:`modes`)."""
+
+    @abstractmethod
+    def tick(
+        self, time: float, estimate: StateEstimate, observations: Observations
+    ) -> Reference:
+        """Decide at ``time`` (s) and return the reference for the coming control period."""
+
+    def call(self, role: str, method: str, *args: Any) -> Any:
+        """Call the plugin of ``role``; an exception becomes a recorded plugin failure."""
+        return call_plugin(self.plugins, role, method, *args)
+
+    @property
+    def safety_distance(self) -> float:
+        """Least surface gap to keep from obstacles, m (0 unless the mission sets one)."""
+        return 0.0
+
+    def surroundings(self, observations: Observations) -> Surroundings:
+        """What the controller is told of its neighbourhood: the tracked obstacles."""
+        return Surroundings(observations.obstacles(), self.safety_distance)
+
+    # ------------------------------------------------------------------ records
+    def telemetry(self) -> dict[str, Any]:
+        """Values of :attr:`columns` now."""
+        return {}
+
+    def progress(self) -> str:
+        """A few words on how far the mission is, for a progress line."""
+        return ""
+
+    def finished(self) -> tuple[str, str] | None:
+        """``(status, reason)`` once the mission is over (``completed`` or ``stopped``)."""
+        return None
+
+    def summary_fields(self, telemetry: Mapping[str, np.ndarray]) -> dict[str, Any]:
+        """The mission's own fields of the run summary, from the telemetry recorded."""
+        return {}

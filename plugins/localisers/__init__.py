@@ -1,0 +1,1 @@
+"""Built-in localisers (one module per plugin)."""

@@ -1,0 +1,1 @@
+"""Built-in path planners (one module per plugin)."""

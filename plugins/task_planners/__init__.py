@@ -1,0 +1,1 @@
+"""Built-in task planners (one module per plugin)."""
