@@ -138,9 +138,9 @@ def run_command(
     """Run SCENARIO (default: the scenario shipped with dcsim) and record it.
 
     The scenario is validated (overrides applied first), its plugins constructed with
-    their validated parameters, and the mission flown until every target is delivered,
-    world.duration is reached, or a stop rule ends it. The run directory receives
-    scenario.yaml (resolved, to repeat the run), telemetry.csv, events.jsonl,
+    their validated parameters, and the mission flown until it is done (for debris:
+    every target delivered), world.duration is reached, or a stop rule ends it. The run
+    directory receives scenario.yaml (resolved, to repeat the run), telemetry.csv, events.jsonl,
     summary.json and plots/. Exit status: 0 when the run completed or was stopped by a
     stop rule, 1 when a plugin failed, 130 when interrupted with Ctrl-C.
     """
@@ -166,10 +166,8 @@ def _print_summary(summary: dict, out: Path) -> None:
 
     reason = f" ({summary['reason']})" if summary["reason"] else ""
     click.echo(f"{summary['scenario']} seed {summary['seed']}: {summary['status']}{reason}")
-    click.echo(
-        f"  delivered {summary['delivered']}/{summary['targets']}, captured {summary['captured']}, "
-        f"collisions {summary['collisions']}"
-    )
+    outcome = f"{summary['outcome']}, " if summary["outcome"] else ""
+    click.echo(f"  {outcome}collisions {summary['collisions']}")
     click.echo(
         f"  delta-v {number('delta_v_mps', 'm/s')}, propellant {number('fuel_used_kg', 'kg')}, "
         f"localisation RMSE {number('localisation_rmse_m', 'm')}, "

@@ -25,7 +25,6 @@ import numpy as np
 from dcsim.messages import (
     BeaconRange,
     Command,
-    StateEstimate,
     MotionInput,
     NoPath,
     PathProblem,
@@ -33,6 +32,7 @@ from dcsim.messages import (
     Prior,
     Reference,
     RobotSpec,
+    StateEstimate,
     Surroundings,
     TaskRequest,
     Trajectory,

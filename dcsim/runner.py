@@ -411,6 +411,7 @@ class Runner:
             "sim_time_s": sim_time,
             "wall_time_s": wall,
             "real_time_factor": sim_time / wall if wall > 0 else None,
+            "outcome": self.mission.progress(),
             **self.mission.summary_fields(telemetry),
             "collisions": len(world.collisions),
             "fuel_used_kg": world.fuel_used,

@@ -32,7 +32,10 @@ def test_wheel_carries_the_default_scenario_plugins_and_entry_points(wheel):
     assert "dcsim/scenarios/default.yaml" in names
     assert {"dcsim_plugins/pd.py", "dcsim_plugins/nearest.py"} <= names
     assert not any(n.startswith("plugins/") for n in names)
-    assert "pd = dcsim_plugins.controllers.pd" in entry_points and "dcsim = dcsim.cli:main" in entry_points
+    assert (
+        "pd = dcsim_plugins.controllers.pd" in entry_points
+        and "dcsim = dcsim.cli:main" in entry_points
+    )
 
 
 def test_wheel_installs_into_a_fresh_environment_and_runs(fresh_env, tmp_path):

@@ -100,7 +100,8 @@ def test_errors_name_file_line_column_and_key_path(tmp_path):
     )
     assert any(p.startswith(f"{path}:7:5: targets[1].motion: ") and "'warp'" in p for p in found)
     assert any(
-        p.startswith(f"{path}:9:3: robot.massive: unknown key (known keys: type, mass,") for p in found
+        p.startswith(f"{path}:9:3: robot.massive: unknown key (known keys: type, mass,")
+        for p in found
     )
     assert len(found) == 3
 

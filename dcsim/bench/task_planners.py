@@ -29,10 +29,10 @@ import numpy as np
 from dcsim.api import (
     DropPoint,
     LinearMotion,
-    StateEstimate,
     ObjectKind,
     ObjectTrack,
     Plan,
+    StateEstimate,
     StaticMotion,
     TaskRequest,
     plan_cost,

@@ -73,9 +73,7 @@ CLOSED_LOOP = [
     *_vector("disturbance_force", "input", "N", "External force on the collector."),
     *_vector("disturbance_torque", "input", "N.m", "External torque on the collector."),
     *_STATE,
-    FmuVariable(
-        "mode", "output", int, "", f"Mission mode, its index in the mission's modes (debris: {_MODES})."
-    ),
+    FmuVariable("mode", "output", int, "", f"Mission mode, by index (debris: {_MODES})."),
     FmuVariable("captured", "output", int, "", "Targets grabbed so far (carried or delivered)."),
     FmuVariable("delivered", "output", int, "", "Targets delivered to the drop point."),
     FmuVariable("collisions", "output", int, "", "Collisions so far."),

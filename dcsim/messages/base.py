@@ -37,9 +37,7 @@ def array_field(
         return field(default=None, metadata=metadata) if optional else field(metadata=metadata)
     value = np.asarray(default, dtype=float)
     frozen, default_shape = tuple(value.ravel()), value.shape
-    return field(
-        default_factory=lambda: np.array(frozen).reshape(default_shape), metadata=metadata
-    )
+    return field(default_factory=lambda: np.array(frozen).reshape(default_shape), metadata=metadata)
 
 
 _ARRAY_FIELDS: dict[type, tuple[tuple[str, tuple[int, ...], bool], ...]] = {}

@@ -13,7 +13,7 @@ from dataclasses import field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from dcsim.geometry import Vector, rotation_vector, quaternion_conjugate, quaternion_multiply, slerp
+from dcsim.geometry import Vector, quaternion_conjugate, quaternion_multiply, rotation_vector, slerp
 from dcsim.messages.base import Message, array_field, message
 from dcsim.messages.sensing import ObjectTrack
 from dcsim.messages.state import RobotState

@@ -34,6 +34,7 @@ class DropPoint(Message):
         """Position and velocity of the drop point at time(s) ``t`` (s)."""
         return self.motion.state_at(t)
 
+
 @message
 class TaskRequest(Message):
     """What a task planner is asked to plan.
@@ -70,6 +71,7 @@ class TaskRequest(Message):
     max_acceleration: float = float("inf")
     time_budget: float = 1.0
 
+
 @message
 class PlanTask(Message):
     """One pickup in a plan (the thesis's PlanTask message).
@@ -91,6 +93,7 @@ class PlanTask(Message):
     pickup_point: Vector = array_field()
     pickup_velocity: Vector = array_field(default=(0.0, 0.0, 0.0))
 
+
 @message
 class DropVisit(Message):
     """A visit to the drop point inside a plan.
@@ -108,6 +111,7 @@ class DropVisit(Message):
     after_task: int
     time: float
     point: Vector = array_field()
+
 
 @message
 class Plan(Message):

@@ -86,9 +86,7 @@ class Mission(ABC):
         """The mode decided for the current control period (one of :attr:`modes`)."""
 
     @abstractmethod
-    def tick(
-        self, time: float, estimate: StateEstimate, observations: Observations
-    ) -> Reference:
+    def tick(self, time: float, estimate: StateEstimate, observations: Observations) -> Reference:
         """Decide at ``time`` (s) and return the reference for the coming control period."""
 
     def call(self, role: str, method: str, *args: Any) -> Any:
@@ -110,7 +108,7 @@ class Mission(ABC):
         return {}
 
     def progress(self) -> str:
-        """A few words on how far the mission is, for a progress line."""
+        """A few words on how far the mission is, for the progress line and the summary."""
         return ""
 
     def finished(self) -> tuple[str, str] | None:

@@ -48,7 +48,6 @@ from dcsim.scenario.model import DebrisMissionSection, Scenario
 from dcsim.world import World
 from dcsim.world.objects import ObjectStatus
 
-
 #: Gap kept between carried cargo and a target being approached, m.
 CARGO_CLEARANCE = 0.1
 
@@ -130,9 +129,7 @@ class DebrisMission(Mission):
         """The thesis's SAFETY_DISTANCE, m."""
         return self.settings.safety_distance
 
-    def tick(
-        self, time: float, estimate: StateEstimate, observations: Observations
-    ) -> Reference:
+    def tick(self, time: float, estimate: StateEstimate, observations: Observations) -> Reference:
         """Advance the state machine at ``time`` and return the reference to track."""
         self.time = time
         self.estimate = estimate
@@ -153,9 +150,11 @@ class DebrisMission(Mission):
         }
 
     def progress(self) -> str:
-        """Targets delivered out of all."""
+        """Targets delivered out of all, and captured."""
         field = self.world.field
-        return f"delivered {field.count(ObjectStatus.DELIVERED)}/{int(field.is_target.sum())}"
+        delivered = field.count(ObjectStatus.DELIVERED)
+        captured = field.count(ObjectStatus.CARRIED) + delivered
+        return f"delivered {delivered}/{int(field.is_target.sum())}, captured {captured}"
 
     def finished(self) -> tuple[str, str] | None:
         """Completed once every target is delivered, if the stop rules say so."""

@@ -23,10 +23,10 @@ from dcsim.errors import PluginInterfaceError, PluginParameterError
 from dcsim.interfaces import PLUGIN_KINDS, Controller, Localiser, Plugin
 from dcsim.messages import (
     Command,
-    StateEstimate,
     NoPath,
     Plan,
     Reference,
+    StateEstimate,
     Surroundings,
     Trajectory,
 )

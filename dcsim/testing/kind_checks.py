@@ -7,7 +7,7 @@ import time
 import numpy as np
 
 from dcsim.interfaces import Plugin
-from dcsim.messages import StateEstimate, NoPath, Reference, Surroundings, Trajectory
+from dcsim.messages import NoPath, Reference, StateEstimate, Surroundings, Trajectory
 from dcsim.testing import problems
 from dcsim.testing.contracts import (
     LOCALISER_ERROR_BOUND,
@@ -336,9 +336,7 @@ def check_double_integrator(plugin_class: type[Plugin]) -> None:
     position, velocity = np.array([10.0, -5.0, 3.0]), np.zeros(3)
     reference = Reference(time=0.0, position=[0.0, 0.0, 0.0])
     for k in range(10_000):
-        estimate = StateEstimate(
-            time=k * dt, position=position, velocity=velocity, converged=True
-        )
+        estimate = StateEstimate(time=k * dt, position=position, velocity=velocity, converged=True)
         force = plugin.command(k * dt, estimate, reference, Surroundings()).force
         velocity = velocity + force / robot.mass * dt
         position = position + velocity * dt

@@ -28,10 +28,10 @@ from filterpy.kalman import ExtendedKalmanFilter
 from dcsim.api import (
     BeaconRange,
     Localiser,
-    StateEstimate,
     MotionInput,
     PluginParams,
     Prior,
+    StateEstimate,
     hookimpl,
     quantity,
 )

@@ -36,10 +36,10 @@ import numpy as np
 from dcsim.api import (
     BeaconRange,
     Localiser,
-    StateEstimate,
     MotionInput,
     PluginParams,
     Prior,
+    StateEstimate,
     hookimpl,
     quantity,
 )

@@ -19,10 +19,10 @@ from scipy.optimize import least_squares
 from dcsim.api import (
     BeaconRange,
     Localiser,
-    StateEstimate,
     MotionInput,
     PluginParams,
     Prior,
+    StateEstimate,
     hookimpl,
     quantity,
 )

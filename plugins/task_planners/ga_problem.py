@@ -1,9 +1,9 @@
 """A task request as arrays, for evaluating whole populations of plans at once.
 
-The ``ga`` planner's model of a plan (see :mod:`dcsim_plugins.task_planners.ga`): the collector flies
-straight constant-velocity legs between timed nodes — its start, each pickup, each drop
-visit — and burns impulsively at every node to match the node's velocity. A leg from
-``(p_a, u_a)`` at ``t_a`` to ``(p_b, u_b)`` at ``t_b`` costs
+The ``ga`` planner's model of a plan (see :mod:`dcsim_plugins.task_planners.ga`): the
+collector flies straight constant-velocity legs between timed nodes — its start, each
+pickup, each drop visit — and burns impulsively at every node to match the node's
+velocity. A leg from ``(p_a, u_a)`` at ``t_a`` to ``(p_b, u_b)`` at ``t_b`` costs
 
     |v − u_a| + |v − u_b| + w (t_b − t_a),        v = (p_b − p_a) / (t_b − t_a),
 

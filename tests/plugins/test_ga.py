@@ -21,9 +21,9 @@ from dcsim_plugins.task_planners.ga_problem import PlanModel, TaskProblem
 from dcsim.api import (
     DropPoint,
     LinearMotion,
-    StateEstimate,
     ObjectKind,
     ObjectTrack,
+    StateEstimate,
     StaticMotion,
     TaskRequest,
     plan_cost,

@@ -11,9 +11,9 @@ from dcsim_plugins.task_planners.nearest import NearestTaskPlanner
 from dcsim.api import (
     DropPoint,
     LinearMotion,
-    StateEstimate,
     ObjectKind,
     ObjectTrack,
+    StateEstimate,
     StaticMotion,
     TaskRequest,
     plan_delta_v,

@@ -9,10 +9,10 @@ import time
 
 import numpy as np
 import pytest
-from dcsim_plugins.task_planners.nearest import NearestTaskPlanner
 from dcsim_plugins.controllers.pd import PDController
-from dcsim_plugins.path_planners.straight_line import StraightLinePlanner
 from dcsim_plugins.localisers.trilateration import TrilaterationLocaliser
+from dcsim_plugins.path_planners.straight_line import StraightLinePlanner
+from dcsim_plugins.task_planners.nearest import NearestTaskPlanner
 
 from dcsim.api import Command, PluginRegistry
 from dcsim.testing import ControllerContract, check_plugin, checks_for
