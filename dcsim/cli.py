@@ -18,6 +18,7 @@ from dcsim import __version__
 from dcsim.errors import DcsimError, PluginLoadWarning
 from dcsim.interfaces import PLUGIN_KINDS
 from dcsim.registry import PluginRegistry
+from dcsim.rundir import prepare_run_directory
 from dcsim.runsetup import prepare_run
 from dcsim.scenario import load_scenario
 
@@ -123,6 +124,7 @@ def validate_command(files: tuple[Path, ...]) -> None:
     type=click.Path(file_okay=False, path_type=Path),
     help="Run directory to write (created if missing). Default: runs/NAME-YYYYmmdd-HHMMSS.",
 )
+@click.option("--force", is_flag=True, help="Replace the run directory if it already holds a run.")
 @click.option("--seed", type=click.IntRange(min=0), help="Seed for this run; replaces world.seed.")
 @click.option(
     "--set",
@@ -133,7 +135,11 @@ def validate_command(files: tuple[Path, ...]) -> None:
     "--set targets[0].motion.r=150000; the value is read as YAML. Repeatable.",
 )
 def run_command(
-    scenario: Path | None, out: Path | None, seed: int | None, overrides: tuple[str, ...]
+    scenario: Path | None,
+    out: Path | None,
+    force: bool,
+    seed: int | None,
+    overrides: tuple[str, ...],
 ) -> None:
     """Run SCENARIO (default: the scenario shipped with dcsim) and record it.
 
@@ -141,14 +147,19 @@ def run_command(
     their validated parameters, and the mission flown until it is done (for debris:
     every target delivered), world.duration is reached, or a stop rule ends it. The run
     directory receives scenario.yaml (resolved, to repeat the run), telemetry.csv, events.jsonl,
-    summary.json and plots/. Exit status: 0 when the run completed or was stopped by a
-    stop rule, 1 when a plugin failed, 130 when interrupted with Ctrl-C.
+    summary.json and plots/; scenario.yaml and a summary with status "running" are
+    there before the first step, and telemetry is streamed as the run goes. A run
+    directory that cannot be written, or that already holds a run (unless --force), is
+    refused before anything runs. Exit status: 0 when the run completed or was stopped
+    by a stop rule, 1 when a plugin failed or the records could not be written, 130
+    when interrupted with Ctrl-C.
     """
     from dcsim.runner import Runner, terminal_progress  # the world engine loads PyBullet
 
     setup = prepare_run(scenario, overrides, seed, registry=_registry())
     if out is None:
         out = Path("runs") / f"{setup.scenario.name}-{datetime.now():%Y%m%d-%H%M%S}"
+    prepare_run_directory(out, force)
     summary = Runner(setup, out, progress=terminal_progress()).run()
     if sys.stderr.isatty():
         click.echo("", err=True)
@@ -248,6 +259,75 @@ def bench_world_command(objects: str, duration: float) -> None:
         f"{summary['sim_time_s']:.1f} s simulated in {summary['wall_time_s']:.2f} s, "
         f"real-time factor {summary['real_time_factor']:.0f}"
     )
+
+
+@bench_group.command("soak")
+@click.option(
+    "--ticks",
+    type=click.IntRange(min=100),
+    default=1_000_000,
+    show_default=True,
+    help="Control ticks to fly.",
+)
+@click.option(
+    "--samples",
+    type=click.IntRange(min=10),
+    default=100,
+    show_default=True,
+    help="Memory and speed samples, evenly spaced.",
+)
+@click.option(
+    "--fmu-cycles",
+    type=click.IntRange(min=0),
+    default=200,
+    show_default=True,
+    help="FMU instantiate/step/terminate/free cycles after the run (0: none).",
+)
+@click.option(
+    "--out",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=None,
+    help="Run directory for the soak run's records (default: a temporary one).",
+)
+@click.option(
+    "--plot",
+    "plot_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Write memory and time per tick against ticks as a PNG.",
+)
+def bench_soak_command(
+    ticks: int, samples: int, fmu_cycles: int, out: Path | None, plot_path: Path | None
+) -> None:
+    """A long run's resident memory and time per tick, and repeated FMU lifetimes.
+
+    Flies the default scenario for TICKS control ticks with its records streamed to
+    disk, sampling resident memory and wall time per tick; then runs FMU-CYCLES
+    lifetimes of the closed-loop FMU in the same process. Prints Markdown for
+    docs/benchmarks.md.
+    """
+    import tempfile
+
+    from dcsim.bench import soak
+
+    def say(line: str) -> None:
+        click.echo(line, err=True)
+
+    with tempfile.TemporaryDirectory(prefix="dcsim-soak-run-") as tmp:
+        run_dir = prepare_run_directory(out or Path(tmp) / "run", force=False)
+        result = soak.soak(ticks, samples, run_dir, say)
+    click.echo(soak.markdown_table(result))
+    if plot_path is not None:
+        soak.plot(result, plot_path)
+        click.echo(f"\nplot: {plot_path}")
+    if fmu_cycles:
+        memory = soak.fmu_cycles(fmu_cycles, say)
+        early = memory[min(len(memory), 20) - 1]
+        click.echo(
+            f"\nFMU: {fmu_cycles} cycles, resident memory {early / 2**20:.1f} MB after cycle "
+            f"{min(len(memory), 20)}, {memory[-1] / 2**20:.1f} MB after the last "
+            f"({100 * (memory[-1] - early) / early:+.1f} %)"
+        )
 
 
 @bench_group.command("localisers")

@@ -1,4 +1,12 @@
-"""What a run records: telemetry rows, the event log, the summary.
+"""What a run records, streamed to its run directory as it goes.
+
+A run directory is useful at every instant: ``scenario.yaml`` (the resolved scenario)
+and a ``summary.json`` with ``status: running`` are written before the first tick;
+telemetry rows are appended to ``telemetry.csv`` in buffered blocks, flushed at least
+every :data:`FLUSH_SECONDS` of wall time and at every event; events are appended to
+``events.jsonl`` as they happen; the final ``summary.json`` replaces the first one
+atomically at the end. Memory stays flat however long the run: no row is kept unless
+the run records in memory only.
 
 Telemetry and events are written deterministically (floats in their shortest
 round-trip form), so the same scenario and seed give byte-identical files.
@@ -7,11 +15,21 @@ round-trip form), so the same scenario and seed give byte-identical files.
 from __future__ import annotations
 
 import json
+import os
+import time as wallclock
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
+
+from dcsim.errors import DcsimError
+
+FLUSH_SECONDS = 2.0
+"""Longest wall time between two flushes of the telemetry, s."""
+
+FLUSH_ROWS = 2000
+"""Rows buffered at most before they are written."""
 
 _LEADING_COLUMNS = (
     "time",
@@ -21,6 +39,11 @@ _LEADING_COLUMNS = (
     "mode", "converged",
 )  # fmt: skip
 _TRAILING_COLUMNS = ("fuel_used", "delta_v", "nearest_obstacle", "fx", "fy", "fz")
+_TEXT_COLUMNS = frozenset({"mode"})
+
+
+class RecordingError(DcsimError):
+    """The run directory could not be written (disk full, permissions, a vanished folder)."""
 
 
 def telemetry_columns(mission_columns: Sequence[str]) -> tuple[str, ...]:
@@ -52,56 +75,238 @@ def to_json(data: Mapping[str, Any]) -> str:
     return json.dumps({k: _json_value(v) for k, v in data.items()}, separators=(", ", ": "))
 
 
+def write_summary(out_dir: Path, summary: Mapping[str, Any]) -> None:
+    """Write ``summary.json`` atomically: readers see the old file or the new, never half.
+
+    Raises
+    ------
+    RecordingError
+        If the file cannot be written.
+    """
+    text = json.dumps({k: _json_value(v) for k, v in summary.items()}, indent=2) + "\n"
+    temporary = out_dir / ".summary.json.tmp"
+    try:
+        temporary.write_text(text, encoding="utf-8")
+        os.replace(temporary, out_dir / "summary.json")
+    except OSError as error:
+        raise RecordingError(f"cannot write {out_dir / 'summary.json'}: {error}") from error
+
+
 class Recorder:
-    """Collects telemetry rows and events, and writes them into a run directory.
+    """Streams telemetry rows and events into a run directory, or keeps them in memory.
 
     Parameters
     ----------
     out_dir : Path or None
-        Run directory; None keeps everything in memory only.
+        Run directory, created if missing (:func:`dcsim.rundir.prepare_run_directory`
+        checks one before a run); None records in memory only.
     columns : sequence of str
         The telemetry columns (:func:`telemetry_columns`).
+    keep_rows : bool, optional
+        Keep every row in :attr:`rows` as well; by default only when there is no run
+        directory.
+
+    Attributes
+    ----------
+    rows : list of dict
+        The rows kept in memory (empty unless ``keep_rows``).
+    events : list of dict
+        Every event so far.
+    count : int
+        Rows recorded so far.
+    last_row : dict or None
+        The latest row.
     """
 
-    def __init__(self, out_dir: Path | None, columns: Sequence[str]) -> None:
+    def __init__(
+        self, out_dir: Path | None, columns: Sequence[str], keep_rows: bool | None = None
+    ) -> None:
         self.out_dir = out_dir
         self.columns = tuple(columns)
+        self.keep_rows = out_dir is None if keep_rows is None else keep_rows
         self.rows: list[dict[str, Any]] = []
         self.events: list[dict[str, Any]] = []
+        self.count = 0
+        self.last_row: dict[str, Any] | None = None
+        self._pending: list[str] = []
+        self._flushed_at = wallclock.perf_counter()
+        self._telemetry_file: IO[str] | None = None
         self._events_file: IO[str] | None = None
-        if out_dir is not None:
-            out_dir.mkdir(parents=True, exist_ok=True)
-            self._events_file = (out_dir / "events.jsonl").open("w", encoding="utf-8")
 
-    def row(self, values: dict[str, Any]) -> None:
-        """Keep one telemetry row (a value for every column)."""
-        self.rows.append(values)
-
-    def event(self, values: dict[str, Any]) -> None:
-        """Keep one event and append it to ``events.jsonl`` straight away."""
-        self.events.append(values)
-        if self._events_file is not None:
-            self._events_file.write(to_json(values) + "\n")
-            self._events_file.flush()
-
-    def telemetry(self) -> dict[str, np.ndarray]:
-        """The telemetry so far as one array per column."""
-        return {c: np.array([r[c] for r in self.rows]) for c in self.columns}
-
-    def write(self, summary: Mapping[str, Any], scenario_yaml: str) -> None:
-        """Write ``scenario.yaml``, ``telemetry.csv`` and ``summary.json``; close the log."""
-        if self._events_file is not None:
-            self._events_file.close()
-            self._events_file = None
+    def start(self, scenario_yaml: str, summary: Mapping[str, Any]) -> None:
+        """Write ``scenario.yaml`` and the first ``summary.json``; open the streams."""
         if self.out_dir is None:
             return
-        (self.out_dir / "scenario.yaml").write_text(scenario_yaml, encoding="utf-8")
-        with (self.out_dir / "telemetry.csv").open("w", encoding="utf-8") as out:
-            out.write(",".join(self.columns) + "\n")
-            for row in self.rows:
-                out.write(",".join(_cell(row[c]) for c in self.columns) + "\n")
-        text = json.dumps({k: _json_value(v) for k, v in summary.items()}, indent=2)
-        (self.out_dir / "summary.json").write_text(text + "\n", encoding="utf-8")
+        with self._writing("scenario.yaml"):
+            self.out_dir.mkdir(parents=True, exist_ok=True)
+            (self.out_dir / "scenario.yaml").write_text(scenario_yaml, encoding="utf-8")
+        write_summary(self.out_dir, summary)
+        with self._writing("telemetry.csv"):
+            self._telemetry_file = (self.out_dir / "telemetry.csv").open("w", encoding="utf-8")
+            self._telemetry_file.write(",".join(self.columns) + "\n")
+            self._telemetry_file.flush()
+        with self._writing("events.jsonl"):
+            self._events_file = (self.out_dir / "events.jsonl").open("w", encoding="utf-8")
+
+    def row(self, values: dict[str, Any]) -> None:
+        """Record one telemetry row (a value for every column)."""
+        self.count += 1
+        self.last_row = values
+        if self.keep_rows:
+            self.rows.append(values)
+        if self._telemetry_file is None:
+            return
+        self._pending.append(",".join(_cell(values[c]) for c in self.columns))
+        if len(self._pending) >= FLUSH_ROWS or (
+            wallclock.perf_counter() - self._flushed_at > FLUSH_SECONDS
+        ):
+            self.flush()
+
+    def event(self, values: dict[str, Any]) -> None:
+        """Record one event: append it to ``events.jsonl`` and flush the telemetry."""
+        self.events.append(values)
+        if self._events_file is None:
+            return
+        with self._writing("events.jsonl"):
+            self._events_file.write(to_json(values) + "\n")
+            self._events_file.flush()
+        self.flush()
+
+    def flush(self) -> None:
+        """Write the buffered telemetry rows to the file."""
+        self._flushed_at = wallclock.perf_counter()
+        if self._telemetry_file is None or not self._pending:
+            return
+        lines, self._pending = self._pending, []
+        with self._writing("telemetry.csv"):
+            self._telemetry_file.write("\n".join(lines) + "\n")
+            self._telemetry_file.flush()
+
+    def telemetry(self, max_points: int | None = None) -> dict[str, np.ndarray]:
+        """The telemetry so far, one array per column.
+
+        From memory when rows are kept, else read back from ``telemetry.csv``.
+
+        Parameters
+        ----------
+        max_points : int, optional
+            Keep at most about this many rows, evenly spaced (the first and the last
+            always), for plots.
+        """
+        if self.keep_rows or self.out_dir is None:
+            rows = self.rows[:: _stride(len(self.rows), max_points)]
+            return _columns(self.columns, rows)
+        self.flush()
+        return read_telemetry(self.out_dir / "telemetry.csv", max_points)
+
+    def finish(self, summary: Mapping[str, Any]) -> None:
+        """Flush and close the streams, then replace ``summary.json`` with the final one."""
+        try:
+            self.flush()
+        finally:
+            self._close()
+        if self.out_dir is not None:
+            write_summary(self.out_dir, summary)
+
+    def _close(self) -> None:
+        for stream in (self._telemetry_file, self._events_file):
+            if stream is not None:
+                try:
+                    stream.close()
+                except OSError:
+                    pass  # what could be written is on disk; the run already failed
+        self._telemetry_file = self._events_file = None
+
+    def _writing(self, name: str) -> _WriteGuard:
+        return _WriteGuard(self, name)
+
+
+class _WriteGuard:
+    """Turns an OSError while writing a run file into a :class:`RecordingError`.
+
+    After the first failure the recorder stops writing (what is on disk stays) but keeps
+    recording in memory, so the run can end ``failed`` with its reason.
+    """
+
+    def __init__(self, recorder: Recorder, name: str) -> None:
+        self.recorder, self.name = recorder, name
+
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, kind: type | None, error: BaseException | None, trace: Any) -> bool:
+        if isinstance(error, OSError):
+            recorder = self.recorder
+            recorder._close()
+            recorder._pending.clear()
+            raise RecordingError(f"cannot write {recorder.out_dir / self.name}: {error}") from error
+        return False
+
+
+def _stride(rows: int, max_points: int | None) -> int:
+    """Step between kept rows so that about ``max_points`` of ``rows`` remain."""
+    if max_points is None or rows <= max_points:
+        return 1
+    return -(-rows // max_points)
+
+
+def _columns(columns: Sequence[str], rows: Sequence[Mapping[str, Any]]) -> dict[str, np.ndarray]:
+    return {c: np.array([r[c] for r in rows]) for c in columns}
+
+
+def read_telemetry(path: Path, max_points: int | None = None) -> dict[str, np.ndarray]:
+    """Read a ``telemetry.csv``, tolerating a last line cut short by a killed run.
+
+    Parameters
+    ----------
+    path : Path
+        The file.
+    max_points : int, optional
+        Keep about this many rows, evenly spaced, plus the first and last and the rows
+        on both sides of every change of ``mode``; the file is streamed, so memory
+        follows ``max_points``, not the file's length.
+
+    Returns
+    -------
+    dict of str to ndarray
+        One array per column: floats, except ``mode`` (text).
+    """
+    step = 1 if max_points is None else _stride(_count_lines(path) - 1, max_points)
+    kept: list[list[str]] = []
+    last: list[str] | None = None
+    with path.open(encoding="utf-8") as stream:
+        header = stream.readline().rstrip("\n").split(",")
+        mode = header.index("mode") if "mode" in header else None
+        for index, text in enumerate(stream):
+            fields = text.rstrip("\n").split(",")
+            if not text.endswith("\n") or len(fields) != len(header):
+                continue  # the line a killed run was writing
+            switched = mode is not None and last is not None and fields[mode] != last[mode]
+            if switched and kept[-1] is not last:
+                kept.append(last)  # a mode change stays sharp however thin the rows
+            if index % step == 0 or switched:
+                kept.append(fields)
+            last = fields
+    if last is not None and kept[-1] is not last:
+        kept.append(last)
+    return _parse(header, kept)
+
+
+def _count_lines(path: Path) -> int:
+    """Number of line ends in a file, read in blocks."""
+    count = 0
+    with path.open("rb") as stream:
+        while block := stream.read(1 << 20):
+            count += block.count(b"\n")
+    return count
+
+
+def _parse(header: Sequence[str], lines: Sequence[Sequence[str]]) -> dict[str, np.ndarray]:
+    table: dict[str, np.ndarray] = {}
+    for index, name in enumerate(header):
+        values = [line[index] for line in lines]
+        table[name] = np.array(values) if name in _TEXT_COLUMNS else np.array(values, float)
+    return table
 
 
 def _cell(value: Any) -> str:

@@ -36,12 +36,15 @@ from dcsim.messages import Command, Observations, Prior, StateEstimate
 from dcsim.missions import Mission, mission_class
 from dcsim.plots import write_plots
 from dcsim.plugin_calls import PluginFailure, call_plugin
-from dcsim.recording import Recorder, telemetry_columns
+from dcsim.recording import Recorder, RecordingError, telemetry_columns
 from dcsim.runsetup import RunSetup
 from dcsim.scenario import dump_scenario
 from dcsim.scenario.model import point_to_cartesian
 from dcsim.seeding import component_rng
 from dcsim.world import World, WorldInputs
+
+PLOT_POINTS = 2000
+"""Telemetry rows the end-of-run plots draw at most (evenly spaced)."""
 
 Progress = Callable[[float, float, str, str], None]
 """``progress(sim_time, duration, mode, mission_progress)``: times in s."""
@@ -98,11 +101,17 @@ class Runner:
     setup : RunSetup
         The resolved scenario and its constructed plugins.
     out_dir : Path, optional
-        Run directory to write; None records in memory only.
+        Run directory to stream the records into (created if missing; see
+        :func:`dcsim.rundir.prepare_run_directory` for the checks the CLI makes first);
+        None records in memory only.
     progress : callable, optional
         ``progress(sim_time, duration, mode, mission_progress)``, called about four
         times a second of wall time by :meth:`run` (``mission_progress`` is the
         mission's own few words, e.g. ``delivered 1/4``).
+    keep_rows : bool, optional
+        Keep every telemetry row in memory (``recorder.rows``); by default only when
+        there is no run directory. A long run that needs only its summary (an FMU)
+        passes False, so memory stays flat.
 
     Attributes
     ----------
@@ -126,12 +135,13 @@ class Runner:
         setup: RunSetup,
         out_dir: Path | None = None,
         progress: Progress | None = None,
+        keep_rows: bool | None = None,
     ) -> None:
         self.setup = setup
         self.scenario = setup.scenario
         self.plugins = setup.plugins
         self.mission_class = mission_class(self.scenario.mission.type)
-        self.recorder = Recorder(out_dir, telemetry_columns(self.mission_class.columns))
+        self.recorder = Recorder(out_dir, telemetry_columns(self.mission_class.columns), keep_rows)
         self.info = RunInfo(self.scenario, self.scenario.world.seed, out_dir)
         self.progress = progress
         self.world: World | None = None
@@ -145,6 +155,9 @@ class Runner:
         self._command = Command()
         self._robot_changes = 0
         self._started = 0.0
+        self._squared_error_sum = 0.0
+        self._converged_rows = 0
+        self._min_gap = float("inf")
 
     @property
     def ended(self) -> bool:
@@ -227,18 +240,31 @@ class Runner:
             self._end("stopped", "closed before the end")
         self.summary = self._summary(wallclock.perf_counter() - self._started)
         self.world.close()
-        if self.info.out_dir is not None:
-            self.recorder.write(self.summary, dump_scenario(self.scenario))
+        try:
+            self.recorder.finish(self.summary)
+            self._plot()
+        except RecordingError as failure:
+            if self.status != "failed":
+                self._end("failed", str(failure))
+                self.summary.update(status=self.status, reason=self.reason)
+        self._hook("dcsim_run_end", run=self.info, summary=self.summary)
+        return self.summary
+
+    def _plot(self) -> None:
+        """Draw the run's pictures from its telemetry file."""
+        if self.info.out_dir is None:
+            return
+        try:
             write_plots(
                 self.info.out_dir,
                 self.scenario,
-                self.recorder.telemetry(),
+                self.recorder.telemetry(max_points=PLOT_POINTS),
                 self.recorder.events,
                 self.mission_class.modes,
                 self.mission.safety_distance,
             )
-        self._hook("dcsim_run_end", run=self.info, summary=self.summary)
-        return self.summary
+        except OSError as error:
+            raise RecordingError(f"cannot draw the plots: {error}") from error
 
     # ------------------------------------------------------------------ loop
     def _guarded(self, step: Callable[..., None], *args: Any) -> None:
@@ -252,7 +278,7 @@ class Runner:
             self._event(
                 "plugin_failed", role=failure.role, plugin=failure.plugin, error=str(failure.error)
             )
-        except HookFailure as failure:
+        except (HookFailure, RecordingError) as failure:
             self._end("failed", str(failure))
 
     def _end(self, status: str, reason: str) -> None:
@@ -260,6 +286,7 @@ class Runner:
 
     def _start(self) -> None:
         world = self.world
+        self.recorder.start(dump_scenario(self.scenario), self._summary_head("running", ""))
         self._hook("dcsim_run_start", run=self.info)
         self.mission = self.mission_class(self.scenario, world, self.plugins, self._event)
         call_plugin(self.plugins, "localiser", "reset", self._prior(), 0.0)
@@ -362,12 +389,13 @@ class Runner:
             nearest_obstacle=out["nearest_obstacle_distance"],
         )
         row.update(zip(("fx", "fy", "fz"), force, strict=True))
+        self._accumulate(out, estimate)
         self.recorder.row(row)
         self._hook("dcsim_run_step", run=self.info, row=row)
 
     def _record_final(self, mode: str) -> None:
         """Record the state reached by the last step (the run ends after it)."""
-        last = self.recorder.rows[-1]
+        last = self.recorder.last_row
         estimate = StateEstimate(
             time=self.world.time,
             position=[last["est_x"], last["est_y"], last["est_z"]],
@@ -389,35 +417,44 @@ class Runner:
         except Exception as error:  # a hook implementation's own bug
             raise HookFailure(f"hook {name} raised: {type(error).__name__}: {error}") from error
 
-    def _summary(self, wall: float) -> dict[str, Any]:
-        world = self.world
-        telemetry = self.recorder.telemetry()
-        converged = (
-            telemetry["converged"].astype(bool) if len(self.recorder.rows) else np.zeros(0, bool)
-        )
-        errors = np.zeros(0)
-        if converged.any():
-            true = np.column_stack([telemetry[c] for c in ("x", "y", "z")])[converged]
-            est = np.column_stack([telemetry[c] for c in ("est_x", "est_y", "est_z")])[converged]
-            errors = np.linalg.norm(true - est, axis=1)
-        gaps = telemetry["nearest_obstacle"] if len(self.recorder.rows) else np.zeros(0)
-        sim_time = world.time
+    def _accumulate(self, outputs: dict[str, Any], estimate: StateEstimate) -> None:
+        """Update the running figures of the summary with one recorded tick."""
+        if estimate.converged:
+            error = outputs["position"] - estimate.position
+            self._squared_error_sum += float(error @ error)
+            self._converged_rows += 1
+        self._min_gap = min(self._min_gap, float(outputs["nearest_obstacle_distance"]))
+
+    def _summary_head(self, status: str, reason: str) -> dict[str, Any]:
+        """The fields that say what ran and how it ended (or that it is running)."""
         return {
-            "status": self.status,
-            "reason": self.reason,
+            "status": status,
+            "reason": reason,
             "scenario": self.scenario.name,
             "mission": self.mission_class.type,
             "seed": self.scenario.world.seed,
+        }
+
+    def _summary(self, wall: float) -> dict[str, Any]:
+        world = self.world
+        sim_time = world.time
+        rmse = (
+            float(np.sqrt(self._squared_error_sum / self._converged_rows))
+            if self._converged_rows
+            else None
+        )
+        return {
+            **self._summary_head(self.status, self.reason),
             "sim_time_s": sim_time,
             "wall_time_s": wall,
             "real_time_factor": sim_time / wall if wall > 0 else None,
             "outcome": self.mission.progress(),
-            **self.mission.summary_fields(telemetry),
+            **self.mission.summary_fields(),
             "collisions": len(world.collisions),
             "fuel_used_kg": world.fuel_used,
             "delta_v_mps": world.delta_v,
-            "localisation_rmse_m": float(np.sqrt(np.mean(errors**2))) if errors.size else None,
-            "min_obstacle_distance_m": float(gaps.min()) if gaps.size else None,
+            "localisation_rmse_m": rmse,
+            "min_obstacle_distance_m": self._min_gap if self.recorder.count else None,
             "plugins": self.setup.plugin_versions(),
             "wall_time_by_phase_s": dict(sorted(self.laps.totals.items())),
         }

@@ -29,7 +29,7 @@ def test_help_lists_commands(dcsim_cli):
     [
         ("plugins", ["--kind", "--json"]),
         ("validate", ["FILES"]),
-        ("run", ["--out", "--seed", "--set", "SCENARIO"]),
+        ("run", ["--out", "--force", "--seed", "--set", "SCENARIO"]),
     ],
 )
 def test_command_help_explains_every_option(dcsim_cli, command, options):
@@ -146,7 +146,7 @@ def test_run_writes_resolved_scenario_with_seed_and_overrides(dcsim_cli, tmp_pat
         ),
         (
             "controller.params.gian=2",
-            "controller.params.gian: unknown key (known keys: bandwidth, damping)",
+            "controller.params.gian: unknown key (known keys: bandwidth, damping, attitude_bandwidth, attitude_damping)",
         ),
         ("targets[7].mass=1", "targets[7]: index 7 is out of range (the list has 4 items)"),
         ("robot.mass", "expected key.path=value"),

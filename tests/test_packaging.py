@@ -30,7 +30,7 @@ def test_wheel_carries_the_default_scenario_plugins_and_entry_points(wheel):
             archive.read(n).decode() for n in names if n.endswith("entry_points.txt")
         )
     assert "dcsim/scenarios/default.yaml" in names
-    assert {"dcsim_plugins/pd.py", "dcsim_plugins/nearest.py"} <= names
+    assert {"dcsim_plugins/controllers/pd.py", "dcsim_plugins/task_planners/nearest.py"} <= names
     assert not any(n.startswith("plugins/") for n in names)
     assert (
         "pd = dcsim_plugins.controllers.pd" in entry_points

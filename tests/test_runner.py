@@ -262,7 +262,7 @@ def test_hooks_observe_the_whole_run_and_an_interrupt_keeps_the_record(tmp_path)
     runner, summary = run(out=out, registry=registry)
     assert summary["status"] == "stopped" and summary["reason"] == "interrupted"
     assert seen["start"] == 1 and seen["end"] == [summary]
-    assert seen["step"] == len(runner.recorder.rows) == 11
+    assert seen["step"] == runner.recorder.count == 11
     assert seen["event"] == len(runner.recorder.events)
     assert len((out / "telemetry.csv").read_text().splitlines()) == 12
     assert json.loads((out / "events.jsonl").read_text().splitlines()[-1])["event"] == "interrupted"

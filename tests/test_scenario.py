@@ -61,7 +61,12 @@ def test_packaged_default_is_the_repository_default():
 
 def test_resolution_fills_plugin_defaults(registry):
     scenario = load_scenario(registry=registry)
-    assert scenario.controller.params == {"bandwidth": 0.2, "damping": 0.9}
+    assert scenario.controller.params == {
+        "bandwidth": 0.2,
+        "damping": 0.9,
+        "attitude_bandwidth": 0.5,
+        "attitude_damping": 0.9,
+    }
     assert scenario.task_planner.plugin == "ga"
     assert scenario.task_planner.params["time_strategy"] == "mixed"
     assert scenario.task_planner.params["MIN_TIME_STEP"] == 1.0

@@ -294,7 +294,7 @@ class ClosedLoopSlave(_ScenarioSlave):
 
     def _open(self) -> None:
         setup = prepare_run(self.scenario_path, self._overrides(), seed=self.values["seed"])
-        self.runner = Runner(setup)
+        self.runner = Runner(setup, keep_rows=False)
         self.runner.open()
 
     def _advance(self) -> None:

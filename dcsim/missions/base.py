@@ -15,8 +15,6 @@ from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any, ClassVar
 
-import numpy as np
-
 from dcsim.interfaces import Plugin
 from dcsim.messages import Observations, Reference, StateEstimate, Surroundings
 from dcsim.plugin_calls import call_plugin
@@ -115,6 +113,7 @@ class Mission(ABC):
         """``(status, reason)`` once the mission is over (``completed`` or ``stopped``)."""
         return None
 
-    def summary_fields(self, telemetry: Mapping[str, np.ndarray]) -> dict[str, Any]:
-        """The mission's own fields of the run summary, from the telemetry recorded."""
+    def summary_fields(self) -> dict[str, Any]:
+        """The mission's own fields of the run summary (kept as running figures: the
+        telemetry is on disk, not in memory)."""
         return {}

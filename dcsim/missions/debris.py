@@ -168,7 +168,7 @@ class DebrisMission(Mission):
             return "completed", "all targets delivered"
         return None
 
-    def summary_fields(self, telemetry: Mapping[str, np.ndarray]) -> dict[str, Any]:
+    def summary_fields(self) -> dict[str, Any]:
         """Targets, and how many were captured and delivered."""
         field = self.world.field
         return {

@@ -42,6 +42,7 @@ class HoldMission(Mission):
         self.home: np.ndarray | None = None
         self.time = 0.0
         self.estimate = None
+        self.worst = 0.0
 
     @property
     def mode(self) -> str:
@@ -57,6 +58,7 @@ class HoldMission(Mission):
 
     def telemetry(self):
         error = 0.0 if self.home is None else np.linalg.norm(self.estimate.position - self.home)
+        self.worst = max(self.worst, float(error))
         return {"hold_error": float(error)}
 
     def finished(self):
@@ -64,8 +66,8 @@ class HoldMission(Mission):
             return "completed", f"held for {self.settings.hold_for:g} s"
         return None
 
-    def summary_fields(self, telemetry):
-        return {"worst_hold_error_m": float(np.max(telemetry["hold_error"]))}
+    def summary_fields(self):
+        return {"worst_hold_error_m": self.worst}
 
 
 register_mission(HoldMission)

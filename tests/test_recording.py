@@ -1,0 +1,153 @@
+"""Runs that survive: streamed telemetry, a run directory useful at every instant,
+checked output paths, and a run that fails cleanly when its disk fills."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+import tracemalloc
+
+import numpy as np
+
+from dcsim.recording import read_telemetry
+from dcsim.registry import PluginRegistry
+from dcsim.runner import Runner
+from dcsim.runsetup import prepare_run
+from dcsim.scenario import load_scenario
+from tests.conftest import DCSIM
+
+LONG_RUN = ["world.duration=100000", "stop.on_all_delivered=false"]
+
+
+def long_runner(out):
+    setup = prepare_run(None, LONG_RUN, registry=PluginRegistry.discover())
+    runner = Runner(setup, out)
+    runner.open()
+    return runner
+
+
+def test_telemetry_streams_to_disk_and_memory_stays_flat(tmp_path):
+    runner = long_runner(tmp_path)
+    telemetry = tmp_path / "telemetry.csv"
+    header = telemetry.stat().st_size
+    try:
+        for _ in range(500):
+            runner.advance()
+        tracemalloc.start()
+        early = tracemalloc.get_traced_memory()[0]
+        sizes = []
+        for _ in range(2):
+            for _ in range(1500):
+                runner.advance()
+            sizes.append(telemetry.stat().st_size)
+        grown = tracemalloc.get_traced_memory()[0] - early
+        tracemalloc.stop()
+    finally:
+        summary = runner.close()
+    assert runner.recorder.rows == [] and runner.recorder.count == 3501
+    assert header < sizes[0] < sizes[1]
+    # Keeping the 3000 rows would take about 3 MB.
+    assert grown < 250_000, grown
+    assert summary["status"] == "stopped"
+    table = read_telemetry(telemetry)
+    assert len(table["time"]) == 3501
+    np.testing.assert_allclose(np.diff(table["time"]), 0.1, atol=1e-9)
+
+
+def test_a_killed_run_leaves_a_readable_repeatable_run_directory(tmp_path):
+    out = tmp_path / "run"
+    args = [str(DCSIM), "run", "--out", str(out)] + [a for s in LONG_RUN for a in ("--set", s)]
+    child = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    telemetry = out / "telemetry.csv"
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            if telemetry.exists() and telemetry.read_text().count("\n") > 20:
+                break
+            time.sleep(0.2)
+    finally:
+        child.send_signal(signal.SIGKILL)
+        child.wait()
+    assert child.returncode == -signal.SIGKILL
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "running" and summary["scenario"] == "default"
+    repeated = load_scenario(out / "scenario.yaml")
+    assert repeated.world.duration == 100000 and not repeated.stop.on_all_delivered
+    table = read_telemetry(telemetry)
+    assert len(table["time"]) > 20 and table["time"][0] == 0.0
+    assert np.all(np.diff(table["time"]) > 0)
+
+
+def test_a_cut_last_line_is_left_out_and_mode_changes_survive_thinning(tmp_path):
+    path = tmp_path / "telemetry.csv"
+    modes = ["A"] * 500 + ["B"] + ["A"] * 499
+    lines = [f"{k * 0.1!r},{mode},{k}" for k, mode in enumerate(modes)]
+    path.write_text("time,mode,x\n" + "\n".join(lines) + "\n1000.0,A")
+    full = read_telemetry(path)
+    assert len(full["time"]) == 1000 and full["x"][-1] == 999
+    thin = read_telemetry(path, max_points=10)
+    assert len(thin["time"]) < 20
+    assert "B" in thin["mode"] and thin["x"][0] == 0 and thin["x"][-1] == 999
+    assert {499, 500, 501} <= set(thin["x"].astype(int))
+
+
+def test_bad_output_paths_are_refused_before_the_run(dcsim_cli, tmp_path):
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+    cases = {
+        "/proc/nope": "error: cannot write the run directory /proc/nope:",
+        str(blocker / "x"): f"error: cannot use {blocker / 'x'} as a run directory: "
+        f"{blocker} is a file",
+    }
+    for out, message in cases.items():
+        result = dcsim_cli("run", "--out", out, "--set", "world.duration=1")
+        assert result.returncode == 2, result.stderr
+        assert message in result.stderr and "Traceback" not in result.stderr
+
+
+def test_an_existing_run_is_replaced_only_with_force(dcsim_cli, tmp_path):
+    out = tmp_path / "run"
+    assert dcsim_cli("run", "--out", str(out), "--set", "world.duration=1").returncode == 0
+    (out / "stale.txt").write_text("from before")
+    again = dcsim_cli("run", "--out", str(out), "--set", "world.duration=2")
+    assert again.returncode == 2
+    assert f"error: {out} holds a run; choose another --out or add --force" in again.stderr
+    forced = dcsim_cli("run", "--out", str(out), "--force", "--set", "world.duration=2")
+    assert forced.returncode == 0, forced.stderr
+    assert not (out / "stale.txt").exists()
+    assert json.loads((out / "summary.json").read_text())["sim_time_s"] == 2.0
+
+
+DISK_FULL = """
+import resource, sys
+resource.setrlimit(resource.RLIMIT_FSIZE, (60_000, 60_000))
+from dcsim.cli import main
+sys.argv = ["dcsim", "run", "--out", sys.argv[1], "--set", "world.duration=600",
+            "--set", "stop.on_all_delivered=false"]
+main()
+"""
+
+
+def test_a_full_disk_ends_the_run_failed_and_keeps_what_was_written(tmp_path):
+    out = tmp_path / "run"
+    done = subprocess.run(
+        [sys.executable, "-c", DISK_FULL, str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "PYTHONPATH": ""},
+    )
+    assert done.returncode == 1, done.stderr
+    assert "Traceback" not in done.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "failed"
+    assert "cannot write" in summary["reason"] and "telemetry.csv" in summary["reason"]
+    assert "File too large" in summary["reason"]
+    assert (out / "telemetry.csv").stat().st_size <= 60_000
+    table = read_telemetry(out / "telemetry.csv")
+    assert len(table["time"]) > 100
+    assert summary["sim_time_s"] < 600
