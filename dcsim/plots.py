@@ -17,7 +17,7 @@ import numpy as np  # noqa: E402
 
 from dcsim.motion import MotionSet  # noqa: E402
 from dcsim.scenario.model import Scenario  # noqa: E402
-from dcsim.world.engine import build_objects  # noqa: E402
+from dcsim.world.objects import build_objects  # noqa: E402
 
 
 def write_plots(

@@ -1,4 +1,4 @@
-"""Space objects (targets and obstacles) as the world keeps them."""
+"""Space objects (targets and obstacles) as the world keeps them, and the field of them all."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ import numpy as np
 
 from dcsim.messages import ObjectKind
 from dcsim.motion import MotionModel, MotionSet
+from dcsim.scenario.model import Scenario
 
 
 class ObjectStatus(enum.IntEnum):
@@ -43,6 +44,19 @@ class SpaceObject:
     radius: float
     mass: float
     motion: MotionModel
+
+
+def build_objects(scenario: Scenario) -> list[SpaceObject]:
+    """The scenario's targets and obstacles as world objects (targets first)."""
+    n = scenario.mean_motion
+    return [
+        SpaceObject(spec.id, kind, spec.radius, spec.mass, spec.motion.build(n))
+        for kind, specs in (
+            (ObjectKind.TARGET, scenario.targets),
+            (ObjectKind.OBSTACLE, scenario.obstacles),
+        )
+        for spec in specs
+    ]
 
 
 class ObjectField:
