@@ -1,5 +1,9 @@
 """PyBullet bodies of a world: the collector, the objects' static bodies, carried targets.
 
+Each body has its object's true shape: a sphere, a box (``GEOM_BOX``, half extents) or
+a cylinder (``GEOM_CYLINDER``, its axis the body z axis), turned by the shape's fixed
+orientation wherever it is placed. The collector is a sphere.
+
 Every body has collision filtering off: contacts are detected by closest-point queries
 (:func:`surface_gap`), never resolved, so bodies pass through each other. A free
 object's body is static and is moved to its motion model's position only when a query
@@ -11,22 +15,21 @@ from __future__ import annotations
 
 import numpy as np
 
+from dcsim.messages import Shape, ShapeKind
 from dcsim.scenario.model import RobotSection, point_to_cartesian
 from dcsim.world.objects import ObjectField
 from dcsim.world.pybullet_client import pb
 
 
-def create_sphere(
-    client: int, radius: float, mass: float, position: np.ndarray, maximal: bool
-) -> int:
-    """A sphere body without collision response.
+def create_body(client: int, shape: Shape, mass: float, position: np.ndarray, maximal: bool) -> int:
+    """A body of ``shape`` without collision response.
 
     Parameters
     ----------
     client : int
         PyBullet client id.
-    radius : float
-        m.
+    shape : Shape
+        Sphere, box or cylinder; its orientation is the body's initial orientation.
     mass : float
         kg; 0 for a static body. A dynamic body gets no damping.
     position : ndarray (3,)
@@ -39,25 +42,46 @@ def create_sphere(
     int
         The body id.
     """
-    shape = pb.createCollisionShape(pb.GEOM_SPHERE, radius=radius, physicsClientId=client)
     body = pb.createMultiBody(
         baseMass=mass,
-        baseCollisionShapeIndex=shape,
+        baseCollisionShapeIndex=_collision_shape(client, shape),
         basePosition=position.tolist(),
+        baseOrientation=shape.orientation.tolist(),
         useMaximalCoordinates=maximal,
         physicsClientId=client,
     )
     pb.setCollisionFilterGroupMask(body, -1, 0, 0, physicsClientId=client)
+    if shape.kind is not ShapeKind.SPHERE:
+        # Bullet rounds a box's or a cylinder's edges by its collision margin (1 mm by
+        # default); without it their closest points are exact (to ~1e-7 m on curved faces).
+        pb.changeDynamics(body, -1, collisionMargin=0.0, physicsClientId=client)
     if mass > 0:
         pb.changeDynamics(body, -1, linearDamping=0, angularDamping=0, physicsClientId=client)
     return body
 
 
+def _collision_shape(client: int, shape: Shape) -> int:
+    """PyBullet collision shape of ``shape`` (a cylinder's axis is its local z)."""
+    if shape.kind is ShapeKind.BOX:
+        return pb.createCollisionShape(
+            pb.GEOM_BOX, halfExtents=shape.half_extents.tolist(), physicsClientId=client
+        )
+    if shape.kind is ShapeKind.CYLINDER:
+        return pb.createCollisionShape(
+            pb.GEOM_CYLINDER, radius=shape.radius, height=shape.height, physicsClientId=client
+        )
+    return pb.createCollisionShape(pb.GEOM_SPHERE, radius=shape.radius, physicsClientId=client)
+
+
 def create_collector(client: int, robot: RobotSection) -> int:
     """The collector's sphere body at its initial state (position, attitude, velocities)."""
     initial = robot.initial
-    body = create_sphere(
-        client, robot.radius, robot.mass, point_to_cartesian(initial.position), False
+    body = create_body(
+        client,
+        Shape(ShapeKind.SPHERE, radius=robot.radius),
+        robot.mass,
+        point_to_cartesian(initial.position),
+        False,
     )
     attitude = np.asarray(initial.attitude) / np.linalg.norm(initial.attitude)
     pb.resetBasePositionAndOrientation(
@@ -112,13 +136,14 @@ class ObjectBodies:
     def __init__(self, client: int, field: ObjectField) -> None:
         self._client = client
         self._field = field
+        self._orientations = [obj.shape.orientation.tolist() for obj in field.objects]
         self.ids = [
-            create_sphere(client, obj.radius, 0.0, field.free_states(0.0)[0][index], True)
+            create_body(client, obj.shape, 0.0, field.free_states(0.0)[0][index], True)
             for index, obj in enumerate(field.objects)
         ]
 
     def place(self, index: int, time: float) -> int:
-        """Move free object ``index``'s static body to its model position at ``time`` (s).
+        """Move free object ``index``'s static body to its model pose at ``time`` (s).
 
         Returns
         -------
@@ -128,12 +153,12 @@ class ObjectBodies:
         body = self.ids[index]
         position = self._field.objects[index].motion.state_at(time)[0]
         pb.resetBasePositionAndOrientation(
-            body, position.tolist(), [0, 0, 0, 1], physicsClientId=self._client
+            body, position.tolist(), self._orientations[index], physicsClientId=self._client
         )
         return body
 
     def make_dynamic(self, index: int, position: np.ndarray, velocity: np.ndarray) -> int:
-        """Replace object ``index``'s static body by a dynamic one of its mass.
+        """Replace object ``index``'s static body by a dynamic one of its mass and shape.
 
         Parameters
         ----------
@@ -149,7 +174,7 @@ class ObjectBodies:
         """
         pb.removeBody(self.ids[index], physicsClientId=self._client)
         obj = self._field.objects[index]
-        body = create_sphere(self._client, obj.radius, obj.mass, position, False)
+        body = create_body(self._client, obj.shape, obj.mass, position, False)
         pb.resetBaseVelocity(body, velocity.tolist(), [0, 0, 0], physicsClientId=self._client)
         self.ids[index] = body
         return body

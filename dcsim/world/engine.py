@@ -241,17 +241,51 @@ class World:
         return positions, velocities
 
     def nearest_obstacle_distance(self) -> float:
-        """Smallest surface gap between the collector (and cargo) and a free obstacle, m."""
+        """Smallest surface gap between the collector (and cargo) and a free obstacle, m.
+
+        Pairs of spheres are measured from their centres and radii, all at once. A pair
+        with a box or a cylinder is measured by PyBullet's closest points, only if its
+        bounding spheres are nearer than the nearest gap found so far.
+        """
         mask = self.field.free_mask() & ~self.field.is_target
         if not mask.any():
             return float("inf")
         positions = self.field.free_states(self.time)[0][mask]
         radii = self.field.radii[mask]
-        gaps = [
-            np.linalg.norm(positions - centre, axis=1) - radii - radius
-            for centre, radius in self._assembly_spheres()
-        ]
-        return float(np.min(gaps))
+        centres, part_radii = zip(*self._assembly_spheres(), strict=True)
+        distances = np.array([np.linalg.norm(positions - centre, axis=1) for centre in centres])
+        bounds = distances - radii - np.array(part_radii)[:, None]
+        exact = np.outer(self._assembly_is_sphere(), self.field.is_sphere[mask])
+        nearest = float(np.min(bounds, where=exact, initial=np.inf))
+        if exact.all():
+            return nearest
+        return self._nearest_shaped_gap(nearest, bounds, distances, ~exact, np.flatnonzero(mask))
+
+    def _nearest_shaped_gap(
+        self,
+        nearest: float,
+        bounds: np.ndarray,
+        distances: np.ndarray,
+        pending: np.ndarray,
+        obstacles: np.ndarray,
+    ) -> float:
+        """``nearest`` lowered by the true gaps of the ``pending`` (part, obstacle) pairs, m.
+
+        ``bounds`` are the pairs' bounding-sphere gaps (lower bounds of the true ones),
+        ``distances`` their centre distances (upper bounds: each shape holds its centre),
+        both (P, K); ``obstacles`` the field indices of the K obstacles. Pairs are
+        measured nearest bound first, until no bound is below the nearest gap.
+        """
+        parts, columns = np.nonzero(pending)
+        order = np.argsort(bounds[parts, columns], kind="stable")
+        carriers = [self.collector, *(body for body, _ in self._cargo.held.values())]
+        for part, column in zip(parts[order], columns[order], strict=True):
+            if bounds[part, column] >= nearest:
+                break
+            body = self._bodies.place(obstacles[column], self.time)
+            within = min(nearest, distances[part, column])
+            nearest = min(nearest, surface_gap(self._client, carriers[part], body, within))
+        return nearest
 
     def cargo_protrusion(self) -> float:
         """How far carried targets reach beyond the collector's surface, m (0 if none).
@@ -263,6 +297,10 @@ class World:
     def _assembly_spheres(self) -> list[tuple[np.ndarray, float]]:
         """Centre and bounding radius of the collector, then of each target it carries."""
         return [(self.collector_state()[0], self.robot.radius), *self._cargo.spheres()]
+
+    def _assembly_is_sphere(self) -> np.ndarray:
+        """Whether each part of :meth:`_assembly_spheres` is a sphere (the collector is)."""
+        return np.array([True, *(self.field.is_sphere[i] for i in self._cargo.held)])
 
     def parameters(self) -> dict[str, float]:
         """Named scalar parameters of the world as a system (fixed for its lifetime)."""

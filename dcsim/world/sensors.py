@@ -61,7 +61,10 @@ class Sensors:
         ]
 
     def object_tracks(self, time: float, position: np.ndarray) -> list[ObjectTrack]:
-        """Tracks at ``time`` (s) of the free objects within sensor range of ``position`` (m)."""
+        """Tracks at ``time`` (s) of the free objects within sensor range of ``position`` (m).
+
+        Each track carries its object's shape and, as ``radius``, its bounding radius.
+        """
         positions, velocities = self._field.free_states(time)
         if len(positions) == 0:
             return []
@@ -77,6 +80,7 @@ class Sensors:
                 mass=obj.mass,
                 radius=obj.radius,
                 motion=obj.motion,
+                shape=obj.shape,
             )
             for i in visible
             for obj in (self._field.objects[i],)

@@ -79,7 +79,8 @@ class Cargo:
     held : dict of int to (int, int)
         Object index of each carried target to its body and constraint ids.
     protrusion : float
-        How far the cargo reaches beyond the collector's surface, m (0 if none).
+        How far the cargo's bounding spheres reach beyond the collector's surface, m (0
+        if none).
     changes : int
         Grabs and releases so far (each changes the robot's mass and shape).
     """
@@ -107,7 +108,7 @@ class Cargo:
         return sum(self._field.objects[i].mass for i in self.held)
 
     def spheres(self) -> list[tuple[np.ndarray, float]]:
-        """Centre (m, world frame) and bounding radius (m) of every target held."""
+        """Centre (m, world frame) and bounding-sphere radius (m) of every target held."""
         spheres = []
         for index, (body, _) in self.held.items():
             p, _ = pb.getBasePositionAndOrientation(body, physicsClientId=self._client)
@@ -185,12 +186,13 @@ class Cargo:
         return ReleaseResult(tuple(delivered), "delivered")
 
     def _attach(self, index: int, time: float, position: np.ndarray, attitude: np.ndarray) -> None:
-        """Hold object ``index`` where it is now, fixed to the collector at its pose."""
-        at, velocity = (a.copy() for a in self._field.objects[index].motion.state_at(time))
+        """Hold object ``index`` as it is now (position and orientation), fixed to the collector."""
+        obj = self._field.objects[index]
+        at, velocity = (a.copy() for a in obj.motion.state_at(time))
         body = self._bodies.make_dynamic(index, at, velocity)
         inverse = pb.invertTransform(position.tolist(), attitude.tolist())
         local_position, local_attitude = pb.multiplyTransforms(
-            inverse[0], inverse[1], at.tolist(), [0, 0, 0, 1]
+            inverse[0], inverse[1], at.tolist(), obj.shape.orientation.tolist()
         )
         constraint = pb.createConstraint(
             self._collector,
