@@ -13,11 +13,13 @@ composes its pieces:
 - **Collector**: a rigid sphere driven by thrust (clipped to ``max_force`` and to the
   propellant left) and torque (clipped to ``max_torque``, from reaction wheels: no
   propellant). The body's mass is updated once per control period.
-- **Objects**: targets and obstacles follow their motion models exactly while free.
+- **Objects**: targets and obstacles, spheres, boxes or cylinders of fixed orientation,
+  follow their motion models exactly while free.
 - **Collisions**: every physics step, the collector and what it carries against every
-  free object that the control period's broad phase found within reach, from
-  PyBullet's closest-point queries. A collision is reported once, when contact starts.
-  Contacts are detected, not resolved: bodies pass through each other.
+  free object that the control period's broad phase (swept bounding spheres) found
+  within reach, from PyBullet's closest-point queries on the true shapes. A collision
+  is reported once, when contact starts. Contacts are detected, not resolved: bodies
+  pass through each other.
 """
 
 from __future__ import annotations
@@ -274,7 +276,8 @@ class World:
         ``bounds`` are the pairs' bounding-sphere gaps (lower bounds of the true ones),
         ``distances`` their centre distances (upper bounds: each shape holds its centre),
         both (P, K); ``obstacles`` the field indices of the K obstacles. Pairs are
-        measured nearest bound first, until no bound is below the nearest gap.
+        measured nearest bound first, until no bound is below the nearest gap, each
+        only as far as the nearest gap (a farther one cannot lower it).
         """
         parts, columns = np.nonzero(pending)
         order = np.argsort(bounds[parts, columns], kind="stable")
@@ -283,7 +286,7 @@ class World:
             if bounds[part, column] >= nearest:
                 break
             body = self._bodies.place(obstacles[column], self.time)
-            within = min(nearest, distances[part, column])
+            within = max(0.0, min(nearest, distances[part, column]))
             nearest = min(nearest, surface_gap(self._client, carriers[part], body, within))
         return nearest
 

@@ -163,3 +163,20 @@ def test_tracks_carry_the_object_shape_built_once():
     assert track.radius == pytest.approx(10**0.5)  # the bounding sphere's
     world.step()
     assert world.object_tracks()[0].shape is track.shape
+
+
+def test_nearest_gap_among_shapes_is_not_the_nearest_bounding_sphere():
+    text = """\
+        world: {frame: geocentric}
+        robot: {radius: 0.5}
+        obstacles:
+          - {id: 1, shape: {type: box, half_extents: [0.2, 4.0, 0.2]}, motion: {type: static, position: [2.5, 0, 0]}}
+          - {id: 2, shape: {type: cylinder, radius: 0.5, height: 1.0}, motion: {type: static, position: [0, 2.0, 0]}}
+          - {id: 3, radius: 0.5, motion: {type: static, position: [0, -3.0, 0]}}
+        """
+    world = World(
+        validate(ScenarioDocument.from_text(textwrap.dedent(text), "mixed.yaml")),
+        np.random.default_rng(0),
+    )
+    # Bounding gaps: box -2.0 m, cylinder 0.79 m, sphere 2.0 m; true gaps 1.8, 1.0 and 2.0 m.
+    assert world.nearest_obstacle_distance() == pytest.approx(1.0, abs=CURVED)
