@@ -1,10 +1,14 @@
 """Pictures of a run: the trajectory (3-D and top view) and a timeline.
 
+The top view outlines each box and cylinder where its path starts and ends (spheres
+are drawn by their paths alone).
+
 Drawn with matplotlib's non-interactive Agg backend into the run's ``plots/`` folder.
 """
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -14,10 +18,15 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
 import numpy as np  # noqa: E402
+from scipy.spatial import ConvexHull  # noqa: E402
 
+from dcsim.geometry import rotate  # noqa: E402
+from dcsim.messages import Shape, ShapeKind  # noqa: E402
 from dcsim.motion import MotionSet  # noqa: E402
 from dcsim.scenario.model import Scenario  # noqa: E402
-from dcsim.world.engine import build_objects  # noqa: E402
+from dcsim.world.objects import build_objects  # noqa: E402
+
+_CIRCLE_POINTS = 48  # points on each end circle of a cylinder's outline
 
 
 def write_plots(
@@ -90,6 +99,8 @@ def _trajectory(path: Path, scenario: Scenario, telemetry, events) -> None:
         top.plot(obj_path[:, 0], obj_path[:, 1], color=colour, lw=0.8, alpha=0.7)
         if len(obj_path):
             top.annotate(str(obj.id), obj_path[0, :2], fontsize=7, color=colour)
+            if obj.shape.kind is not ShapeKind.SPHERE:
+                _draw_footprint(top, obj.shape, obj_path[[0, -1], :2], colour)
     ax3d.plot(*true.T, color="tab:blue", lw=1.5, label="collector")
     top.plot(true[:, 0], true[:, 1], color="tab:blue", lw=1.5, label="collector (true)")
     top.plot(
@@ -117,6 +128,30 @@ def _trajectory(path: Path, scenario: Scenario, telemetry, events) -> None:
     figure.tight_layout()
     figure.savefig(path, dpi=110)
     plt.close(figure)
+
+
+def _draw_footprint(axis, shape: Shape, centres: np.ndarray, colour: str) -> None:
+    """Outline ``shape``'s top view (x-y) about each of ``centres`` (K, 2), m."""
+    outline = _footprint(shape)
+    for centre in np.unique(centres, axis=0):
+        axis.fill(*(centre + outline).T, facecolor=colour, edgecolor=colour, alpha=0.3, lw=0.8)
+
+
+def _footprint(shape: Shape) -> np.ndarray:
+    """Top-view outline (M, 2) of a box or a cylinder about its centre, world x-y, m.
+
+    The convex hull of the box's corners, or of the cylinder's two end circles, turned
+    by the shape's orientation and projected on x-y.
+    """
+    if shape.kind is ShapeKind.BOX:
+        body = np.array(list(itertools.product(*((-h, h) for h in shape.half_extents))))
+    else:
+        angles = np.linspace(0.0, 2.0 * np.pi, _CIRCLE_POINTS, endpoint=False)
+        ring = shape.radius * np.column_stack([np.cos(angles), np.sin(angles)])
+        half = 0.5 * shape.height
+        body = np.vstack([np.column_stack([ring, np.full(len(ring), z)]) for z in (-half, half)])
+    points = rotate(shape.orientation, body)[:, :2]
+    return points[ConvexHull(points).vertices]
 
 
 def _timeline(path: Path, telemetry, modes: tuple[str, ...], safety_distance: float) -> None:

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from dcsim.api import ScenarioError
+from dcsim.api import ScenarioError, Shape, ShapeKind
 from dcsim.registry import PluginRegistry
 from dcsim.scenario import (
     ScenarioDocument,
@@ -17,6 +17,7 @@ from dcsim.scenario import (
     format_key_path,
     load_scenario,
     parse_key_path,
+    validate,
 )
 from dcsim.scenario.model import SphericalMotionSpec
 from tests.conftest import REPO
@@ -132,6 +133,79 @@ def test_rules_across_sections(tmp_path):
         f"{path}:4:22: targets[0].motion.type: 'cw' motion needs world.frame: lvlh",
         f"{path}:6:6: obstacles[0].id: id 4 is already used by targets[0]",
         f"{path}:7:35: drop_point.motion: give either position or motion, not both",
+    ]
+
+
+def test_object_shapes_build_and_fill_in_the_bounding_radius(tmp_path):
+    path = write(
+        tmp_path,
+        """\
+        obstacles:
+          - {id: 1, radius: 0.7, motion: {type: static, position: [0, 0, 0]}}
+          - {id: 2, shape: {type: box, half_extents: [1, 2, 2]}, motion: {type: static, position: [9, 0, 0]}}
+          - id: 3
+            shape: {type: cylinder, radius: 3, height: 8, orientation: [0, 1, 0, 1]}
+            motion: {type: static, position: [0, 9, 0]}
+          - {id: 4, radius: 2, shape: {type: sphere, radius: 2}, motion: {type: static, position: [0, 0, 9]}}
+        """,
+    )
+    sphere, box, cylinder, given = load_scenario(path).obstacles
+    assert sphere.shape is None and sphere.build_shape() == Shape(ShapeKind.SPHERE, radius=0.7)
+    assert box.radius == 3.0  # |(1, 2, 2)|, filled in
+    assert box.build_shape() == Shape(ShapeKind.BOX, half_extents=[1.0, 2.0, 2.0])
+    assert cylinder.radius == 5.0  # hypot(3, 8 / 2)
+    built = cylinder.build_shape()
+    assert built.kind is ShapeKind.CYLINDER and (built.radius, built.height) == (3.0, 8.0)
+    np.testing.assert_allclose(built.orientation, [0, 0.5**0.5, 0, 0.5**0.5])  # normalised
+    assert given.radius == 2.0 and given.build_shape().kind is ShapeKind.SPHERE
+    # Written back out, radius and shape both appear and agree.
+    again = ScenarioDocument.from_text(dump_scenario(load_scenario(path)), "resolved.yaml")
+    assert validate(again).obstacles == load_scenario(path).obstacles
+
+
+def test_shape_errors_name_their_key_paths(tmp_path):
+    path = write(
+        tmp_path,
+        """\
+        targets:
+          - id: 1
+            shape: {type: box, half_extents: [1, -2, 2], orientation: [0, 0, 0, 0]}
+            motion: {type: static, position: [0, 0, 0]}
+          - id: 2
+            shape: {type: cone, radius: 1}
+            motion: {type: static, position: [0, 0, 0]}
+          - id: 3
+            shape: {type: cylinder, radius: 1, half_extents: [1, 1, 1]}
+            motion: {type: static, position: [0, 0, 0]}
+          - id: 4
+            shape: {type: sphere}
+            motion: {type: static, position: [0, 0, 0]}
+        """,
+    )
+    assert problems(path) == [
+        f"{path}:3:42: targets[0].shape.half_extents[1]: -2 is not allowed: Input should be greater than 0",
+        f"{path}:3:50: targets[0].shape.orientation: [0, 0, 0, 0] is not allowed: Value error, the quaternion must not be zero",
+        f"{path}:6:5: targets[1].shape: {{'type': 'cone', 'radius': 1}} is not allowed: Input tag 'cone' found using 'type' does not match any of the expected tags: 'sphere', 'box', 'cylinder'",
+        f"{path}:9:5: targets[2].shape.height: required but missing",
+        f"{path}:9:40: targets[2].shape.half_extents: unknown key (known keys: type, radius, height, orientation)",
+        f"{path}:12:5: targets[3].shape.radius: required but missing",
+    ]
+
+
+def test_radius_given_with_a_shape_must_agree_with_it(tmp_path):
+    path = write(
+        tmp_path,
+        """\
+        targets:
+          - {id: 1, radius: 2, shape: {type: box, half_extents: [1, 2, 2]}, motion: {type: static, position: [0, 0, 0]}}
+        obstacles:
+          - {id: 2, radius: 3, shape: {type: box, half_extents: [1, 2, 2]}, motion: {type: static, position: [0, 0, 0]}}
+          - {id: 3, radius: 1.5, shape: {type: sphere, radius: 2}, motion: {type: static, position: [0, 0, 0]}}
+        """,
+    )
+    assert problems(path) == [
+        f"{path}:2:13: targets[0].radius: 2 m disagrees with the shape's bounding radius (3 m); leave radius out when giving a shape",
+        f"{path}:5:13: obstacles[1].radius: 1.5 m disagrees with the shape's bounding radius (2 m); leave radius out when giving a shape",
     ]
 
 

@@ -172,6 +172,7 @@ def _rule_violations(scenario: Scenario) -> list[tuple[KeyPath, str]]:
                     ((section, index, "id"), f"id {obj.id} is already used by {owners[obj.id]}")
                 )
             owners.setdefault(obj.id, here)
+            found += [((section, index, *path), message) for path, message in obj.violations()]
             if isinstance(obj.motion, CWMotionSpec) and world.frame != "lvlh":
                 found.append(
                     (

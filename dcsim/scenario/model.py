@@ -8,12 +8,22 @@ Unknown keys are errors. docs/scenarios.md is generated from these models.
 from __future__ import annotations
 
 import functools
+import math
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, create_model
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    ConfigDict,
+    Field,
+    ModelWrapValidatorHandler,
+    create_model,
+    model_validator,
+)
 
 from dcsim.geometry import Vector, spherical_to_cartesian
+from dcsim.messages.sensing import Shape, ShapeKind
 from dcsim.motion import (
     STANDARD_GRAVITATIONAL_PARAMETER_EARTH,
     ClohessyWiltshireMotion,
@@ -213,13 +223,136 @@ class RobotSection(Section):
     )
 
 
+def _nonzero(quaternion: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
+    if sum(q * q for q in quaternion) < 1e-12:
+        raise ValueError("the quaternion must not be zero")
+    return quaternion
+
+
+Quaternion = Annotated[tuple[float, float, float, float], AfterValidator(_nonzero)]
+"""A rotation ``[x, y, z, w]``, any non-zero length (normalised where used)."""
+
+PositiveVec3 = tuple[
+    Annotated[float, Field(gt=0)], Annotated[float, Field(gt=0)], Annotated[float, Field(gt=0)]
+]
+"""Three lengths, each > 0."""
+
+
+def _unit(quaternion: Quaternion) -> Vector:
+    q = np.array(quaternion, dtype=float)
+    return q / np.linalg.norm(q)
+
+
+def _orientation() -> Any:
+    return quantity(
+        (0.0, 0.0, 0.0, 1.0),
+        description="Body-to-world rotation [x, y, z, w], fixed while the object moves "
+        "(normalised; not zero).",
+    )
+
+
+class SphereShapeSpec(Section):
+    """A sphere centred on the object's position."""
+
+    type: Literal["sphere"]
+    radius: float = quantity(unit="m", gt=0, description="Radius.")
+
+    def build(self) -> Shape:
+        """The shape this spec describes."""
+        return Shape(ShapeKind.SPHERE, radius=self.radius)
+
+
+class BoxShapeSpec(Section):
+    """A box centred on the object's position, its body axes turned by `orientation`."""
+
+    type: Literal["box"]
+    half_extents: PositiveVec3 = quantity(
+        unit="m", description="Half side lengths along the body x, y and z axes (each > 0)."
+    )
+    orientation: Quaternion = _orientation()
+
+    def build(self) -> Shape:
+        """The shape this spec describes."""
+        return Shape(
+            ShapeKind.BOX, half_extents=self.half_extents, orientation=_unit(self.orientation)
+        )
+
+
+class CylinderShapeSpec(Section):
+    """A cylinder centred on the object's position, its axis the body z axis."""
+
+    type: Literal["cylinder"]
+    radius: float = quantity(unit="m", gt=0, description="Radius.")
+    height: float = quantity(unit="m", gt=0, description="Full length along the body z axis.")
+    orientation: Quaternion = _orientation()
+
+    def build(self) -> Shape:
+        """The shape this spec describes."""
+        return Shape(
+            ShapeKind.CYLINDER,
+            radius=self.radius,
+            height=self.height,
+            orientation=_unit(self.orientation),
+        )
+
+
+ShapeSpec = Annotated[
+    SphereShapeSpec | BoxShapeSpec | CylinderShapeSpec, Field(discriminator="type")
+]
+"""A collision shape, chosen by its ``type`` key: sphere, box or cylinder."""
+
+
 class SpaceObjectSpec(Section):
-    """A target or an obstacle."""
+    """A target or an obstacle.
+
+    Without a ``shape`` the object is a sphere of ``radius``. With one, ``radius`` is the
+    shape's bounding radius: it is filled in when omitted, and given anyway it must
+    agree (a scenario written back out states both).
+    """
 
     id: int = quantity(ge=0, description="Unique id among targets and obstacles.")
-    radius: float = quantity(1.0, unit="m", gt=0, description="Radius of the bounding sphere.")
+    radius: float = quantity(
+        1.0,
+        unit="m",
+        gt=0,
+        description="Radius of the sphere when there is no `shape`; with a `shape`, its "
+        "bounding radius (leave it out: it is computed).",
+    )
     mass: float = quantity(10.0, unit="kg", gt=0, description="Mass.")
     motion: MotionSpec = Field(description="How the object moves until grabbed.")
+    shape: ShapeSpec | None = Field(
+        None, description="Collision shape: sphere, box or cylinder; null for a sphere of `radius`."
+    )
+
+    @model_validator(mode="wrap")
+    @classmethod
+    def _bounding_radius(cls, data: Any, handler: ModelWrapValidatorHandler[Any]) -> Any:
+        """Fill in ``radius`` from the shape when it is not given."""
+        spec = handler(data)
+        if spec.shape is not None and "radius" not in spec.model_fields_set:
+            return spec.model_copy(update={"radius": spec.shape.build().bounding_radius})
+        return spec
+
+    def build_shape(self) -> Shape:
+        """The object's collision shape (a sphere of ``radius`` when none is given)."""
+        if self.shape is None:
+            return Shape(ShapeKind.SPHERE, radius=self.radius)
+        return self.shape.build()
+
+    def violations(self) -> list[tuple[tuple[str | int, ...], str]]:
+        """Rules between this object's keys, as (key path within the object, message)."""
+        if self.shape is None:
+            return []
+        bounding = self.shape.build().bounding_radius
+        if math.isclose(self.radius, bounding, rel_tol=1e-9):
+            return []
+        return [
+            (
+                ("radius",),
+                f"{self.radius:g} m disagrees with the shape's bounding radius ({bounding:g} m); "
+                "leave radius out when giving a shape",
+            )
+        ]
 
 
 class BeaconsSection(Section):

@@ -100,7 +100,8 @@ def _heading(model: type[BaseModel], paths: list[str]) -> str:
     tag = model.model_fields.get("type")
     where = ", ".join(f"`{p}`" for p in paths) if paths != [""] else "top level"
     if tag is not None:
-        return f"motion `type: {get_args(tag.annotation)[0]}` (in {where})"
+        key = paths[0].rsplit(".", 1)[-1].removesuffix("[i]")
+        return f"{key} `type: {get_args(tag.annotation)[0]}` (in {where})"
     return where
 
 

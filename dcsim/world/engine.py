@@ -1,51 +1,44 @@
-"""The PyBullet world: collector dynamics, object motion, sensors, services, collisions.
+"""The world as a steppable system: the collector's dynamics, collisions, state and outputs.
 
 One PyBullet DIRECT client per world, zero gravity, a fixed physics step; every call
-passes the client id, so several worlds live side by side in one process.
+passes the client id, so several worlds live side by side in one process. The world
+composes its pieces:
+
+- :mod:`~dcsim.world.bodies`: the PyBullet bodies of the collector and the objects;
+- :mod:`~dcsim.world.environment`: Clohessy–Wiltshire forces and the propellant;
+- :mod:`~dcsim.world.sensors`: beacon ranges, object tracks, attitude and rate;
+- :mod:`~dcsim.world.services`: grab and release (the cargo);
+- :mod:`~dcsim.world.objects`: the targets and obstacles and their motion.
 
 - **Collector**: a rigid sphere driven by thrust (clipped to ``max_force`` and to the
   propellant left) and torque (clipped to ``max_torque``, from reaction wheels: no
-  propellant). Propellant use is ``|F| dt / (Isp g0)``; delta-v accumulates
-  ``|F| dt / m`` with ``m`` the mass of the collector and what it carries. The body's
-  mass is updated once per control period.
-- **Objects**: targets and obstacles follow their motion models exactly while free.
-  They are static collision spheres that are moved to their model position only when
-  a query needs them, so a large field costs little.
-- **Frame**: in ``lvlh`` the collector (and what it carries) feels the
-  Clohessy–Wiltshire accelerations ``(3n²x + 2nẏ, −2nẋ, −n²z)`` as external forces;
-  ``geocentric`` is force-free, as in the source thesis.
+  propellant). The body's mass is updated once per control period.
+- **Objects**: targets and obstacles, spheres, boxes or cylinders of fixed orientation,
+  follow their motion models exactly while free.
 - **Collisions**: every physics step, the collector and what it carries against every
-  free object that the control period's broad phase found within reach, from
-  PyBullet's closest-point queries. A collision is reported once, when contact starts.
-  Contacts are detected, not resolved: bodies pass through each other.
+  free object that the control period's broad phase (swept bounding spheres) found
+  within reach, from PyBullet's closest-point queries on the true shapes. A collision
+  is reported once, when contact starts. Contacts are detected, not resolved: bodies
+  pass through each other.
 """
 
 from __future__ import annotations
 
 import weakref
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from dcsim.geometry import clip_norm
-from dcsim.messages import (
-    BeaconRange,
-    DropPoint,
-    MotionInput,
-    ObjectKind,
-    ObjectTrack,
-    Observations,
-    RobotSpec,
-)
-from dcsim.scenario.model import Scenario, point_to_cartesian
-from dcsim.world.objects import ObjectField, ObjectStatus, SpaceObject
+from dcsim.messages import BeaconRange, DropPoint, MotionInput, ObjectTrack, Observations, RobotSpec
+from dcsim.scenario.model import Scenario
+from dcsim.world.bodies import ObjectBodies, create_collector, surface_gap
+from dcsim.world.environment import Propellant, apply_cw_force, cw_acceleration
+from dcsim.world.objects import ObjectField, ObjectStatus, build_objects
 from dcsim.world.pybullet_client import connect_direct, pb
+from dcsim.world.sensors import Sensors
+from dcsim.world.services import Cargo, GrabResult, ReleaseResult
 
-STANDARD_GRAVITY = 9.80665
-"""g0 used with the specific impulse, m/s²."""
-
-_CONSTRAINT_FORCE = 1e9  # N; a grabbed target must not slip
 _BROAD_PHASE_SLACK = 1e-3  # m added to the swept reach of each control period
 
 
@@ -93,37 +86,6 @@ class CollisionEvent:
     penetration: float
 
 
-@dataclass(frozen=True)
-class GrabResult:
-    """Outcome of :meth:`World.grab`: success, and why not."""
-
-    success: bool
-    target_id: int
-    reason: str
-    gap: float
-
-
-@dataclass(frozen=True)
-class ReleaseResult:
-    """Outcome of :meth:`World.release`: the targets delivered, and why none if so."""
-
-    delivered: tuple[int, ...]
-    reason: str
-
-
-def build_objects(scenario: Scenario) -> list[SpaceObject]:
-    """The scenario's targets and obstacles as world objects (targets first)."""
-    n = scenario.mean_motion
-    return [
-        SpaceObject(spec.id, kind, spec.radius, spec.mass, spec.motion.build(n))
-        for kind, specs in (
-            (ObjectKind.TARGET, scenario.targets),
-            (ObjectKind.OBSTACLE, scenario.obstacles),
-        )
-        for spec in specs
-    ]
-
-
 class World:
     """A steppable PyBullet world built from a scenario.
 
@@ -145,13 +107,12 @@ class World:
         Simulated time, s (a whole number of physics steps).
     inputs : WorldInputs
         Inputs applied over the next :meth:`step`.
-    fuel_used, delta_v : float
-        Propellant used (kg) and delta-v accumulated (m/s).
+    field : ObjectField
+        The targets and obstacles.
+    drop_point : DropPoint
+        Where cargo is delivered.
     collisions : list of CollisionEvent
         Every collision so far.
-    robot_changes : int
-        How many times the robot's mass or shape changed by a grab or a release (its
-        :meth:`robot_spec` is then new).
     """
 
     def __init__(self, scenario: Scenario, rng: np.random.Generator) -> None:
@@ -159,88 +120,33 @@ class World:
         self.physics_step = scenario.world.physics_step
         self.steps_per_control = round(scenario.world.control_period / self.physics_step)
         self.control_period = self.steps_per_control * self.physics_step
-        self._rng = rng
         self._steps = 0
         robot = scenario.robot
         self.robot = robot
         self.dry_mass = robot.mass - robot.propellant_mass
-        self.propellant = robot.propellant_mass
-        self.fuel_used = 0.0
-        self.delta_v = 0.0
+        self._propellant = Propellant(
+            robot.propellant_mass, robot.specific_impulse, self.physics_step, self.steps_per_control
+        )
         self.collisions: list[CollisionEvent] = []
         self.inputs = WorldInputs()
         self._mean_motion = scenario.mean_motion if scenario.world.frame == "lvlh" else None
-        self.beacons = np.array(
-            [point_to_cartesian(p) for p in scenario.beacons.positions]
-        ).reshape(-1, 3)
         self.drop_point = DropPoint(
             scenario.drop_point.build(scenario.mean_motion), scenario.drop_point.tolerance
         )
         self.field = ObjectField(build_objects(scenario))
+        self._sensors = Sensors(scenario, self.field, rng)
         self._client = connect_direct()
         # A world dropped without close() (an FMU reset does that) still disconnects.
         self._disconnect = weakref.finalize(self, pb.disconnect, physicsClientId=self._client)
         self._state_cache: tuple[int, tuple[np.ndarray, ...]] | None = None
         pb.setTimeStep(self.physics_step, physicsClientId=self._client)
-        self.collector = self._create_collector()
-        self._bodies = [self._create_object_body(i) for i in range(len(self.field))]
-        self._carried: dict[int, tuple[int, int]] = {}  # object index -> (body, constraint)
-        self._protrusion = 0.0  # m, see cargo_protrusion
-        self.robot_changes = 0
+        self.collector = create_collector(self._client, robot)
+        self._bodies = ObjectBodies(self._client, self.field)
+        self._cargo = Cargo(self._client, self.collector, self.field, self._bodies, robot)
         self._contacts: set[tuple[int, int]] = set()
         self._candidates = np.zeros(0, dtype=int)
         self._period_mass = self.assembly_mass()
         self._body_mass = robot.mass
-        self._last_acceleration = np.zeros(3)
-
-    # ------------------------------------------------------------------ bodies
-    def _sphere(self, radius: float, mass: float, position: np.ndarray, maximal: bool) -> int:
-        shape = pb.createCollisionShape(pb.GEOM_SPHERE, radius=radius, physicsClientId=self._client)
-        body = pb.createMultiBody(
-            baseMass=mass,
-            baseCollisionShapeIndex=shape,
-            basePosition=position.tolist(),
-            useMaximalCoordinates=maximal,
-            physicsClientId=self._client,
-        )
-        pb.setCollisionFilterGroupMask(body, -1, 0, 0, physicsClientId=self._client)
-        if mass > 0:
-            pb.changeDynamics(
-                body, -1, linearDamping=0, angularDamping=0, physicsClientId=self._client
-            )
-        return body
-
-    def _create_collector(self) -> int:
-        initial = self.robot.initial
-        body = self._sphere(
-            self.robot.radius, self.robot.mass, point_to_cartesian(initial.position), False
-        )
-        attitude = np.asarray(initial.attitude) / np.linalg.norm(initial.attitude)
-        pb.resetBasePositionAndOrientation(
-            body,
-            point_to_cartesian(initial.position).tolist(),
-            attitude.tolist(),
-            physicsClientId=self._client,
-        )
-        pb.resetBaseVelocity(
-            body,
-            list(initial.velocity),
-            list(initial.angular_velocity),
-            physicsClientId=self._client,
-        )
-        return body
-
-    def _create_object_body(self, index: int) -> int:
-        obj = self.field.objects[index]
-        position = self.field.free_states(0.0)[0][index]
-        return self._sphere(obj.radius, 0.0, position, True)
-
-    def _place(self, index: int) -> None:
-        """Move a free object's static body to its model position now."""
-        position = self.field.objects[index].motion.state_at(self.time)[0]
-        pb.resetBasePositionAndOrientation(
-            self._bodies[index], position.tolist(), [0, 0, 0, 1], physicsClientId=self._client
-        )
 
     # ------------------------------------------------------------------ state
     @property
@@ -252,6 +158,34 @@ class World:
     def time(self) -> float:
         """Simulated time, s."""
         return self._steps * self.physics_step
+
+    @property
+    def beacons(self) -> np.ndarray:
+        """Beacon positions (B, 3), world frame, m."""
+        return self._sensors.beacons
+
+    @property
+    def propellant(self) -> float:
+        """Propellant left, kg."""
+        return self._propellant.remaining
+
+    @property
+    def fuel_used(self) -> float:
+        """Propellant used so far, kg."""
+        return self._propellant.used
+
+    @property
+    def delta_v(self) -> float:
+        """Delta-v accumulated, m/s."""
+        return self._propellant.delta_v
+
+    @property
+    def robot_changes(self) -> int:
+        """How many times the robot's mass or shape changed by a grab or a release.
+
+        Its :meth:`robot_spec` is new after each change.
+        """
+        return self._cargo.changes
 
     def collector_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """True ``(position, velocity, attitude [x, y, z, w], angular velocity)``.
@@ -276,8 +210,7 @@ class World:
 
     def assembly_mass(self) -> float:
         """Mass of the collector and every target it carries, kg."""
-        carried = sum(self.field.objects[i].mass for i in self._carried)
-        return self.collector_mass() + carried
+        return self.collector_mass() + self._cargo.mass
 
     def robot_spec(self) -> RobotSpec:
         """The collector's current mass, inertia, limits and bounding radius (cargo included).
@@ -298,47 +231,79 @@ class World:
 
     def carried_ids(self) -> list[int]:
         """Ids of the targets on board."""
-        return [self.field.objects[i].id for i in self._carried]
+        return [self.field.objects[i].id for i in self._cargo.held]
 
     def object_states(self) -> tuple[np.ndarray, np.ndarray]:
         """True positions and velocities (N, 3) of all objects; carried ones from physics."""
         positions, velocities = (a.copy() for a in self.field.free_states(self.time))
-        for index, (body, _) in self._carried.items():
+        for index, (body, _) in self._cargo.held.items():
             p, _ = pb.getBasePositionAndOrientation(body, physicsClientId=self._client)
             v, _ = pb.getBaseVelocity(body, physicsClientId=self._client)
             positions[index], velocities[index] = p, v
         return positions, velocities
 
     def nearest_obstacle_distance(self) -> float:
-        """Smallest surface gap between the collector (and cargo) and a free obstacle, m."""
+        """Smallest surface gap between the collector (and cargo) and a free obstacle, m.
+
+        Pairs of spheres are measured from their centres and radii, all at once. A pair
+        with a box or a cylinder is measured by PyBullet's closest points, only if its
+        bounding spheres are nearer than the nearest gap found so far.
+        """
         mask = self.field.free_mask() & ~self.field.is_target
         if not mask.any():
             return float("inf")
         positions = self.field.free_states(self.time)[0][mask]
         radii = self.field.radii[mask]
-        gaps = [
-            np.linalg.norm(positions - centre, axis=1) - radii - radius
-            for centre, radius in self._assembly_spheres()
-        ]
-        return float(np.min(gaps))
+        centres, part_radii = zip(*self._assembly_spheres(), strict=True)
+        distances = np.array([np.linalg.norm(positions - centre, axis=1) for centre in centres])
+        bounds = distances - radii - np.array(part_radii)[:, None]
+        exact = np.outer(self._assembly_is_sphere(), self.field.is_sphere[mask])
+        nearest = float(np.min(bounds, where=exact, initial=np.inf))
+        if exact.all():
+            return nearest
+        return self._nearest_shaped_gap(nearest, bounds, distances, ~exact, np.flatnonzero(mask))
+
+    def _nearest_shaped_gap(
+        self,
+        nearest: float,
+        bounds: np.ndarray,
+        distances: np.ndarray,
+        pending: np.ndarray,
+        obstacles: np.ndarray,
+    ) -> float:
+        """``nearest`` lowered by the true gaps of the ``pending`` (part, obstacle) pairs, m.
+
+        ``bounds`` are the pairs' bounding-sphere gaps (lower bounds of the true ones),
+        ``distances`` their centre distances (upper bounds: each shape holds its centre),
+        both (P, K); ``obstacles`` the field indices of the K obstacles. Pairs are
+        measured nearest bound first, until no bound is below the nearest gap, each
+        only as far as the nearest gap (a farther one cannot lower it).
+        """
+        parts, columns = np.nonzero(pending)
+        order = np.argsort(bounds[parts, columns], kind="stable")
+        carriers = [self.collector, *(body for body, _ in self._cargo.held.values())]
+        for part, column in zip(parts[order], columns[order], strict=True):
+            if bounds[part, column] >= nearest:
+                break
+            body = self._bodies.place(obstacles[column], self.time)
+            within = max(0.0, min(nearest, distances[part, column]))
+            nearest = min(nearest, surface_gap(self._client, carriers[part], body, within))
+        return nearest
 
     def cargo_protrusion(self) -> float:
         """How far carried targets reach beyond the collector's surface, m (0 if none).
 
         Cargo is held rigidly, so this changes only at a grab or a release.
         """
-        return self._protrusion
-
-    def _measure_protrusion(self) -> float:
-        (centre, radius), *cargo = self._assembly_spheres()
-        return max((np.linalg.norm(c - centre) + r - radius for c, r in cargo), default=0.0)
+        return self._cargo.protrusion
 
     def _assembly_spheres(self) -> list[tuple[np.ndarray, float]]:
-        spheres = [(self.collector_state()[0], self.robot.radius)]
-        for index, (body, _) in self._carried.items():
-            p, _ = pb.getBasePositionAndOrientation(body, physicsClientId=self._client)
-            spheres.append((np.array(p), self.field.objects[index].radius))
-        return spheres
+        """Centre and bounding radius of the collector, then of each target it carries."""
+        return [(self.collector_state()[0], self.robot.radius), *self._cargo.spheres()]
+
+    def _assembly_is_sphere(self) -> np.ndarray:
+        """Whether each part of :meth:`_assembly_spheres` is a sphere (the collector is)."""
+        return np.array([True, *(self.field.is_sphere[i] for i in self._cargo.held)])
 
     def parameters(self) -> dict[str, float]:
         """Named scalar parameters of the world as a system (fixed for its lifetime)."""
@@ -371,7 +336,7 @@ class World:
             "propellant": self.propellant,
             "fuel_used": self.fuel_used,
             "delta_v": self.delta_v,
-            "carried": len(self._carried),
+            "carried": len(self._cargo.held),
             "captured": self.field.count(ObjectStatus.CARRIED)
             + self.field.count(ObjectStatus.DELIVERED),
             "delivered": self.field.count(ObjectStatus.DELIVERED),
@@ -399,7 +364,7 @@ class World:
             float(q) for q in torque + np.asarray(self.inputs.disturbance_torque, dtype=float)
         )
         started: list[CollisionEvent] = []
-        for thrust in self._burn_schedule(force):
+        for thrust in self._propellant.burn(force, self._period_mass):
             self._physics_step(thrust, disturbance, total_torque)
             if len(self._candidates):
                 started += self._detect_collisions()
@@ -411,51 +376,26 @@ class World:
         pb.changeDynamics(self.collector, -1, mass=mass, physicsClientId=self._client)
         self._body_mass = mass
 
-    def _burn_schedule(self, force: np.ndarray) -> list[tuple[float, float, float]]:
-        """Thrust of each physics step of the coming period, with propellant bookkeeping.
-
-        The commanded force is held over the period until the propellant runs out.
-        """
-        steps, dt = self.steps_per_control, self.physics_step
-        magnitude = float(np.linalg.norm(force))
-        per_step = magnitude * dt / (self.robot.specific_impulse * STANDARD_GRAVITY)
-        fractions = np.zeros(steps)
-        if per_step > 0:
-            fractions = np.clip(
-                (self.propellant - per_step * np.arange(steps)) / per_step, 0.0, 1.0
-            )
-        used = per_step * float(fractions.sum())
-        self.propellant = max(self.propellant - used, 0.0)
-        self.fuel_used += used
-        self.delta_v += magnitude * dt * float(fractions.sum()) / self._period_mass
-        self._last_acceleration = force * (fractions.mean() / self._period_mass)
-        return [tuple(float(f) for f in force * k) for k in fractions]
-
     def _physics_step(
         self,
         thrust: tuple[float, float, float],
         disturbance: tuple[float, float, float],
         torque: tuple[float, float, float],
     ) -> None:
+        """One physics step: thrust, disturbance and orbital forces on the assembly."""
         client, body = self._client, self.collector
         position, _ = pb.getBasePositionAndOrientation(body, physicsClientId=client)
         fx, fy, fz = (thrust[k] + disturbance[k] for k in range(3))
         if self._mean_motion is not None:
             velocity, _ = pb.getBaseVelocity(body, physicsClientId=client)
-            ax, ay, az = self._cw_acceleration(position, velocity)
+            ax, ay, az = cw_acceleration(self._mean_motion, position, velocity)
             fx, fy, fz = (
                 fx + self._body_mass * ax,
                 fy + self._body_mass * ay,
                 fz + self._body_mass * az,
             )
-            for index, (cargo, _) in self._carried.items():
-                p, _ = pb.getBasePositionAndOrientation(cargo, physicsClientId=client)
-                v, _ = pb.getBaseVelocity(cargo, physicsClientId=client)
-                m = self.field.objects[index].mass
-                cx, cy, cz = self._cw_acceleration(p, v)
-                pb.applyExternalForce(
-                    cargo, -1, (m * cx, m * cy, m * cz), p, pb.WORLD_FRAME, physicsClientId=client
-                )
+            for index, (cargo, _) in self._cargo.held.items():
+                apply_cw_force(client, cargo, self.field.objects[index].mass, self._mean_motion)
         pb.applyExternalForce(
             body, -1, (fx, fy, fz), position, pb.WORLD_FRAME, physicsClientId=client
         )
@@ -463,17 +403,6 @@ class World:
             pb.applyExternalTorque(body, -1, torque, pb.WORLD_FRAME, physicsClientId=client)
         pb.stepSimulation(physicsClientId=client)
         self._steps += 1
-
-    def _cw_acceleration(
-        self, position: Sequence[float], velocity: Sequence[float]
-    ) -> tuple[float, float, float]:
-        """Clohessy–Wiltshire acceleration at an LVLH state, m/s²."""
-        n = self._mean_motion
-        return (
-            3.0 * n * n * position[0] + 2.0 * n * velocity[1],
-            -2.0 * n * velocity[0],
-            -n * n * position[2],
-        )
 
     def _update_broad_phase(self, force: np.ndarray) -> None:
         """Find the free objects that could touch the assembly in the coming period."""
@@ -488,7 +417,9 @@ class World:
         push = np.linalg.norm(force) + np.linalg.norm(self.inputs.disturbance_force)
         accel = push / self._period_mass
         if self._mean_motion is not None:
-            accel += 2 * float(np.linalg.norm(self._cw_acceleration(position, velocity)))
+            accel += 2 * float(
+                np.linalg.norm(cw_acceleration(self._mean_motion, position, velocity))
+            )
         sweep = np.linalg.norm(velocity) * period + accel * period**2
         now = self.field.free_states(self.time)[0][free]
         later = self.field.free_states((self._steps + self.steps_per_control) * self.physics_step)[
@@ -502,17 +433,14 @@ class World:
         started = []
         carriers = [(self.collector, "collector", -1)] + [
             (body, f"target {self.field.objects[i].id}", i)
-            for i, (body, _) in self._carried.items()
+            for i, (body, _) in self._cargo.held.items()
         ]
         for index in self._candidates:
             if self.field.status[index] != ObjectStatus.FREE:
                 continue
-            self._place(index)
-            for body, label, key in carriers:
-                points = pb.getClosestPoints(
-                    body, self._bodies[index], 0.0, physicsClientId=self._client
-                )
-                depth = -min((pt[8] for pt in points), default=0.0)
+            body = self._bodies.place(index, self.time)
+            for carrier, label, key in carriers:
+                depth = -surface_gap(self._client, carrier, body, 0.0)
                 pair = (int(index), key)
                 if depth > 0 and pair not in self._contacts:
                     self._contacts.add(pair)
@@ -526,62 +454,23 @@ class World:
     # ------------------------------------------------------------------ sensors
     def beacon_ranges(self) -> list[BeaconRange]:
         """Noisy ranges to the nearest beacons within range (the thesis's Beacon topic)."""
-        if len(self.beacons) == 0:
-            return []
-        settings = self.scenario.beacons
-        distances = np.linalg.norm(self.beacons - self.collector_state()[0], axis=1)
-        order = np.argsort(distances, kind="stable")
-        if settings.max_range is not None:
-            order = order[distances[order] <= settings.max_range]
-        order = order[: settings.report_nearest]
-        noise = (
-            self._rng.normal(0.0, settings.noise_sigma, len(order)) if settings.noise_sigma else 0.0
-        )
-        measured = distances[order] + noise
-        return [
-            BeaconRange(int(i), self.beacons[i], float(r), settings.noise_sigma)
-            for i, r in zip(order, np.atleast_1d(measured), strict=True)
-        ]
+        return self._sensors.beacon_ranges(self.collector_state()[0])
 
     def object_tracks(self) -> list[ObjectTrack]:
         """Tracks of the free objects within sensor range (the thesis's Objects topic)."""
-        positions, velocities = self.field.free_states(self.time)
-        if len(positions) == 0:
-            return []
-        distances = np.linalg.norm(positions - self.collector_state()[0], axis=1)
-        visible = np.flatnonzero(self.field.free_mask() & (distances <= self.robot.sensor_range))
-        return [
-            ObjectTrack(
-                id=obj.id,
-                kind=obj.kind,
-                time=self.time,
-                position=positions[i],
-                velocity=velocities[i],
-                mass=obj.mass,
-                radius=obj.radius,
-                motion=obj.motion,
-            )
-            for i in visible
-            for obj in (self.field.objects[i],)
-        ]
+        return self._sensors.object_tracks(self.time, self.collector_state()[0])
 
     def observations(self) -> Observations:
         """Every sensor's reading now: beacon ranges, object tracks, attitude and rate.
 
         The star tracker and the gyros are noise-free.
         """
-        _, _, attitude, angular_velocity = self.collector_state()
-        return Observations(
-            time=self.time,
-            ranges=tuple(self.beacon_ranges()),
-            tracks=tuple(self.object_tracks()),
-            attitude=attitude,
-            angular_velocity=angular_velocity,
-        )
+        position, _, attitude, angular_velocity = self.collector_state()
+        return self._sensors.observations(self.time, position, attitude, angular_velocity)
 
     def motion_input(self) -> MotionInput:
         """Mean thrust acceleration applied over the last control period."""
-        return MotionInput(acceleration=self._last_acceleration)
+        return MotionInput(acceleration=self._propellant.last_acceleration)
 
     # ------------------------------------------------------------------ services
     def grab(self, target_id: int) -> GrabResult:
@@ -591,87 +480,24 @@ class World:
         the two surfaces is at most ``robot.grab_distance``. The target is then attached
         by a fixed constraint and moves with the collector.
         """
-        index = self.field.index.get(target_id)
-        if index is None or not self.field.is_target[index]:
-            return GrabResult(False, target_id, "no such target", float("nan"))
-        if self.field.status[index] != ObjectStatus.FREE:
-            return GrabResult(False, target_id, "target is not free", float("nan"))
-        if len(self._carried) >= self.robot.capacity:
-            return GrabResult(
-                False, target_id, f"capacity {self.robot.capacity} reached", float("nan")
-            )
-        self._place(index)
-        reach = self.robot.grab_distance
-        points = pb.getClosestPoints(
-            self.collector, self._bodies[index], reach + 1.0, physicsClientId=self._client
-        )
-        gap = min((pt[8] for pt in points), default=float("inf"))
-        if gap > reach:
-            return GrabResult(
-                False, target_id, f"out of reach: gap {gap:.3f} m > {reach:g} m", float(gap)
-            )
-        self._attach(index)
-        return GrabResult(True, target_id, "grabbed", float(gap))
-
-    def _attach(self, index: int) -> None:
-        obj = self.field.objects[index]
-        position, velocity = (a.copy() for a in obj.motion.state_at(self.time))
-        pb.removeBody(self._bodies[index], physicsClientId=self._client)
-        body = self._sphere(obj.radius, obj.mass, position, False)
-        pb.resetBaseVelocity(body, velocity.tolist(), [0, 0, 0], physicsClientId=self._client)
-        c_position, _, c_attitude, _ = self.collector_state()
-        inverse = pb.invertTransform(c_position.tolist(), c_attitude.tolist())
-        local_position, local_attitude = pb.multiplyTransforms(
-            inverse[0], inverse[1], position.tolist(), [0, 0, 0, 1]
-        )
-        constraint = pb.createConstraint(
-            self.collector,
-            -1,
-            body,
-            -1,
-            pb.JOINT_FIXED,
-            [0, 0, 0],
-            parentFramePosition=local_position,
-            childFramePosition=[0, 0, 0],
-            parentFrameOrientation=local_attitude,
-            physicsClientId=self._client,
-        )
-        pb.changeConstraint(constraint, maxForce=_CONSTRAINT_FORCE, physicsClientId=self._client)
-        self._carried[index] = (body, constraint)
-        self._protrusion = self._measure_protrusion()
-        self.robot_changes += 1
-        self._bodies[index] = body
-        self.field.status[index] = ObjectStatus.CARRIED
-        self._contacts = {pair for pair in self._contacts if pair[0] != index}
+        position, _, attitude, _ = self.collector_state()
+        result = self._cargo.grab(target_id, self.time, position, attitude)
+        if result.success:
+            index = self.field.index[target_id]
+            self._contacts = {pair for pair in self._contacts if pair[0] != index}
+        return result
 
     def release(self) -> ReleaseResult:
         """Release every carried target if the collector is at the drop point.
 
         Released targets count as delivered and leave the world.
         """
-        if not self._carried:
-            return ReleaseResult((), "nothing carried")
-        distance = float(
-            np.linalg.norm(self.collector_state()[0] - self.drop_point.state_at(self.time)[0])
-        )
-        if distance > self.drop_point.tolerance:
-            return ReleaseResult(
-                (),
-                f"{distance:.3f} m from the drop point (tolerance {self.drop_point.tolerance:g} m)",
+        result = self._cargo.release(self.collector_state()[0], self.drop_point, self.time)
+        if result.delivered:
+            pb.changeDynamics(
+                self.collector, -1, mass=self.collector_mass(), physicsClientId=self._client
             )
-        delivered = []
-        for index, (body, constraint) in self._carried.items():
-            pb.removeConstraint(constraint, physicsClientId=self._client)
-            pb.removeBody(body, physicsClientId=self._client)
-            self.field.status[index] = ObjectStatus.DELIVERED
-            delivered.append(self.field.objects[index].id)
-        self._carried.clear()
-        self._protrusion = 0.0
-        self.robot_changes += 1
-        pb.changeDynamics(
-            self.collector, -1, mass=self.collector_mass(), physicsClientId=self._client
-        )
-        return ReleaseResult(tuple(delivered), "delivered")
+        return result
 
     # ------------------------------------------------------------------ lifetime
     def close(self) -> None:

@@ -1,15 +1,16 @@
-"""Space objects (targets and obstacles) as the world keeps them."""
+"""Space objects (targets and obstacles) as the world keeps them, and the field of them all."""
 
 from __future__ import annotations
 
 import enum
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from dcsim.messages import ObjectKind
+from dcsim.messages import ObjectKind, Shape, ShapeKind
 from dcsim.motion import MotionModel, MotionSet
+from dcsim.scenario.model import Scenario
 
 
 class ObjectStatus(enum.IntEnum):
@@ -30,19 +31,38 @@ class SpaceObject:
         Unique id.
     kind : ObjectKind
         Target or obstacle.
-    radius : float
-        Bounding-sphere radius, m.
+    shape : Shape
+        Collision shape, centred on the object's position, its orientation fixed.
     mass : float
         Mass, kg.
     motion : MotionModel
         Motion followed exactly while the object is free.
+    radius : float
+        Radius of the shape's bounding sphere, m (computed once).
     """
 
     id: int
     kind: ObjectKind
-    radius: float
+    shape: Shape
     mass: float
     motion: MotionModel
+    radius: float = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "radius", self.shape.bounding_radius)
+
+
+def build_objects(scenario: Scenario) -> list[SpaceObject]:
+    """The scenario's targets and obstacles as world objects (targets first)."""
+    n = scenario.mean_motion
+    return [
+        SpaceObject(spec.id, kind, spec.build_shape(), spec.mass, spec.motion.build(n))
+        for kind, specs in (
+            (ObjectKind.TARGET, scenario.targets),
+            (ObjectKind.OBSTACLE, scenario.obstacles),
+        )
+        for spec in specs
+    ]
 
 
 class ObjectField:
@@ -53,9 +73,11 @@ class ObjectField:
     objects : tuple of SpaceObject
         The objects, in scenario order (targets first).
     radii : ndarray (N,)
-        Radii, m.
+        Bounding-sphere radii, m.
     is_target : ndarray (N,) of bool
         Which objects are targets.
+    is_sphere : ndarray (N,) of bool
+        Which objects are spheres (their bounding sphere is their shape).
     status : ndarray (N,) of int
         :class:`ObjectStatus` of each object.
     """
@@ -64,6 +86,9 @@ class ObjectField:
         self.objects = tuple(objects)
         self.radii = np.array([o.radius for o in self.objects], dtype=float)
         self.is_target = np.array([o.kind is ObjectKind.TARGET for o in self.objects], dtype=bool)
+        self.is_sphere = np.array(
+            [o.shape.kind is ShapeKind.SPHERE for o in self.objects], dtype=bool
+        )
         self.status = np.full(len(self.objects), ObjectStatus.FREE, dtype=int)
         self.index = {o.id: i for i, o in enumerate(self.objects)}
         self._motions = MotionSet([o.motion for o in self.objects])

@@ -81,6 +81,10 @@ the attraction, eqs 5.1–5.3 and the Move message stay as they are:
 With both layers on, the collector seldom enters the safety sphere of an obstacle it is
 closing on, so the thesis's repulsion mostly stands by as the innermost layer.
 
+Every obstacle is taken as its bounding sphere (``ObjectTrack.radius``), as in the
+thesis: for a box or a cylinder (``ObjectTrack.shape``) this is conservative, the
+collector keeps clear of the sphere that holds the shape.
+
 The gains are softer than a tracking loop's would be (``gain`` 0.03/s, ``response_time``
 4 s): every dodge is followed by a return to the reference, and the velocity loop feeds
 the navigation noise into thrust, both at a delta-v cost proportional to them.

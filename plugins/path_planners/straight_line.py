@@ -8,8 +8,10 @@ required time if one is given, otherwise as soon as a cruise speed of
 ``speed_fraction`` of the speed limit allows. The path is checked against every
 obstacle's predicted motion every ``check_spacing`` metres; if it passes closer than
 the two radii plus ``clearance`` the answer is "no path", naming the obstacle and the
-time (unless ``check_obstacles`` is false). This is the yardstick the real planners are
-compared with.
+time (unless ``check_obstacles`` is false). An obstacle's radius is its bounding sphere's
+(``ObjectTrack.radius``): for a box or a cylinder (``ObjectTrack.shape``) the check is
+conservative and may refuse a path that clears the true shape. This is the yardstick the
+real planners are compared with.
 """
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ import pytest
 from dcsim.api import ClohessyWiltshireMotion, SphericalMotion, mean_motion
 from dcsim.scenario import ScenarioDocument, validate
 from dcsim.world import World, WorldInputs
-from dcsim.world.engine import STANDARD_GRAVITY
+from dcsim.world.environment import STANDARD_GRAVITY
 from dcsim.world.pybullet_client import pb
 
 N = mean_motion(6_778_137.0)

@@ -1,0 +1,180 @@
+"""PyBullet bodies of a world: the collector, the objects' static bodies, carried targets.
+
+Each body has its object's true shape: a sphere, a box (``GEOM_BOX``, half extents) or
+a cylinder (``GEOM_CYLINDER``, its axis the body z axis), turned by the shape's fixed
+orientation wherever it is placed. The collector is a sphere.
+
+Every body has collision filtering off: contacts are detected by closest-point queries
+(:func:`surface_gap`), never resolved, so bodies pass through each other. A free
+object's body is static and is moved to its motion model's position only when a query
+needs it (:meth:`ObjectBodies.place`), so a large field costs little; a grabbed target
+gets a dynamic body of its mass.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dcsim.messages import Shape, ShapeKind
+from dcsim.scenario.model import RobotSection, point_to_cartesian
+from dcsim.world.objects import ObjectField
+from dcsim.world.pybullet_client import pb
+
+
+def create_body(client: int, shape: Shape, mass: float, position: np.ndarray, maximal: bool) -> int:
+    """A body of ``shape`` without collision response.
+
+    Parameters
+    ----------
+    client : int
+        PyBullet client id.
+    shape : Shape
+        Sphere, box or cylinder; its orientation is the body's initial orientation.
+    mass : float
+        kg; 0 for a static body. A dynamic body gets no damping.
+    position : ndarray (3,)
+        Initial position, world frame, m.
+    maximal : bool
+        Use maximal coordinates (cheaper for static bodies).
+
+    Returns
+    -------
+    int
+        The body id.
+    """
+    body = pb.createMultiBody(
+        baseMass=mass,
+        baseCollisionShapeIndex=_collision_shape(client, shape),
+        basePosition=position.tolist(),
+        baseOrientation=shape.orientation.tolist(),
+        useMaximalCoordinates=maximal,
+        physicsClientId=client,
+    )
+    pb.setCollisionFilterGroupMask(body, -1, 0, 0, physicsClientId=client)
+    if shape.kind is not ShapeKind.SPHERE:
+        # Bullet rounds a box's or a cylinder's edges by its collision margin (1 mm by
+        # default); without it their closest points are exact (to ~1e-7 m on curved faces).
+        pb.changeDynamics(body, -1, collisionMargin=0.0, physicsClientId=client)
+    if mass > 0:
+        pb.changeDynamics(body, -1, linearDamping=0, angularDamping=0, physicsClientId=client)
+    return body
+
+
+def _collision_shape(client: int, shape: Shape) -> int:
+    """PyBullet collision shape of ``shape`` (a cylinder's axis is its local z)."""
+    if shape.kind is ShapeKind.BOX:
+        return pb.createCollisionShape(
+            pb.GEOM_BOX, halfExtents=shape.half_extents.tolist(), physicsClientId=client
+        )
+    if shape.kind is ShapeKind.CYLINDER:
+        return pb.createCollisionShape(
+            pb.GEOM_CYLINDER, radius=shape.radius, height=shape.height, physicsClientId=client
+        )
+    return pb.createCollisionShape(pb.GEOM_SPHERE, radius=shape.radius, physicsClientId=client)
+
+
+def create_collector(client: int, robot: RobotSection) -> int:
+    """The collector's sphere body at its initial state (position, attitude, velocities)."""
+    initial = robot.initial
+    body = create_body(
+        client,
+        Shape(ShapeKind.SPHERE, radius=robot.radius),
+        robot.mass,
+        point_to_cartesian(initial.position),
+        False,
+    )
+    attitude = np.asarray(initial.attitude) / np.linalg.norm(initial.attitude)
+    pb.resetBasePositionAndOrientation(
+        body,
+        point_to_cartesian(initial.position).tolist(),
+        attitude.tolist(),
+        physicsClientId=client,
+    )
+    pb.resetBaseVelocity(
+        body, list(initial.velocity), list(initial.angular_velocity), physicsClientId=client
+    )
+    return body
+
+
+def surface_gap(client: int, body_a: int, body_b: int, within: float) -> float:
+    """Smallest distance between the surfaces of two bodies, m (negative when they overlap).
+
+    Parameters
+    ----------
+    client : int
+        PyBullet client id.
+    body_a, body_b : int
+        The bodies, at their current poses.
+    within : float
+        Largest gap looked for, m.
+
+    Returns
+    -------
+    float
+        The gap, or ``inf`` if it exceeds ``within``.
+    """
+    points = pb.getClosestPoints(body_a, body_b, within, physicsClientId=client)
+    return min((pt[8] for pt in points), default=float("inf"))
+
+
+class ObjectBodies:
+    """The PyBullet body of every space object, by the object's index in the field.
+
+    Parameters
+    ----------
+    client : int
+        PyBullet client id.
+    field : ObjectField
+        The objects; each gets a static body at its position at t = 0.
+
+    Attributes
+    ----------
+    ids : list of int
+        Body id of each object (a carried target's dynamic body once grabbed).
+    """
+
+    def __init__(self, client: int, field: ObjectField) -> None:
+        self._client = client
+        self._field = field
+        self._orientations = [obj.shape.orientation.tolist() for obj in field.objects]
+        self.ids = [
+            create_body(client, obj.shape, 0.0, field.free_states(0.0)[0][index], True)
+            for index, obj in enumerate(field.objects)
+        ]
+
+    def place(self, index: int, time: float) -> int:
+        """Move free object ``index``'s static body to its model pose at ``time`` (s).
+
+        Returns
+        -------
+        int
+            The body id.
+        """
+        body = self.ids[index]
+        position = self._field.objects[index].motion.state_at(time)[0]
+        pb.resetBasePositionAndOrientation(
+            body, position.tolist(), self._orientations[index], physicsClientId=self._client
+        )
+        return body
+
+    def make_dynamic(self, index: int, position: np.ndarray, velocity: np.ndarray) -> int:
+        """Replace object ``index``'s static body by a dynamic one of its mass and shape.
+
+        Parameters
+        ----------
+        index : int
+            The object's index in the field.
+        position, velocity : ndarray (3,)
+            The new body's state, world frame, m and m/s.
+
+        Returns
+        -------
+        int
+            The new body id.
+        """
+        pb.removeBody(self.ids[index], physicsClientId=self._client)
+        obj = self._field.objects[index]
+        body = create_body(self._client, obj.shape, obj.mass, position, False)
+        pb.resetBaseVelocity(body, velocity.tolist(), [0, 0, 0], physicsClientId=self._client)
+        self.ids[index] = body
+        return body

@@ -1,0 +1,128 @@
+"""The space environment the collector flies in: orbital forces and its propellant.
+
+- **Clohessy–Wiltshire**: in the ``lvlh`` frame a body feels the relative-motion
+  accelerations ``(3n²x + 2nẏ, −2nẋ, −n²z)``, applied as external forces at its centre;
+  ``geocentric`` is force-free, as in the source thesis.
+- **Propellant**: the thrusters burn ``|F| dt / (Isp g0)`` a physics step; delta-v
+  accumulates ``|F| dt / m`` with ``m`` the mass of the collector and what it carries.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from dcsim.world.pybullet_client import pb
+
+STANDARD_GRAVITY = 9.80665
+"""g0 used with the specific impulse, m/s²."""
+
+Force = tuple[float, float, float]
+
+
+def cw_acceleration(
+    mean_motion: float, position: Sequence[float], velocity: Sequence[float]
+) -> Force:
+    """Clohessy–Wiltshire acceleration at an LVLH state.
+
+    Parameters
+    ----------
+    mean_motion : float
+        Mean motion ``n`` of the reference orbit, rad/s.
+    position, velocity : sequence of 3 floats
+        LVLH state (x radial, y along-track), m and m/s.
+
+    Returns
+    -------
+    tuple of 3 floats
+        Acceleration, LVLH frame, m/s².
+    """
+    n = mean_motion
+    return (
+        3.0 * n * n * position[0] + 2.0 * n * velocity[1],
+        -2.0 * n * velocity[0],
+        -n * n * position[2],
+    )
+
+
+def apply_cw_force(client: int, body: int, mass: float, mean_motion: float) -> None:
+    """Apply the Clohessy–Wiltshire force on ``body`` (mass in kg) for the next physics step.
+
+    The force, ``mass`` times :func:`cw_acceleration` at the body's current state, acts
+    at its centre of mass in the world (LVLH) frame.
+    """
+    p, _ = pb.getBasePositionAndOrientation(body, physicsClientId=client)
+    v, _ = pb.getBaseVelocity(body, physicsClientId=client)
+    cx, cy, cz = cw_acceleration(mean_motion, p, v)
+    pb.applyExternalForce(
+        body, -1, (mass * cx, mass * cy, mass * cz), p, pb.WORLD_FRAME, physicsClientId=client
+    )
+
+
+class Propellant:
+    """The thrusters' propellant: what is left and used, and the delta-v flown.
+
+    Parameters
+    ----------
+    mass : float
+        Usable propellant at the start, kg.
+    specific_impulse : float
+        Thruster specific impulse, s.
+    physics_step : float
+        Physics time step, s.
+    steps : int
+        Physics steps in a control period.
+
+    Attributes
+    ----------
+    remaining : float
+        Propellant left, kg.
+    used : float
+        Propellant used so far, kg.
+    delta_v : float
+        Delta-v accumulated, m/s.
+    last_acceleration : ndarray (3,)
+        Mean thrust acceleration over the last burn, world frame, m/s².
+    """
+
+    def __init__(
+        self, mass: float, specific_impulse: float, physics_step: float, steps: int
+    ) -> None:
+        self.remaining = mass
+        self.used = 0.0
+        self.delta_v = 0.0
+        self.last_acceleration = np.zeros(3)
+        self._specific_impulse = specific_impulse
+        self._dt = physics_step
+        self._steps = steps
+
+    def burn(self, force: np.ndarray, mass: float) -> list[Force]:
+        """Thrust of each physics step of the coming control period, with the bookkeeping.
+
+        The commanded force is held over the period until the propellant runs out.
+
+        Parameters
+        ----------
+        force : ndarray (3,)
+            Commanded thrust, world frame, N (already within the limit).
+        mass : float
+            Mass accelerated over the period (collector and cargo), kg.
+
+        Returns
+        -------
+        list of tuple
+            The thrust (N, world frame) of each physics step of the period.
+        """
+        steps, dt = self._steps, self._dt
+        magnitude = float(np.linalg.norm(force))
+        per_step = magnitude * dt / (self._specific_impulse * STANDARD_GRAVITY)
+        fractions = np.zeros(steps)
+        if per_step > 0:
+            fractions = np.clip((self.remaining - per_step * np.arange(steps)) / per_step, 0.0, 1.0)
+        used = per_step * float(fractions.sum())
+        self.remaining = max(self.remaining - used, 0.0)
+        self.used += used
+        self.delta_v += magnitude * dt * float(fractions.sum()) / mass
+        self.last_acceleration = force * (fractions.mean() / mass)
+        return [tuple(float(f) for f in force * k) for k in fractions]
