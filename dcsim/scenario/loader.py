@@ -25,7 +25,7 @@ from pydantic import BaseModel, ValidationError
 
 from dcsim.errors import DcsimError, PluginParameterError, Problem, ScenarioError
 from dcsim.interfaces import PLUGIN_KINDS
-from dcsim.params import describe_error
+from dcsim.params import describe_error, short_repr
 from dcsim.registry import PluginRegistry
 from dcsim.scenario.document import KeyPath, ScenarioDocument
 from dcsim.scenario.model import CWMotionSpec, Scenario
@@ -191,9 +191,9 @@ def _schema_problems(doc: ScenarioDocument, exc: ValidationError) -> list[Proble
         if exact:
             message = describe_error(owner, field, err)
         elif err["type"] == "missing" and isinstance(err["loc"][-1], int):
-            message = f"{err['input']!r} has too few items"
+            message = f"{short_repr(err['input'])} has too few items"
         else:
-            message = f"{err['input']!r} is not allowed: {err['msg']}"
+            message = f"{short_repr(err['input'])} is not allowed: {err['msg']}"
         messages.setdefault(path, []).append(message)
     found = [
         doc.problem(path, "; or ".join(dict.fromkeys(msgs))) for path, msgs in messages.items()

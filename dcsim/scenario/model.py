@@ -2,7 +2,8 @@
 
 Units are SI unless the key says otherwise; angles are in degrees where the source
 thesis uses degrees, with the unit in the key name (``polar_deg``, ``beta_deg_s``).
-Unknown keys are errors. docs/scenarios.md is generated from these models.
+Unknown keys are errors, and so are NaN and infinite numbers. docs/scenarios.md is
+generated from these models.
 """
 
 from __future__ import annotations
@@ -28,9 +29,9 @@ Vec3 = tuple[float, float, float]
 
 
 class Section(BaseModel):
-    """Base of every scenario section: immutable, unknown keys rejected."""
+    """Base of every scenario section: immutable, unknown keys and non-finite numbers rejected."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 class SphericalPoint(Section):
