@@ -27,6 +27,18 @@ from dcsim.params import quantity
 
 Vec3 = tuple[float, float, float]
 
+MAX_STEPS_PER_CONTROL_PERIOD = 100_000
+"""Most physics steps in one control period."""
+
+MAX_PHYSICS_STEPS = 100_000_000
+"""Most physics steps in a run (``world.duration / world.physics_step``)."""
+
+MEAN_MOTION_RANGE = (1e-9, 0.1)
+"""Least and largest mean motion of the reference orbit, rad/s (periods of 63 s to 200 years)."""
+
+MAX_SEED = 2**31 - 1
+"""Largest seed: the range of an FMI Integer, as the FMU's ``seed`` parameter is one."""
+
 
 class Section(BaseModel):
     """Base of every scenario section: immutable, unknown keys and non-finite numbers rejected."""
@@ -142,17 +154,34 @@ class WorldSpec(Section):
         description="lvlh: Clohessy–Wiltshire relative motion about the reference orbit; "
         "geocentric: the thesis's force-free spherical world.",
     )
-    orbit: OrbitSpec = Field(default_factory=OrbitSpec, description="Reference orbit (lvlh only).")
+    orbit: OrbitSpec = Field(
+        default_factory=OrbitSpec,
+        description="Reference orbit (lvlh only); its mean motion is between "
+        f"{MEAN_MOTION_RANGE[0]:g} and {MEAN_MOTION_RANGE[1]:g} rad/s.",
+    )
     physics_step: float = quantity(
         0.01, unit="s", gt=0, le=1, description="Fixed physics time step."
     )
     control_period: float = quantity(
-        0.1, unit="s", gt=0, description="Control period; a whole number of physics steps."
+        0.1,
+        unit="s",
+        gt=0,
+        description="Control period; a whole number of physics steps, at most "
+        f"{MAX_STEPS_PER_CONTROL_PERIOD:,}.",
     )
     duration: float = quantity(
-        600.0, unit="s", gt=0, description="Simulated time after which the run ends."
+        600.0,
+        unit="s",
+        gt=0,
+        description="Simulated time after which the run ends; at most "
+        f"{MAX_PHYSICS_STEPS:,} physics steps.",
     )
-    seed: int = quantity(0, ge=0, description="Seed of every random number in the run.")
+    seed: int = quantity(
+        0,
+        ge=0,
+        le=MAX_SEED,
+        description="Seed of every random number in the run (it fits an FMU Integer).",
+    )
 
 
 class InitialStateSpec(Section):
