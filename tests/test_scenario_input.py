@@ -237,6 +237,40 @@ def test_a_recursive_alias_is_an_error(tmp_path):
     ]
 
 
+@pytest.mark.parametrize(
+    "text, expected",
+    [
+        (
+            "targets:\n  - {motion: {type: static, position: [1, 2, 3]}}\n",
+            ["2:5: targets[0].id: required but missing"],
+        ),
+        (
+            "world: 3\nrobot: [1, 2]\n",
+            [
+                "1:1: world: 3 is not allowed: Input should be a valid dictionary or instance of WorldSpec",
+                "2:1: robot: [1, 2] is not allowed: Input should be a valid dictionary or instance of RobotSection",
+            ],
+        ),
+        (
+            "robot:\n  mass: heavy\n",
+            [
+                "2:3: robot.mass: 'heavy' is not allowed: Input should be a valid number, unable to parse string as a number (allowed: > 0 kg)"
+            ],
+        ),
+        (
+            "obstacles: {a: {b: {c: [[[{d: 1}]]]}}}\n",
+            [
+                "1:1: obstacles: {'a': {'b': {'c': [[[{'d': 1}]]]}}} is not allowed: Input should be a valid list"
+            ],
+        ),
+    ],
+    ids=["deleted-required-key", "sections-replaced", "wrong-type", "nested-junk"],
+)
+def test_wrong_types_missing_keys_and_nested_junk_stay_clean_errors(tmp_path, text, expected):
+    path = write(tmp_path, text)
+    assert problems(path) == [f"{path}:{line}" for line in expected]
+
+
 def test_rules_across_keys_are_reported_with_field_errors(tmp_path):
     path = write(
         tmp_path,
