@@ -7,6 +7,7 @@ no traceback; ``dcsim --debug ...`` shows the traceback instead.
 from __future__ import annotations
 
 import json
+import re
 import sys
 import warnings
 from datetime import datetime
@@ -21,6 +22,7 @@ from dcsim.registry import PluginRegistry
 from dcsim.rundir import prepare_run_directory
 from dcsim.runsetup import prepare_run
 from dcsim.scenario import load_scenario
+from dcsim.scenario.model import MAX_SEED
 
 EXIT_USER_ERROR = 2
 
@@ -125,7 +127,11 @@ def validate_command(files: tuple[Path, ...]) -> None:
     help="Run directory to write (created if missing). Default: runs/NAME-YYYYmmdd-HHMMSS.",
 )
 @click.option("--force", is_flag=True, help="Replace the run directory if it already holds a run.")
-@click.option("--seed", type=click.IntRange(min=0), help="Seed for this run; replaces world.seed.")
+@click.option(
+    "--seed",
+    type=click.IntRange(min=0, max=MAX_SEED),
+    help="Seed for this run; replaces world.seed.",
+)
 @click.option(
     "--set",
     "overrides",
@@ -158,7 +164,8 @@ def run_command(
 
     setup = prepare_run(scenario, overrides, seed, registry=_registry())
     if out is None:
-        out = Path("runs") / f"{setup.scenario.name}-{datetime.now():%Y%m%d-%H%M%S}"
+        stamp = f"{datetime.now():%Y%m%d-%H%M%S}"
+        out = Path("runs") / f"{_file_name_part(setup.scenario.name)}-{stamp}"
     prepare_run_directory(out, force)
     summary = Runner(setup, out, progress=terminal_progress()).run()
     if sys.stderr.isatty():
@@ -168,6 +175,11 @@ def run_command(
         sys.exit(130)
     if summary["status"] == "failed":
         sys.exit(1)
+
+
+def _file_name_part(name: str) -> str:
+    """``name`` made safe inside a file name: no separators or control characters, short."""
+    return re.sub(r"[\x00-\x1f\x7f/\\]", "_", name)[:50]
 
 
 def _print_summary(summary: dict, out: Path) -> None:

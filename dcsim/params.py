@@ -3,7 +3,8 @@
 Plugin parameters and scenario sections are pydantic models built from
 :func:`quantity` fields. Each field carries its unit, default, bounds and a one-line
 description, which the documentation generator and the error messages read from the
-same place.
+same place. Numbers must be finite: NaN and ±infinity are rejected unless a field is
+declared with ``allow_inf_nan=True`` and its description says "inf allowed".
 
 Examples
 --------
@@ -50,7 +51,9 @@ def quantity(
     gt, ge, lt, le : float, optional
         Exclusive and inclusive bounds.
     **kwargs
-        Passed on to :func:`pydantic.Field` (e.g. ``default_factory``).
+        Passed on to :func:`pydantic.Field` (e.g. ``default_factory``, or
+        ``allow_inf_nan=True`` for a number that may be infinite, whose description
+        then says "inf allowed").
 
     Returns
     -------
@@ -87,7 +90,7 @@ def field_bounds(model: type[BaseModel], name: str) -> str:
         for attr, symbol in _BOUND_SYMBOLS.items():
             value = getattr(meta, attr, None)
             if value is not None:
-                parts.append(f"{symbol} {value:g}")
+                parts.append(f"{symbol} {value if isinstance(value, int) else f'{value:g}'}")
     return ", ".join(parts)
 
 
@@ -95,11 +98,13 @@ class PluginParams(BaseModel):
     """Base class of every plugin's parameter model.
 
     Subclasses declare their fields with :func:`quantity`. Instances are immutable,
-    unknown parameter names are rejected, and types are checked strictly enough that a
-    string is never silently taken for a number.
+    unknown parameter names are rejected, numbers must be finite, and types are checked
+    strictly enough that a string is never silently taken for a number.
     """
 
-    model_config = ConfigDict(extra="forbid", frozen=True, validate_default=True)
+    model_config = ConfigDict(
+        extra="forbid", frozen=True, validate_default=True, allow_inf_nan=False
+    )
 
     @classmethod
     def parse(cls, plugin: str, values: Mapping[str, Any] | None) -> PluginParams:
@@ -158,9 +163,24 @@ def describe_error(model: type[BaseModel] | None, field: str | None, error: Erro
         allowed = ", ".join(model.model_fields) if model is not None else ""
         hint = f" (known keys: {allowed})" if allowed else ""
         return f"unknown key{hint}"
-    message = f"{error['input']!r} is not allowed: {error['msg']}"
+    message = f"{short_repr(error['input'])} is not allowed: {error['msg']}"
     if model is not None and field in model.model_fields:
         bounds, unit = field_bounds(model, field), field_unit(model, field)
         if bounds:
             message += f" (allowed: {bounds}{' ' + unit if unit else ''})"
     return message
+
+
+def short_repr(value: Any, limit: int = 80) -> str:
+    """``repr(value)``, cut to about ``limit`` characters for error messages.
+
+    Examples
+    --------
+    >>> short_repr(list(range(100)), 20)
+    '[0, 1, 2, 3, 4, 5, …'
+    """
+    try:
+        text = repr(value)
+    except ValueError:  # an integer too long to print
+        return f"an integer of {value.bit_length()} bits"
+    return text if len(text) <= limit else text[: limit - 1] + "…"

@@ -218,8 +218,10 @@ def test_yaml_syntax_error_and_duplicate_keys(tmp_path):
     assert "the top level must be a mapping" in problems(path)[0]
 
 
-def test_empty_file_is_the_all_defaults_scenario(tmp_path):
-    scenario = load_scenario(write(tmp_path, ""))
+def test_empty_file_is_an_error_and_an_empty_mapping_the_defaults(tmp_path):
+    path = write(tmp_path, "# nothing yet\n")
+    assert problems(path) == [f"{path}:1:1: the file is empty; a scenario is a mapping of sections"]
+    scenario = load_scenario(write(tmp_path, "{}"))
     assert scenario.name == "unnamed" and scenario.world.frame == "lvlh"
 
 

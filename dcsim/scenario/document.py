@@ -15,6 +15,13 @@ from typing import Any
 import yaml
 
 from dcsim.errors import Problem, ScenarioError
+from dcsim.scenario.yamltext import (
+    MAX_DEPTH,
+    MAX_FILE_BYTES,
+    YamlInputError,
+    compose,
+    decode,
+)
 
 KeyPath = tuple[str | int, ...]
 _TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_-]*)|\[(\d+)\]")
@@ -79,27 +86,24 @@ class ScenarioDocument:
         Raises
         ------
         ScenarioError
-            On a YAML syntax error, a duplicated key, or a top level that is not a mapping.
+            On a YAML syntax error, a document beyond the limits of
+            :mod:`dcsim.scenario.yamltext`, a duplicated key, an empty text, or a top
+            level that is not a mapping.
         """
-        loader = yaml.SafeLoader(text)
         try:
-            node = loader.get_single_node()
-            data = loader.construct_document(node) if node is not None else {}
-        except yaml.MarkedYAMLError as exc:
-            mark = exc.problem_mark or exc.context_mark
-            line, column = (mark.line + 1, mark.column + 1) if mark else (None, None)
-            problem = Problem("", f"not valid YAML: {exc.problem or exc}", line, column)
-            raise ScenarioError(filename, [problem]) from None
-        finally:
-            loader.dispose()
+            node, data = compose(text)
+        except YamlInputError as exc:
+            raise ScenarioError(filename, [Problem("", str(exc), exc.line, exc.column)]) from None
+        if node is None:
+            message = "the file is empty; a scenario is a mapping of sections"
+            raise ScenarioError(filename, [Problem("", message, 1, 1)])
         if not isinstance(data, dict):
             raise ScenarioError(
                 filename, [Problem("", "the top level must be a mapping of sections", 1, 1)]
             )
         doc = cls(filename, data)
         duplicates: list[Problem] = []
-        if node is not None:
-            doc._collect_marks(node, (), duplicates)
+        doc._collect_marks(node, (), duplicates)
         if duplicates:
             raise ScenarioError(filename, duplicates)
         return doc
@@ -111,14 +115,24 @@ class ScenarioDocument:
         Raises
         ------
         ScenarioError
-            If the file cannot be read or parsed.
+            If the file cannot be read, is larger than
+            :data:`~dcsim.scenario.yamltext.MAX_FILE_BYTES`, is not UTF-8 text, or cannot
+            be parsed.
         """
         try:
-            text = Path(path).read_text(encoding="utf-8")
+            with Path(path).open("rb") as file:
+                raw = file.read(MAX_FILE_BYTES + 1)
         except OSError as exc:
             raise ScenarioError(
                 str(path), [Problem("", f"cannot read the file: {exc.strerror}")]
             ) from None
+        if len(raw) > MAX_FILE_BYTES:
+            message = f"the file is larger than {MAX_FILE_BYTES:,} bytes; a scenario needs far less"
+            raise ScenarioError(str(path), [Problem("", message)])
+        try:
+            text = decode(raw)
+        except YamlInputError as exc:
+            raise ScenarioError(str(path), [Problem("", str(exc), exc.line, exc.column)]) from None
         return cls.from_text(text, str(path))
 
     def _collect_marks(self, node: yaml.Node, path: KeyPath, duplicates: list[Problem]) -> None:
@@ -155,8 +169,10 @@ class ScenarioDocument:
             if not sep:
                 raise ValueError("expected key.path=value")
             path = parse_key_path(key_text.strip())
-            value = yaml.safe_load(value_text) if value_text.strip() else None
-        except (ValueError, yaml.YAMLError) as exc:
+            if len(path) > MAX_DEPTH:
+                raise ValueError(f"the key path is more than {MAX_DEPTH} keys long")
+            value = compose(value_text)[1] if value_text.strip() else None
+        except ValueError as exc:
             raise ScenarioError(self.filename, [Problem("", str(exc), source=source)]) from None
         container: Any = self.data
         for depth, key in enumerate(path[:-1]):

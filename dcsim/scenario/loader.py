@@ -15,19 +15,28 @@ gives an equal scenario.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import math
+from collections.abc import Callable, Sequence
+from functools import cache
 from importlib import resources
 from pathlib import Path
 from typing import Annotated, Any, get_args, get_origin
 
+import numpy as np
 import yaml
-from pydantic import BaseModel, ValidationError
+from pydantic import BaseModel, TypeAdapter, ValidationError
 
 from dcsim.errors import DcsimError, PluginParameterError, Problem, ScenarioError
-from dcsim.params import describe_error
+from dcsim.params import describe_error, short_repr
 from dcsim.registry import PluginRegistry
-from dcsim.scenario.document import KeyPath, ScenarioDocument
-from dcsim.scenario.model import CWMotionSpec, Scenario, scenario_model
+from dcsim.scenario.document import KeyPath, ScenarioDocument, format_key_path
+from dcsim.scenario.model import (
+    MAX_PHYSICS_STEPS,
+    MAX_STEPS_PER_CONTROL_PERIOD,
+    MEAN_MOTION_RANGE,
+    Scenario,
+    scenario_model,
+)
 
 DEFAULT_SCENARIO = "default.yaml"
 
@@ -87,11 +96,19 @@ def validate(doc: ScenarioDocument) -> Scenario:
     try:
         scenario = model.model_validate(doc.data)
     except ValidationError as exc:
-        raise ScenarioError(doc.filename, _schema_problems(doc, exc, model)) from None
-    problems = [doc.problem(path, message) for path, message in _rule_violations(scenario)]
+        problems = _schema_problems(doc, exc, model)
+    else:
+        problems = []
+    violations = _rule_violations(doc.data, model)
+    problems += [doc.problem(path, message) for path, message in violations]
     if problems:
-        raise ScenarioError(doc.filename, problems)
+        raise ScenarioError(doc.filename, sorted(problems, key=_document_order))
     return scenario
+
+
+def _document_order(problem: Problem) -> tuple[bool, int, int]:
+    """Sort key of problems: by line and column, those without a line last."""
+    return (problem.line is None, problem.line or 0, problem.column or 0)
 
 
 def resolve_plugins(
@@ -140,52 +157,238 @@ def dump_scenario(scenario: Scenario) -> str:
     return yaml.safe_dump(scenario.model_dump(mode="json"), sort_keys=False, allow_unicode=True)
 
 
-def _rule_violations(scenario: Scenario) -> list[tuple[KeyPath, str]]:
-    """Rules that span fields or sections, as (key path, message) pairs."""
+class _Invalid(Exception):
+    """A value a rule reads is itself invalid (the schema reports it); the rule is skipped."""
+
+
+class _Values:
+    """Validated values of single keys of raw scenario data, for the rules across keys.
+
+    ``get("world", "physics_step")`` is the key's value validated on its own (its
+    default if absent); :class:`_Invalid` is raised when it cannot be known.
+    """
+
+    def __init__(self, data: dict[str, Any], model: type[Scenario]) -> None:
+        self.data, self.model = data, model
+
+    def __call__(self, *path: str | int) -> Any:
+        return _value(self.data, path, self.model)
+
+    def given(self, *path: str | int) -> bool:
+        """Whether the raw data has a value at ``path``."""
+        node: Any = self.data
+        for key in path:
+            found = isinstance(node, dict) and key in node
+            found = found or (isinstance(node, list) and isinstance(key, int) and key < len(node))
+            if not found:
+                return False
+            node = node[key]
+        return True
+
+    def items(self, key: str) -> range:
+        """Indices of the raw list at top-level ``key`` (none if it is not a list)."""
+        raw = self.data.get(key)
+        return range(len(raw) if isinstance(raw, list) else 0)
+
+
+Rule = Callable[..., list[tuple[KeyPath, str]]]
+"""A rule across keys: takes :class:`_Values` (and more), gives (key path, message) pairs."""
+
+
+def _rule_violations(data: dict[str, Any], model: type[Scenario]) -> list[tuple[KeyPath, str]]:
+    """Rules that span fields or sections, as (key path, message) pairs.
+
+    A rule is checked whenever the values it reads are valid, whatever other keys of
+    the document are invalid, so that its violations are reported with the schema's.
+    A rule reading a key the scenario's mission does not have is skipped.
+    """
+    get = _Values(data, model)
+    return [found for rule in _RULES for found in _checked(rule, get)]
+
+
+def _checked(rule: Rule, *args: Any) -> list[tuple[KeyPath, str]]:
+    """The violations of ``rule``; none if a value it reads is invalid."""
+    try:
+        return rule(*args)
+    except _Invalid:
+        return []
+
+
+def _control_period_rule(get: _Values) -> list[tuple[KeyPath, str]]:
+    step, period = get("world", "physics_step"), get("world", "control_period")
+    ratio = period / step
+    if ratio > MAX_STEPS_PER_CONTROL_PERIOD:
+        message = (
+            f"{period:g} s is more than {MAX_STEPS_PER_CONTROL_PERIOD:,} physics steps of "
+            f"{step:g} s; shorten world.control_period or lengthen world.physics_step"
+        )
+    elif abs(ratio - round(ratio)) > 1e-9 * ratio or round(ratio) < 1:
+        message = f"{period:g} s is not a whole multiple of physics_step ({step:g} s)"
+    else:
+        return []
+    return [(("world", "control_period"), message)]
+
+
+def _duration_rule(get: _Values) -> list[tuple[KeyPath, str]]:
+    step, duration = get("world", "physics_step"), get("world", "duration")
+    if duration / step <= MAX_PHYSICS_STEPS:
+        return []
+    message = (
+        f"{duration:g} s is more than {MAX_PHYSICS_STEPS:,} physics steps of {step:g} s; "
+        "shorten world.duration or lengthen world.physics_step"
+    )
+    return [(("world", "duration"), message)]
+
+
+def _orbit_rule(get: _Values) -> list[tuple[KeyPath, str]]:
+    if get("world", "frame") != "lvlh":
+        return []
+    radius, mu = get("world", "orbit", "radius"), get("world", "orbit", "mu")
+    with np.errstate(all="ignore"):  # as mean_motion() computes it, overflow giving inf or 0
+        rate = float(np.sqrt(np.float64(mu) / np.float64(radius) ** 3))
+    low, high = MEAN_MOTION_RANGE
+    if low <= rate <= high:
+        return []
+    message = (
+        f"radius {radius:g} m and mu {mu:g} m^3/s^2 give a mean motion of {rate:.3g} rad/s; "
+        f"change them so that it is between {low:g} and {high:g} rad/s"
+    )
+    return [(("world", "orbit"), message)]
+
+
+def _propellant_rule(get: _Values) -> list[tuple[KeyPath, str]]:
+    propellant, mass = get("robot", "propellant_mass"), get("robot", "mass")
+    if propellant < mass:
+        return []
+    message = f"{propellant:g} kg must be less than robot.mass ({mass:g} kg)"
+    return [(("robot", "propellant_mass"), message)]
+
+
+def _reach_rule(get: _Values) -> list[tuple[KeyPath, str]]:
+    reach, grab = get("mission", "reach"), get("robot", "grab_distance")
+    if reach <= grab:
+        return []
+    return [(("mission", "reach"), f"{reach:g} m is beyond robot.grab_distance ({grab:g} m)")]
+
+
+def _attitude_rule(get: _Values) -> list[tuple[KeyPath, str]]:
+    if sum(q * q for q in get("robot", "initial", "attitude")) >= 1e-12:
+        return []
+    return [(("robot", "initial", "attitude"), "the quaternion must not be zero")]
+
+
+def _object_rules(get: _Values) -> list[tuple[KeyPath, str]]:
     found: list[tuple[KeyPath, str]] = []
-    world, robot = scenario.world, scenario.robot
-    ratio = world.control_period / world.physics_step
-    if abs(ratio - round(ratio)) > 1e-9 * ratio or round(ratio) < 1:
-        found.append(
-            (
-                ("world", "control_period"),
-                f"{world.control_period:g} s is not a whole multiple of physics_step "
-                f"({world.physics_step:g} s)",
-            )
-        )
-    if robot.propellant_mass >= robot.mass:
-        found.append(
-            (
-                ("robot", "propellant_mass"),
-                f"{robot.propellant_mass:g} kg must be less than robot.mass ({robot.mass:g} kg)",
-            )
-        )
-    found += scenario.mission.violations(scenario)
-    if sum(q * q for q in robot.initial.attitude) < 1e-12:
-        found.append((("robot", "initial", "attitude"), "the quaternion must not be zero"))
     owners: dict[int, str] = {}
     for section in ("targets", "obstacles"):
-        for index, obj in enumerate(getattr(scenario, section)):
-            here = f"{section}[{index}]"
-            if obj.id in owners:
-                found.append(
-                    ((section, index, "id"), f"id {obj.id} is already used by {owners[obj.id]}")
-                )
-            owners.setdefault(obj.id, here)
-            found += [((section, index, *path), message) for path, message in obj.violations()]
-            if isinstance(obj.motion, CWMotionSpec) and world.frame != "lvlh":
-                found.append(
-                    (
-                        (section, index, "motion", "type"),
-                        "'cw' motion needs world.frame: lvlh",
-                    )
-                )
-    drop = scenario.drop_point
-    if drop.position is not None and drop.motion is not None:
-        found.append((("drop_point", "motion"), "give either position or motion, not both"))
-    if isinstance(drop.motion, CWMotionSpec) and world.frame != "lvlh":
-        found.append((("drop_point", "motion", "type"), "'cw' motion needs world.frame: lvlh"))
+        for index in get.items(section):
+            found += _checked(_unique_id_rule, get, (section, index), owners)
+            found += _checked(_cw_rule, get, (section, index, "motion", "type"))
+            found += _checked(_shape_radius_rule, get, (section, index))
     return found
+
+
+def _unique_id_rule(
+    get: _Values, item: KeyPath, owners: dict[int, str]
+) -> list[tuple[KeyPath, str]]:
+    obj_id = get(*item, "id")
+    if obj_id in owners:
+        return [((*item, "id"), f"id {obj_id} is already used by {owners[obj_id]}")]
+    owners[obj_id] = format_key_path(item)
+    return []
+
+
+def _shape_radius_rule(get: _Values, item: KeyPath) -> list[tuple[KeyPath, str]]:
+    """A radius given beside a shape must be the shape's bounding radius."""
+    if not get.given(*item, "radius") or get(*item, "shape") is None:
+        return []
+    radius, bounding = get(*item, "radius"), get(*item, "shape").build().bounding_radius
+    if math.isclose(radius, bounding, rel_tol=1e-9):
+        return []
+    message = (
+        f"{radius:g} m disagrees with the shape's bounding radius ({bounding:g} m); "
+        "leave radius out when giving a shape"
+    )
+    return [((*item, "radius"), message)]
+
+
+def _cw_rule(get: _Values, path: KeyPath) -> list[tuple[KeyPath, str]]:
+    if get(*path) == "cw" and get("world", "frame") != "lvlh":
+        return [(path, "'cw' motion needs world.frame: lvlh")]
+    return []
+
+
+def _drop_point_rule(get: _Values) -> list[tuple[KeyPath, str]]:
+    if get("drop_point", "position") is not None and get("drop_point", "motion") is not None:
+        return [(("drop_point", "motion"), "give either position or motion, not both")]
+    return []
+
+
+def _drop_point_cw_rule(get: _Values) -> list[tuple[KeyPath, str]]:
+    return _cw_rule(get, ("drop_point", "motion", "type"))
+
+
+_RULES: list[Rule] = [
+    _control_period_rule,
+    _duration_rule,
+    _orbit_rule,
+    _propellant_rule,
+    _reach_rule,
+    _attitude_rule,
+    _object_rules,
+    _drop_point_rule,
+    _drop_point_cw_rule,
+]
+"""Every rule across keys, in the order their messages are listed."""
+
+
+def _value(data: dict[str, Any], path: KeyPath, root: type[BaseModel]) -> Any:
+    """The validated value at ``path`` of raw scenario data under model ``root``, its
+    default if absent.
+
+    Each key is validated on its own, so one invalid key does not hide the others.
+
+    Raises
+    ------
+    _Invalid
+        If the value, or a section or list on the way to it, is invalid.
+    """
+    node: Any = data
+    model: type[BaseModel] | None = root
+    annotation: Any = None
+    for position, key in enumerate(path):
+        if isinstance(key, int):
+            if not isinstance(node, list) or key >= len(node):
+                raise _Invalid
+            node = node[key]
+            model = _pick_model(annotation, node)
+            continue
+        if model is None or key not in model.model_fields or not isinstance(node, dict):
+            raise _Invalid
+        if position == len(path) - 1:
+            return _field_value(model, key, node)
+        annotation = model.model_fields[key].annotation
+        node = node.get(key, {})
+        model = _pick_model(annotation, node)
+    raise _Invalid
+
+
+def _field_value(model: type[BaseModel], name: str, section: dict[str, Any]) -> Any:
+    """Field ``name`` of ``model`` validated on its own from raw ``section`` data."""
+    if name not in section:
+        return model.model_fields[name].get_default(call_default_factory=True)
+    try:
+        return _field_adapter(model, name).validate_python(section[name])
+    except ValidationError:
+        raise _Invalid from None
+
+
+@cache
+def _field_adapter(model: type[BaseModel], name: str) -> TypeAdapter[Any]:
+    """A validator of field ``name`` of ``model`` on its own: type, bounds and config."""
+    info = model.model_fields[name]
+    annotation = Annotated[info.annotation, *info.metadata] if info.metadata else info.annotation
+    return TypeAdapter(annotation, config=model.model_config)
 
 
 def _scenario_model(doc: ScenarioDocument) -> type[Scenario]:
@@ -202,15 +405,8 @@ def _scenario_model(doc: ScenarioDocument) -> type[Scenario]:
     mission_type = section.get("type", "debris") if isinstance(section, dict) else "debris"
     missions = mission_types()
     if not isinstance(mission_type, str) or mission_type not in missions:
-        known = ", ".join(sorted(missions))
-        raise ScenarioError(
-            doc.filename,
-            [
-                doc.problem(
-                    ("mission", "type"), f"unknown mission type {mission_type!r}; known: {known}"
-                )
-            ],
-        )
+        message = f"unknown mission type {short_repr(mission_type)}; known: {', '.join(missions)}"
+        raise ScenarioError(doc.filename, [doc.problem(("mission", "type"), message)])
     return scenario_model(missions[mission_type].Settings)
 
 
@@ -225,14 +421,11 @@ def _schema_problems(
         if exact:
             message = describe_error(owner, field, err)
         elif err["type"] == "missing" and isinstance(err["loc"][-1], int):
-            message = f"{err['input']!r} has too few items"
+            message = f"{short_repr(err['input'])} has too few items"
         else:
-            message = f"{err['input']!r} is not allowed: {err['msg']}"
+            message = f"{short_repr(err['input'])} is not allowed: {err['msg']}"
         messages.setdefault(path, []).append(message)
-    found = [
-        doc.problem(path, "; or ".join(dict.fromkeys(msgs))) for path, msgs in messages.items()
-    ]
-    return sorted(found, key=lambda p: (p.line is None, p.line or 0, p.column or 0))
+    return [doc.problem(path, "; or ".join(dict.fromkeys(msgs))) for path, msgs in messages.items()]
 
 
 def _locate(

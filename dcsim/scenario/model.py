@@ -2,13 +2,13 @@
 
 Units are SI unless the key says otherwise; angles are in degrees where the source
 thesis uses degrees, with the unit in the key name (``polar_deg``, ``beta_deg_s``).
-Unknown keys are errors. docs/scenarios.md is generated from these models.
+Unknown keys are errors, and so are NaN and infinite numbers. docs/scenarios.md is
+generated from these models.
 """
 
 from __future__ import annotations
 
 import functools
-import math
 from typing import Annotated, Any, Literal
 
 import numpy as np
@@ -37,11 +37,23 @@ from dcsim.params import quantity
 
 Vec3 = tuple[float, float, float]
 
+MAX_STEPS_PER_CONTROL_PERIOD = 100_000
+"""Most physics steps in one control period."""
+
+MAX_PHYSICS_STEPS = 100_000_000
+"""Most physics steps in a run (``world.duration / world.physics_step``)."""
+
+MEAN_MOTION_RANGE = (1e-9, 0.1)
+"""Least and largest mean motion of the reference orbit, rad/s (periods of 63 s to 200 years)."""
+
+MAX_SEED = 2**31 - 1
+"""Largest seed: the range of an FMI Integer, as the FMU's ``seed`` parameter is one."""
+
 
 class Section(BaseModel):
-    """Base of every scenario section: immutable, unknown keys rejected."""
+    """Base of every scenario section: immutable, unknown keys and non-finite numbers rejected."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 class SphericalPoint(Section):
@@ -152,17 +164,34 @@ class WorldSpec(Section):
         description="lvlh: Clohessy–Wiltshire relative motion about the reference orbit; "
         "geocentric: the thesis's force-free spherical world.",
     )
-    orbit: OrbitSpec = Field(default_factory=OrbitSpec, description="Reference orbit (lvlh only).")
+    orbit: OrbitSpec = Field(
+        default_factory=OrbitSpec,
+        description="Reference orbit (lvlh only); its mean motion is between "
+        f"{MEAN_MOTION_RANGE[0]:g} and {MEAN_MOTION_RANGE[1]:g} rad/s.",
+    )
     physics_step: float = quantity(
         0.01, unit="s", gt=0, le=1, description="Fixed physics time step."
     )
     control_period: float = quantity(
-        0.1, unit="s", gt=0, description="Control period; a whole number of physics steps."
+        0.1,
+        unit="s",
+        gt=0,
+        description="Control period; a whole number of physics steps, at most "
+        f"{MAX_STEPS_PER_CONTROL_PERIOD:,}.",
     )
     duration: float = quantity(
-        600.0, unit="s", gt=0, description="Simulated time after which the run ends."
+        600.0,
+        unit="s",
+        gt=0,
+        description="Simulated time after which the run ends; at most "
+        f"{MAX_PHYSICS_STEPS:,} physics steps.",
     )
-    seed: int = quantity(0, ge=0, description="Seed of every random number in the run.")
+    seed: int = quantity(
+        0,
+        ge=0,
+        le=MAX_SEED,
+        description="Seed of every random number in the run (it fits an FMU Integer).",
+    )
 
 
 class InitialStateSpec(Section):
@@ -339,21 +368,6 @@ class SpaceObjectSpec(Section):
             return Shape(ShapeKind.SPHERE, radius=self.radius)
         return self.shape.build()
 
-    def violations(self) -> list[tuple[tuple[str | int, ...], str]]:
-        """Rules between this object's keys, as (key path within the object, message)."""
-        if self.shape is None:
-            return []
-        bounding = self.shape.build().bounding_radius
-        if math.isclose(self.radius, bounding, rel_tol=1e-9):
-            return []
-        return [
-            (
-                ("radius",),
-                f"{self.radius:g} m disagrees with the shape's bounding radius ({bounding:g} m); "
-                "leave radius out when giving a shape",
-            )
-        ]
-
 
 class BeaconsSection(Section):
     """Fixed localisation beacons and their range sensor."""
@@ -405,10 +419,6 @@ class MissionSettings(Section):
     """Base of every mission type's section: ``type`` selects the mission."""
 
     type: str = Field("debris", description="The mission type (`debris`).")
-
-    def violations(self, scenario: Scenario) -> list[tuple[tuple[str | int, ...], str]]:
-        """Rules between this section and the rest of ``scenario``, as (key path, message)."""
-        return []
 
 
 class DebrisMissionSection(MissionSettings):
@@ -464,18 +474,6 @@ class DebrisMissionSection(MissionSettings):
         le=1,
         description="Fraction of the drop tolerance within which the collector releases its cargo.",
     )
-
-    def violations(self, scenario: Scenario) -> list[tuple[tuple[str | int, ...], str]]:
-        """REACH must be within the grab distance."""
-        grab_distance = scenario.robot.grab_distance
-        if self.reach > grab_distance:
-            return [
-                (
-                    ("mission", "reach"),
-                    f"{self.reach:g} m is beyond robot.grab_distance ({grab_distance:g} m)",
-                )
-            ]
-        return []
 
 
 class StopSection(Section):
