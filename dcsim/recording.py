@@ -199,6 +199,13 @@ class Recorder:
         self.flush()
         return read_telemetry(self.out_dir / "telemetry.csv", max_points)
 
+    def write_file(self, name: str, text: str) -> None:
+        """Write one more file of the run directory (nothing when recording in memory)."""
+        if self.out_dir is None:
+            return
+        with self._writing(name):
+            (self.out_dir / name).write_text(text, encoding="utf-8")
+
     def finish(self, summary: Mapping[str, Any]) -> None:
         """Flush and close the streams, then replace ``summary.json`` with the final one."""
         try:

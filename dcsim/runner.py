@@ -241,6 +241,8 @@ class Runner:
         self.summary = self._summary(wallclock.perf_counter() - self._started)
         self.world.close()
         try:
+            for name, text in self.mission.records().items():
+                self.recorder.write_file(name, text)
             self.recorder.finish(self.summary)
             self._plot()
         except RecordingError as failure:
@@ -286,10 +288,11 @@ class Runner:
 
     def _start(self) -> None:
         world = self.world
+        self.mission = self.mission_class(self.scenario, world, self.plugins, self._event)
         self.recorder.start(dump_scenario(self.scenario), self._summary_head("running", ""))
         self._hook("dcsim_run_start", run=self.info)
-        self.mission = self.mission_class(self.scenario, world, self.plugins, self._event)
-        call_plugin(self.plugins, "localiser", "reset", self._prior(), 0.0)
+        if "localiser" in self.plugins:
+            call_plugin(self.plugins, "localiser", "reset", self._prior(), 0.0)
         call_plugin(self.plugins, "controller", "reset", world.robot_spec())
         self._robot_changes = world.robot_changes
         self.laps.start()
@@ -301,11 +304,7 @@ class Runner:
         t = world.time
         observations = world.observations()
         laps.lap("sensors")
-        if t > 0:
-            call_plugin(plugins, "localiser", "predict", world.motion_input(), world.control_period)
-        call_plugin(plugins, "localiser", "update", list(observations.ranges))
-        estimate = _with_readings(call_plugin(plugins, "localiser", "estimate"), observations)
-        self.estimate = estimate
+        estimate = self.estimate = _with_readings(self._localise(observations), observations)
         laps.lap("localiser")
         reference = self.mission.tick(t, estimate, observations)
         laps.lap("mission")
@@ -320,6 +319,19 @@ class Runner:
         self._record(t, estimate, self.mission.mode, self._command.force)
         self._check_stop(t)
         laps.lap("recording")
+
+    def _localise(self, observations: Observations) -> StateEstimate:
+        """The localiser's estimate now, or the true state when the mission flies without one."""
+        world, plugins = self.world, self.plugins
+        if "localiser" not in plugins:
+            position, velocity, _, _ = world.collector_state()
+            return StateEstimate(
+                world.time, position, velocity=velocity, covariance=np.zeros((6, 6)), converged=True
+            )
+        if world.time > 0:
+            call_plugin(plugins, "localiser", "predict", world.motion_input(), world.control_period)
+        call_plugin(plugins, "localiser", "update", list(observations.ranges))
+        return call_plugin(plugins, "localiser", "estimate")
 
     def _advance(self, disturbance_force: np.ndarray, disturbance_torque: np.ndarray) -> None:
         inputs = WorldInputs(
@@ -382,7 +394,7 @@ class Runner:
         row.update(zip(("est_vx", "est_vy", "est_vz"), estimate.velocity, strict=True))
         row.update(zip(("qx", "qy", "qz", "qw"), out["attitude"], strict=True))
         row.update(mode=mode, converged=int(estimate.converged))
-        row.update(self.mission.telemetry())
+        row.update(self.mission.telemetry(out))
         row.update(
             fuel_used=out["fuel_used"],
             delta_v=out["delta_v"],
@@ -417,9 +429,15 @@ class Runner:
         except Exception as error:  # a hook implementation's own bug
             raise HookFailure(f"hook {name} raised: {type(error).__name__}: {error}") from error
 
+    def _localiser_note(self) -> str:
+        """Which localiser the estimate came from, or that it was the truth."""
+        if "localiser" in self.plugins:
+            return self.plugins["localiser"].name
+        return "none: the mission was fed the true state"
+
     def _accumulate(self, outputs: dict[str, Any], estimate: StateEstimate) -> None:
         """Update the running figures of the summary with one recorded tick."""
-        if estimate.converged:
+        if estimate.converged and "localiser" in self.plugins:
             error = outputs["position"] - estimate.position
             self._squared_error_sum += float(error @ error)
             self._converged_rows += 1
@@ -456,6 +474,7 @@ class Runner:
             "localisation_rmse_m": rmse,
             "min_obstacle_distance_m": self._min_gap if self.recorder.count else None,
             "plugins": self.setup.plugin_versions(),
+            "localiser": self._localiser_note(),
             "wall_time_by_phase_s": dict(sorted(self.laps.totals.items())),
         }
 

@@ -90,10 +90,12 @@ def build_run(scenario: Scenario, registry: PluginRegistry) -> RunSetup:
     PluginError
         If a plugin is unknown or its parameters are invalid.
     """
-    from dcsim.missions import mission_class  # missions load the world engine
+    from dcsim.missions import scenario_roles  # missions load the world engine
 
-    roles = mission_class(scenario.mission.type).roles
-    sources = {role: registry.get(role, getattr(scenario, role).plugin) for role in roles}
+    sources = {
+        role: registry.get(role, getattr(scenario, role).plugin)
+        for role in scenario_roles(scenario)
+    }
     plugins = {
         role: entry.cls(getattr(scenario, role).params, component_rng(scenario.world.seed, role))
         for role, entry in sources.items()

@@ -1,16 +1,23 @@
 """Mission types, selected in a scenario by ``mission.type``.
 
-Built in: ``debris`` (:class:`~dcsim.missions.debris.DebrisMission`). A new mission
+Built in: ``debris`` (:class:`~dcsim.missions.debris.DebrisMission`) and ``transfer``
+(:class:`~dcsim.missions.transfer.TransferMission`). A new mission
 derives from :class:`~dcsim.missions.base.Mission`, declares its ``Settings`` section,
 and is added with :func:`register_mission`.
 """
 
 from __future__ import annotations
 
+from dcsim.interfaces import PLUGIN_KINDS
 from dcsim.missions.base import Mission
 from dcsim.missions.debris import DebrisMission
+from dcsim.missions.transfer import TransferMission
+from dcsim.scenario.model import Scenario
 
-_MISSIONS: dict[str, type[Mission]] = {DebrisMission.type: DebrisMission}
+_MISSIONS: dict[str, type[Mission]] = {
+    DebrisMission.type: DebrisMission,
+    TransferMission.type: TransferMission,
+}
 
 
 def register_mission(cls: type[Mission]) -> type[Mission]:
@@ -35,6 +42,18 @@ def mission_types() -> dict[str, type[Mission]]:
     return dict(_MISSIONS)
 
 
+def scenario_roles(scenario: Scenario) -> tuple[str, ...]:
+    """The plugin roles a scenario's run uses, in data-flow order.
+
+    Those its mission needs, and the optional ones (``role_defaults`` of None in the
+    mission's settings) for which the scenario names a plugin.
+    """
+    mission = mission_class(scenario.mission.type)
+    optional = [role for role, default in mission.Settings.role_defaults.items() if default is None]
+    used = set(mission.roles) | {role for role in optional if getattr(scenario, role) is not None}
+    return tuple(role for role in PLUGIN_KINDS if role in used)
+
+
 def mission_class(mission_type: str) -> type[Mission]:
     """The mission class of ``mission_type``.
 
@@ -46,4 +65,12 @@ def mission_class(mission_type: str) -> type[Mission]:
     return _MISSIONS[mission_type]
 
 
-__all__ = ["DebrisMission", "Mission", "mission_class", "mission_types", "register_mission"]
+__all__ = [
+    "DebrisMission",
+    "Mission",
+    "TransferMission",
+    "mission_class",
+    "mission_types",
+    "register_mission",
+    "scenario_roles",
+]

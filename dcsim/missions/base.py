@@ -50,14 +50,14 @@ class Mission(ABC):
     Settings : type of MissionSettings
         The scenario's ``mission`` section for this mission.
     roles : tuple of str
-        Plugin roles the mission uses, in data-flow order.
+        Plugin roles the mission needs, in data-flow order; a role its ``Settings``
+        make optional (``role_defaults`` of None) is used when the scenario names a
+        plugin for it (without a localiser the mission is fed the true state).
     modes : tuple of str
         The mission's modes; :attr:`mode` is one of them (telemetry records its name,
         FMU outputs its index).
     columns : tuple of str
         The mission's own telemetry columns, recorded after ``mode`` and ``converged``.
-    column_doc : str
-        What the columns hold, with units.
     """
 
     type: ClassVar[str]
@@ -66,7 +66,6 @@ class Mission(ABC):
     roles: ClassVar[tuple[str, ...]]
     modes: ClassVar[tuple[str, ...]]
     columns: ClassVar[tuple[str, ...]] = ()
-    column_doc: ClassVar[str] = ""
 
     def __init__(
         self, scenario: Scenario, world: World, plugins: Mapping[str, Plugin], emit: Emit
@@ -101,8 +100,12 @@ class Mission(ABC):
         return Surroundings(observations.obstacles(), self.safety_distance)
 
     # ------------------------------------------------------------------ records
-    def telemetry(self) -> dict[str, Any]:
-        """Values of :attr:`columns` now."""
+    def telemetry(self, outputs: Mapping[str, Any]) -> dict[str, Any]:
+        """Values of :attr:`columns` now, given the world's outputs (:meth:`World.outputs`)."""
+        return {}
+
+    def records(self) -> dict[str, str]:
+        """Further files for the run directory, by name (written when the run ends)."""
         return {}
 
     def progress(self) -> str:

@@ -88,7 +88,6 @@ class DebrisMission(Mission):
     roles = ("localiser", "task_planner", "path_planner", "controller")
     modes = tuple(mode.name for mode in Mode)
     columns = ("carried", "delivered")
-    column_doc = "targets carried and delivered"
     settings: DebrisMissionSection
 
     def __init__(
@@ -142,12 +141,9 @@ class DebrisMission(Mission):
                 return reference
         return reference
 
-    def telemetry(self) -> dict[str, Any]:
+    def telemetry(self, outputs: Mapping[str, Any]) -> dict[str, Any]:
         """Targets carried and delivered now."""
-        return {
-            "carried": len(self.world.carried_ids()),
-            "delivered": self.world.field.count(ObjectStatus.DELIVERED),
-        }
+        return {"carried": outputs["carried"], "delivered": outputs["delivered"]}
 
     def progress(self) -> str:
         """Targets delivered out of all, and captured."""

@@ -121,12 +121,12 @@ def resolve_plugins(
     ScenarioError
         For unknown or ambiguous plugin names and invalid parameters.
     """
-    from dcsim.missions import mission_class  # missions load the world engine
+    from dcsim.missions import scenario_roles  # missions load the world engine
 
     problems: list[Problem] = []
     resolved: dict[str, Any] = {}
     robot = scenario.robot.type
-    for role in mission_class(scenario.mission.type).roles:
+    for role in scenario_roles(scenario):
         choice = getattr(scenario, role)
         try:
             cls = registry.get(role, choice.plugin).cls

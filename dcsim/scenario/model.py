@@ -9,7 +9,7 @@ generated from these models.
 from __future__ import annotations
 
 import functools
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import (
@@ -23,6 +23,7 @@ from pydantic import (
 )
 
 from dcsim.geometry import Vector, spherical_to_cartesian
+from dcsim.messages.planning import GoalRegion
 from dcsim.messages.sensing import Shape, ShapeKind
 from dcsim.motion import (
     STANDARD_GRAVITATIONAL_PARAMETER_EARTH,
@@ -416,9 +417,15 @@ class PluginChoice(Section):
 
 
 class MissionSettings(Section):
-    """Base of every mission type's section: ``type`` selects the mission."""
+    """Base of every mission type's section: ``type`` selects the mission.
 
-    type: str = Field("debris", description="The mission type (`debris`).")
+    ``role_defaults`` replaces the scenario's default plugin choice of a role for this
+    mission; ``None`` makes the role optional (absent unless the file names a plugin).
+    """
+
+    role_defaults: ClassVar[dict[str, PluginChoice | None]] = {}
+
+    type: str = Field("debris", description="The mission type (`debris` or `transfer`).")
 
 
 class DebrisMissionSection(MissionSettings):
@@ -473,6 +480,123 @@ class DebrisMissionSection(MissionSettings):
         gt=0,
         le=1,
         description="Fraction of the drop tolerance within which the collector releases its cargo.",
+    )
+
+
+class GoalSection(Section):
+    """The goal region of a transfer: a sphere or a box, and what must hold on arrival."""
+
+    position: Vec3 = quantity(unit="m", description="Centre of the goal region.")
+    radius: float = quantity(
+        1.0, unit="m", gt=0, description="Radius of a spherical region (without `half_extents`)."
+    )
+    half_extents: Vec3 | None = quantity(
+        None,
+        unit="m",
+        description="Half side lengths of an axis-aligned box region (instead of `radius`).",
+    )
+    velocity: Vec3 = quantity((0.0, 0.0, 0.0), unit="m/s", description="Velocity to arrive with.")
+    velocity_tolerance: float | None = quantity(
+        None,
+        unit="m/s",
+        ge=0,
+        description="Largest arrival velocity error; null: not checked.",
+    )
+    attitude: tuple[float, float, float, float] | None = quantity(
+        None, description="Attitude quaternion [x, y, z, w] to arrive at; null: any."
+    )
+    attitude_tolerance_deg: float = quantity(
+        5.0, unit="deg", gt=0, le=180, description="Largest arrival attitude error."
+    )
+    arrival_time: float | None = quantity(
+        None, unit="s", ge=0, description="Time to arrive at; null: as soon as allowed."
+    )
+    time_tolerance: float | None = quantity(
+        None, unit="s", ge=0, description="Largest arrival time error; null: not checked."
+    )
+
+    @model_validator(mode="after")
+    def _one_region(self) -> GoalSection:
+        """A region is a sphere or a box, not both."""
+        if self.half_extents is not None and "radius" in self.model_fields_set:
+            raise ValueError("give either radius (a sphere) or half_extents (a box), not both")
+        return self
+
+    def build(self) -> GoalRegion:
+        """The goal region message."""
+        return GoalRegion(
+            position=self.position,
+            tolerance=0.0 if self.half_extents is not None else self.radius,
+            velocity=self.velocity,
+            time=self.arrival_time,
+            half_extents=self.half_extents,
+            attitude=None
+            if self.attitude is None
+            else np.asarray(self.attitude) / np.linalg.norm(self.attitude),
+            attitude_tolerance=np.radians(self.attitude_tolerance_deg),
+            velocity_tolerance=np.inf
+            if self.velocity_tolerance is None
+            else self.velocity_tolerance,
+            time_tolerance=np.inf if self.time_tolerance is None else self.time_tolerance,
+        )
+
+
+class BoundsSection(Section):
+    """An axis-aligned box the path must stay in."""
+
+    lower: Vec3 = quantity(unit="m", description="Lowest corner.")
+    upper: Vec3 = quantity(unit="m", description="Highest corner.")
+
+
+class WeightsSection(Section):
+    """Weights of a path's cost J = w_dv Δv + w_L L + w_T T."""
+
+    delta_v: float = quantity(1.0, unit="s/m", ge=0, description="Weight on delta-v.")
+    length: float = quantity(0.0, unit="1/m", ge=0, description="Weight on path length.")
+    time: float = quantity(0.0, unit="1/s", ge=0, description="Weight on duration.")
+
+
+class TransferMissionSection(MissionSettings):
+    """A transfer: from the robot's initial state to a goal region among obstacles."""
+
+    role_defaults: ClassVar[dict[str, PluginChoice | None]] = {"localiser": None}
+
+    type: Literal["transfer"] = Field(
+        "transfer", description="The mission type: a transfer to a goal region."
+    )
+    goal: GoalSection = Field(description="The goal region and what must hold on arrival.")
+    bounds: BoundsSection | None = Field(None, description="Box the path must stay in; null: none.")
+    weights: WeightsSection = Field(
+        default_factory=WeightsSection, description="Path cost weights given to the planner."
+    )
+    max_delta_v: float | None = quantity(
+        None, unit="m/s", gt=0, description="Largest total delta-v of a plan; null: none."
+    )
+    acceleration_fraction: float = quantity(
+        0.5,
+        gt=0,
+        le=1,
+        description="Fraction of the thrust-limited acceleration that plans may use.",
+    )
+    planning_budget: float = quantity(
+        5.0, unit="s", gt=0, description="Wall time given to a planner call."
+    )
+    retry: float = quantity(
+        5.0, unit="s", gt=0, description='Wait before planning again after "no path".'
+    )
+    tracking_tolerance: float = quantity(
+        2.0,
+        unit="m",
+        gt=0,
+        description="Re-plan from the estimate when it strays this far from the trajectory.",
+    )
+    safety_distance: float = quantity(
+        0.0, unit="m", ge=0, description="Least surface gap to obstacles, given to the controller."
+    )
+    max_plan_attempts: int = quantity(
+        3,
+        ge=1,
+        description='"No path" answers in a row after which the run ends stopped.',
     )
 
 
@@ -537,13 +661,24 @@ def scenario_model(settings: type[MissionSettings]) -> type[Scenario]:
     Parameters
     ----------
     settings : type of MissionSettings
-        A mission type's section (``DebrisMissionSection`` gives :class:`Scenario`).
+        A mission type's section (``DebrisMissionSection`` gives :class:`Scenario`);
+        its ``role_defaults`` replace the roles' default plugins.
     """
     if settings is DebrisMissionSection:
         return Scenario
+    roles: dict[str, Any] = {
+        role: (
+            PluginChoice | None,
+            Field(
+                default, description=f"{role.replace('_', ' ').capitalize()} plugin; null: none."
+            ),
+        )
+        for role, default in settings.role_defaults.items()
+    }
     return create_model(
         "Scenario",
         __base__=Scenario,
         __doc__=Scenario.__doc__,
         mission=(settings, Field(description="The mission and its settings.")),
+        **roles,
     )

@@ -18,7 +18,14 @@ from pydantic_core import PydanticUndefined
 
 from dcsim.docgen import update_block
 from dcsim.params import field_bounds, field_unit
-from dcsim.scenario.model import MotionSpec, PluginChoice, Scenario, SphericalPoint, Vec3
+from dcsim.scenario.model import (
+    MotionSpec,
+    PluginChoice,
+    Scenario,
+    SphericalPoint,
+    TransferMissionSection,
+    Vec3,
+)
 
 BEGIN = "<!-- BEGIN GENERATED KEY REFERENCE (make docs) -->"
 END = "<!-- END GENERATED KEY REFERENCE -->"
@@ -79,9 +86,10 @@ def _child_path(prefix: str, name: str, annotation: Any) -> str:
 
 
 def _sections() -> dict[type[BaseModel], list[str]]:
-    """Every model class reachable from Scenario, with the key paths it appears at."""
-    paths: dict[type[BaseModel], list[str]] = {Scenario: [""]}
-    queue: list[tuple[str, type[BaseModel]]] = [("", Scenario)]
+    """Every model class reachable from Scenario and the mission sections, with the key
+    paths it appears at."""
+    paths: dict[type[BaseModel], list[str]] = {Scenario: [""], TransferMissionSection: ["mission"]}
+    queue: list[tuple[str, type[BaseModel]]] = [("", Scenario), ("mission", TransferMissionSection)]
     while queue:
         prefix, model = queue.pop(0)
         for name, info in model.model_fields.items():

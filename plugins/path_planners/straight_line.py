@@ -10,8 +10,9 @@ obstacle's predicted motion every ``check_spacing`` metres; if it passes closer 
 the two radii plus ``clearance`` the answer is "no path", naming the obstacle and the
 time (unless ``check_obstacles`` is false). An obstacle's radius is its bounding sphere's
 (``ObjectTrack.radius``): for a box or a cylinder (``ObjectTrack.shape``) the check is
-conservative and may refuse a path that clears the true shape. This is the yardstick the
-real planners are compared with.
+conservative and may refuse a path that clears the true shape. The attitude is held at
+the start's, or, when the goal gives one, turned onto it at a constant rate (slerp) over
+the flight. This is the yardstick the real planners are compared with.
 """
 
 from __future__ import annotations
@@ -27,7 +28,11 @@ from dcsim.api import (
     cruise_speed,
     hookimpl,
     quantity,
+    quaternion_conjugate,
+    quaternion_multiply,
     rest_to_rest_time,
+    rotation_vector,
+    slerp,
 )
 
 _MIN_DURATION = 1e-3  # s; a zero-length path still spans a positive time
@@ -140,10 +145,13 @@ class StraightLinePlanner(PathPlanner):
                 return blocked
         tau = profile.sample_times()
         positions, velocities = states(tau)
+        attitudes, angular_velocities = _attitudes(start.attitude, goal.attitude, tau)
         return Trajectory(
             times=start.time + tau,
             positions=positions,
             velocities=velocities,
+            attitudes=attitudes,
+            angular_velocities=angular_velocities,
             delta_v=delta_v,
             length=float(np.linalg.norm(np.diff(fine_positions, axis=0), axis=1).sum()),
             duration=profile.duration,
@@ -198,6 +206,19 @@ class StraightLinePlanner(PathPlanner):
                     f"at t = {times[k]:.1f} s (needs {needed:.2f} m)"
                 )
         return None
+
+
+def _attitudes(
+    start: np.ndarray, goal: np.ndarray | None, tau: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Attitudes and angular velocities (rad/s) at times ``tau`` since the start: the start
+    attitude held, or turned at a constant rate onto the goal's over the flight."""
+    if goal is None:
+        return np.tile(start, (len(tau), 1)), np.zeros((len(tau), 3))
+    fraction = tau / tau[-1]
+    turn = rotation_vector(quaternion_multiply(goal, quaternion_conjugate(start)))
+    rate = turn / tau[-1]
+    return slerp(start, goal, fraction), np.tile(rate, (len(tau), 1))
 
 
 @hookimpl

@@ -56,7 +56,7 @@ class HoldMission(Mission):
         target = estimate.position if self.home is None else self.home
         return Reference(time=time, position=target)
 
-    def telemetry(self):
+    def telemetry(self, outputs):
         error = 0.0 if self.home is None else np.linalg.norm(self.estimate.position - self.home)
         self.worst = max(self.worst, float(error))
         return {"hold_error": float(error)}

@@ -1,0 +1,342 @@
+"""The ``transfer`` mission: from the robot's initial state to a goal region among obstacles.
+
+The free-flyer problems of the source documents (the Boeing paper's grid search near a
+space station, the kinodynamic RRT escape from an asteroid field, the ant colony among
+spheres) share this shape. Modes::
+
+    PLAN ──trajectory──► FLY ──inside the goal region, within its tolerances──► ARRIVED
+      ▲ │ no path          │ strayed beyond tracking_tolerance
+      │ ▼                  │
+     HOLD ◄────────────────┘ (re-plans at once from the estimate)
+
+The path planner is asked once at the start and again from the current estimate when it
+said "no path" (after ``retry`` seconds) or when the estimate strays from the trajectory
+by more than ``tracking_tolerance``. The controller tracks the trajectory's full state
+(position, velocity, attitude, angular velocity); per-segment forces and torques of the
+trajectory are fed forward as accelerations. After ``max_plan_attempts`` "no path"
+answers in a row the mission gives up and the run ends ``stopped`` with the reason.
+"""
+
+from __future__ import annotations
+
+import io
+import time as wallclock
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from dcsim.geometry import rotate
+from dcsim.interfaces import Plugin
+from dcsim.messages import (
+    Bounds,
+    CostWeights,
+    FrameDynamics,
+    FrameKind,
+    NoPath,
+    Observations,
+    PathProblem,
+    Reference,
+    RobotState,
+    StateEstimate,
+    Trajectory,
+)
+from dcsim.missions.base import Emit, Mission
+from dcsim.scenario.model import Scenario, TransferMissionSection
+from dcsim.world import World
+
+_TRAJECTORY_HEADER = (
+    "time_s,x_m,y_m,z_m,qx,qy,qz,qw,vx_mps,vy_mps,vz_mps,wx_radps,wy_radps,wz_radps,"
+    "fx_N,fy_N,fz_N,tx_Nm,ty_Nm,tz_Nm"
+)
+
+
+class TransferMission(Mission):
+    """Plans a path to the goal region, flies it, re-plans when needed, stops on arrival.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The resolved scenario; ``scenario.mission`` is a :class:`TransferMissionSection`.
+    world : World
+        The world (its frame, the robot's properties).
+    plugins : mapping of str to Plugin
+        The path planner, the controller and, if the scenario names one, the localiser.
+    emit : callable
+        ``emit(event_name, **data)`` records an event.
+    """
+
+    type = "transfer"
+    summary = "fly from the initial state to a goal region among obstacles"
+    Settings = TransferMissionSection
+    roles = ("path_planner", "controller")
+    modes = ("PLAN", "HOLD", "FLY", "ARRIVED")
+    columns = ("ref_x", "ref_y", "ref_z", "tracking_error", "goal_distance")
+    settings: TransferMissionSection
+
+    def __init__(
+        self, scenario: Scenario, world: World, plugins: Mapping[str, Plugin], emit: Emit
+    ) -> None:
+        super().__init__(scenario, world, plugins, emit)
+        self.goal = self.settings.goal.build()
+        self.state = "PLAN"
+        self.trajectory: Trajectory | None = None
+        self.reference: Reference | None = None
+        self.hold: RobotState | None = None
+        self.retry_at = 0.0
+        self.failures = 0
+        self.reason = ""
+        self.reached_at: float | None = None
+        self.planned: list[Trajectory] = []
+        self.planning_time = 0.0
+        self.nodes_expanded = 0.0
+        self.tracking_error = 0.0
+        self.max_tracking_error = 0.0
+        self.min_clearance = np.inf
+
+    # ------------------------------------------------------------------ the tick
+    @property
+    def mode(self) -> str:
+        """PLAN, HOLD, FLY or ARRIVED."""
+        return self.state
+
+    @property
+    def safety_distance(self) -> float:
+        """The least surface gap the controller is asked to keep, m."""
+        return self.settings.safety_distance
+
+    def tick(self, time: float, estimate: StateEstimate, observations: Observations) -> Reference:
+        """Plan when needed, follow the trajectory, and check arrival."""
+        state = _state_of(estimate)
+        if self.goal.contains(state):
+            if self.reached_at is None:
+                self.reached_at = time
+                self.emit("arrived", time_to_goal=time)
+            self._go("ARRIVED")
+            return self._holding(state)
+        if self.trajectory is None and time >= self.retry_at:
+            self._plan(state, observations)
+        if self.trajectory is None:
+            return self._holding(state)
+        reference = self._follow(time)
+        self.tracking_error = float(np.linalg.norm(reference.position - estimate.position))
+        if self.tracking_error > self.settings.tracking_tolerance:
+            self.emit("off_track", error=self.tracking_error)
+            self._plan(state, observations)
+            if self.trajectory is None:
+                return self._holding(state)
+            reference = self._follow(time)
+            self.tracking_error = float(np.linalg.norm(reference.position - estimate.position))
+        return reference
+
+    def finished(self) -> tuple[str, str] | None:
+        """Completed in the goal region; stopped once planning is given up."""
+        if self.reached_at is not None:
+            return "completed", "goal reached"
+        if self.failures >= self.settings.max_plan_attempts:
+            return "stopped", f"no path after {self.failures} attempts: {self.reason}"
+        return None
+
+    # ------------------------------------------------------------------ planning
+    def _plan(self, start: RobotState, observations: Observations) -> None:
+        """Ask the path planner for a trajectory from ``start``."""
+        self._go("PLAN")
+        problem = self._problem(start, observations)
+        began = wallclock.perf_counter()
+        result = self.call("path_planner", "plan", problem)
+        self.planning_time += wallclock.perf_counter() - began
+        if isinstance(result, NoPath):
+            self.trajectory = None
+            self.failures += 1
+            self.reason = result.reason
+            self.retry_at = start.time + self.settings.retry
+            self.emit("no_path", reason=result.reason)
+            self._go("HOLD")
+            return
+        self.failures = 0
+        self.trajectory = result
+        self.planned.append(result)
+        self.nodes_expanded += float(result.statistics.get("nodes_expanded", 0.0))
+        self.hold = None
+        self.emit(
+            "path",
+            duration=result.duration,
+            length=result.length,
+            delta_v=result.delta_v,
+            statistics=dict(result.statistics),
+        )
+        self._go("FLY")
+
+    def _problem(self, start: RobotState, observations: Observations) -> PathProblem:
+        settings, spec = self.settings, self.world.robot_spec()
+        bounds = None
+        if settings.bounds is not None:
+            bounds = Bounds(settings.bounds.lower, settings.bounds.upper)
+        weights = settings.weights
+        max_delta_v = np.inf if settings.max_delta_v is None else settings.max_delta_v
+        return PathProblem(
+            start=start,
+            goal=self.goal,
+            obstacles=observations.obstacles(),
+            frame=self._frame(),
+            robot_radius=spec.radius,
+            max_speed=spec.max_speed,
+            max_acceleration=settings.acceleration_fraction * spec.max_force / spec.mass,
+            max_delta_v=max_delta_v,
+            max_angular_acceleration=spec.max_torque
+            / float(np.max(np.linalg.eigvalsh(spec.inertia))),
+            bounds=bounds,
+            weights=CostWeights(weights.delta_v, weights.length, weights.time),
+            time_budget=settings.planning_budget,
+        )
+
+    def _frame(self) -> FrameDynamics:
+        if self.scenario.world.frame == "lvlh":
+            return FrameDynamics(FrameKind.CLOHESSY_WILTSHIRE, self.scenario.mean_motion)
+        return FrameDynamics(FrameKind.INERTIAL)
+
+    # ------------------------------------------------------------------ references
+    def _follow(self, time: float) -> Reference:
+        """The trajectory's state at ``time`` with its feed-forward (held after the end)."""
+        trajectory = self.trajectory
+        state = trajectory.state_at(time)
+        attitude = state.attitude if trajectory.attitudes is not None else self._held_attitude()
+        acceleration, angular_acceleration = self._feed_forward(trajectory, time)
+        self.reference = Reference(
+            time=time,
+            position=state.position,
+            velocity=state.velocity,
+            acceleration=acceleration,
+            attitude=attitude,
+            angular_velocity=state.angular_velocity,
+            angular_acceleration=angular_acceleration,
+        )
+        return self.reference
+
+    def _feed_forward(self, trajectory: Trajectory, time: float) -> tuple[np.ndarray, np.ndarray]:
+        """Linear and angular acceleration of the segment flown at ``time`` (zero after it)."""
+        zero = np.zeros(3)
+        if not trajectory.times[0] <= time < trajectory.times[-1]:
+            return zero, zero
+        segment = int(np.searchsorted(trajectory.times, time, side="right")) - 1
+        spec = self.world.robot_spec()
+        acceleration = zero if trajectory.forces is None else trajectory.forces[segment] / spec.mass
+        if trajectory.torques is None:
+            return acceleration, zero
+        attitude = (
+            trajectory.attitude_at(time)
+            if trajectory.attitudes is not None
+            else self._held_attitude()
+        )
+        rotation = np.column_stack([rotate(attitude, axis) for axis in np.eye(3)])
+        inertia = rotation @ spec.inertia @ rotation.T
+        return acceleration, np.linalg.solve(inertia, trajectory.torques[segment])
+
+    def _held_attitude(self) -> np.ndarray:
+        """The attitude held when the trajectory leaves it free: the goal's, or the start's."""
+        if self.goal.attitude is not None:
+            return self.goal.attitude
+        initial = np.asarray(self.scenario.robot.initial.attitude, dtype=float)
+        return initial / np.linalg.norm(initial)
+
+    def _holding(self, state: RobotState) -> Reference:
+        """Hold where the robot was when holding began, at rest, attitude held."""
+        if self.hold is None:
+            self.hold = state
+        self.reference = Reference(
+            time=state.time, position=self.hold.position, attitude=self._held_attitude()
+        )
+        return self.reference
+
+    def _go(self, mode: str) -> None:
+        if mode != self.state:
+            self.emit("mode", previous=self.state, mode=mode)
+            self.state = mode
+
+    # ------------------------------------------------------------------ records
+    def telemetry(self, outputs: Mapping[str, Any]) -> dict[str, Any]:
+        """Reference position, tracking error and distance to the goal centre."""
+        self.max_tracking_error = max(self.max_tracking_error, self.tracking_error)
+        self.min_clearance = min(self.min_clearance, float(outputs["nearest_obstacle_distance"]))
+        reference = self.reference.position if self.reference is not None else outputs["position"]
+        return {
+            "ref_x": float(reference[0]),
+            "ref_y": float(reference[1]),
+            "ref_z": float(reference[2]),
+            "tracking_error": self.tracking_error,
+            "goal_distance": float(np.linalg.norm(outputs["position"] - self.goal.position)),
+        }
+
+    def progress(self) -> str:
+        """Whether the goal is reached."""
+        if self.reached_at is not None:
+            return f"goal reached at t = {self.reached_at:.1f} s"
+        return f"{len(self.planned)} plan(s), goal not reached"
+
+    def summary_fields(self) -> dict[str, Any]:
+        """Arrival, planning effort and tracking figures."""
+        planned = self.planned[-1].delta_v if self.planned else None
+        return {
+            "reached": self.reached_at is not None,
+            "time_to_goal_s": self.reached_at,
+            "planned_delta_v_mps": planned,
+            "planning_time_s": self.planning_time,
+            "replans": max(len(self.planned) - 1, 0),
+            "nodes_expanded": self.nodes_expanded,
+            "min_clearance_m": self.min_clearance,
+            "max_tracking_error_m": self.max_tracking_error,
+        }
+
+    def records(self) -> dict[str, str]:
+        """``trajectory.csv``: the last planned trajectory, SI units in the header."""
+        if not self.planned:
+            return {}
+        return {"trajectory.csv": trajectory_csv(self.planned[-1])}
+
+
+def trajectory_csv(trajectory: Trajectory) -> str:
+    """A trajectory as CSV: time, position, attitude, velocity, angular velocity, force, torque.
+
+    Attitudes and angular velocities the trajectory leaves free are empty; so are the
+    force and torque of the last sample (they hold over the segment after each sample).
+    """
+    n = len(trajectory.times)
+    columns = [
+        trajectory.times[:, None],
+        trajectory.positions,
+        _or_empty(trajectory.attitudes, n, 4),
+        trajectory.velocities,
+        _or_empty(trajectory.angular_velocities, n, 3),
+        _padded(trajectory.forces, n),
+        _padded(trajectory.torques, n),
+    ]
+    table = np.hstack(columns)
+    out = io.StringIO()
+    out.write(_TRAJECTORY_HEADER + "\n")
+    for row in table:
+        out.write(",".join("" if np.isnan(v) else repr(float(v)) for v in row) + "\n")
+    return out.getvalue()
+
+
+def _or_empty(values: np.ndarray | None, rows: int, width: int) -> np.ndarray:
+    return np.full((rows, width), np.nan) if values is None else values
+
+
+def _padded(values: np.ndarray | None, rows: int) -> np.ndarray:
+    padded = np.full((rows, 3), np.nan)
+    if values is not None:
+        padded[:-1] = values
+    return padded
+
+
+def _state_of(estimate: StateEstimate) -> RobotState:
+    """The estimate as a plain robot state."""
+    return RobotState(
+        estimate.time,
+        estimate.position,
+        estimate.attitude,
+        estimate.velocity,
+        estimate.angular_velocity,
+        estimate.joint_positions,
+        estimate.joint_velocities,
+    )
