@@ -34,7 +34,6 @@ import numpy as np
 from dcsim.hookspecs import RunInfo
 from dcsim.messages import Command, Observations, Prior, StateEstimate
 from dcsim.missions import Mission, mission_class
-from dcsim.plots import write_plots
 from dcsim.plugin_calls import PluginFailure, call_plugin
 from dcsim.recording import Recorder, RecordingError, telemetry_columns
 from dcsim.runsetup import RunSetup
@@ -257,13 +256,10 @@ class Runner:
         if self.info.out_dir is None:
             return
         try:
-            write_plots(
+            self.mission.plot(
                 self.info.out_dir,
-                self.scenario,
                 self.recorder.telemetry(max_points=PLOT_POINTS),
                 self.recorder.events,
-                self.mission_class.modes,
-                self.mission.safety_distance,
             )
         except OSError as error:
             raise RecordingError(f"cannot draw the plots: {error}") from error

@@ -12,11 +12,13 @@ fields it adds, and when it is finished.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from dcsim.interfaces import Plugin
 from dcsim.messages import Observations, Reference, StateEstimate, Surroundings
+from dcsim.plots import write_plots
 from dcsim.plugin_calls import call_plugin
 from dcsim.scenario.model import MissionSettings, Scenario
 
@@ -103,6 +105,22 @@ class Mission(ABC):
     def telemetry(self, outputs: Mapping[str, Any]) -> dict[str, Any]:
         """Values of :attr:`columns` now, given the world's outputs (:meth:`World.outputs`)."""
         return {}
+
+    def plot(
+        self,
+        out_dir: Path,
+        telemetry: Mapping[str, np.ndarray],
+        events: Sequence[Mapping[str, Any]],
+    ) -> list[Path]:
+        """Draw the run's pictures into ``out_dir/plots``; return the files written.
+
+        The default draws the trajectory with every object's path and the timeline of
+        modes, propellant, localisation error and obstacle gap
+        (:func:`dcsim.plots.write_plots`). ``telemetry`` is thinned for plotting.
+        """
+        return write_plots(
+            out_dir, self.scenario, telemetry, events, self.modes, self.safety_distance
+        )
 
     def records(self) -> dict[str, str]:
         """Further files for the run directory, by name (written when the run ends)."""
