@@ -16,6 +16,8 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
+import numpy as np
+
 from dcsim.interfaces import Plugin
 from dcsim.messages import Observations, Reference, StateEstimate, Surroundings
 from dcsim.plots import write_plots
