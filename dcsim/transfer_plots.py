@@ -289,6 +289,7 @@ def _draw_3d(axis, scene: Scene) -> None:
         title="3-D view",
     )
     axis.set_box_aspect(np.maximum(scene.upper - scene.lower, 1e-3))
+    axis.locator_params(nbins=5)  # a short side would crowd its ticks
 
 
 def _wireframes(axis, placed: Placed, ls: str = "-") -> None:
