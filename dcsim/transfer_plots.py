@@ -357,7 +357,7 @@ def _legend(scene: Scene) -> list:
         Patch(facecolor=_GOAL, alpha=0.3, edgecolor=_GOAL, label="goal region"),
         Patch(facecolor=_FIXED, alpha=0.35, edgecolor=_FIXED, label="obstacle"),
     ]
-    if any(p.colour == _MOVING for p in scene.obstacles):
+    if any(len(p.path) for p in scene.obstacles):
         when = ", ".join(f"{t:.0f}" for t in scene.instants)
         label = f"moving obstacle at t = {when} s (darker later)"
         handles.append(Patch(facecolor=_MOVING, alpha=0.3, edgecolor=_MOVING, label=label))
@@ -407,7 +407,9 @@ def _timeline_figure(
     plt.close(figure)
 
 
-def _limited(axis, times, values, limit: float, ylabel: str, title: str, name: str) -> None:
+def _limited(
+    axis, times: np.ndarray, values: np.ndarray, limit: float, ylabel: str, title: str, name: str
+) -> None:
     """A quantity over time with its limit as a dashed line."""
     axis.plot(times, values, color=_FLOWN, lw=1.0)
     axis.axhline(limit, color="k", ls="--", lw=0.8)
