@@ -8,7 +8,6 @@ Drawn with matplotlib's non-interactive Agg backend into the run's ``plots/`` fo
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -18,15 +17,12 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
 import numpy as np  # noqa: E402
-from scipy.spatial import ConvexHull  # noqa: E402
 
-from dcsim.geometry import rotate  # noqa: E402
 from dcsim.messages import Shape, ShapeKind  # noqa: E402
 from dcsim.motion import MotionSet  # noqa: E402
 from dcsim.scenario.model import Scenario  # noqa: E402
+from dcsim.shape_outlines import outline  # noqa: E402
 from dcsim.world.objects import build_objects  # noqa: E402
-
-_CIRCLE_POINTS = 48  # points on each end circle of a cylinder's outline
 
 
 def write_plots(
@@ -132,26 +128,9 @@ def _trajectory(path: Path, scenario: Scenario, telemetry, events) -> None:
 
 def _draw_footprint(axis, shape: Shape, centres: np.ndarray, colour: str) -> None:
     """Outline ``shape``'s top view (x-y) about each of ``centres`` (K, 2), m."""
-    outline = _footprint(shape)
+    footprint = outline(shape)
     for centre in np.unique(centres, axis=0):
-        axis.fill(*(centre + outline).T, facecolor=colour, edgecolor=colour, alpha=0.3, lw=0.8)
-
-
-def _footprint(shape: Shape) -> np.ndarray:
-    """Top-view outline (M, 2) of a box or a cylinder about its centre, world x-y, m.
-
-    The convex hull of the box's corners, or of the cylinder's two end circles, turned
-    by the shape's orientation and projected on x-y.
-    """
-    if shape.kind is ShapeKind.BOX:
-        body = np.array(list(itertools.product(*((-h, h) for h in shape.half_extents))))
-    else:
-        angles = np.linspace(0.0, 2.0 * np.pi, _CIRCLE_POINTS, endpoint=False)
-        ring = shape.radius * np.column_stack([np.cos(angles), np.sin(angles)])
-        half = 0.5 * shape.height
-        body = np.vstack([np.column_stack([ring, np.full(len(ring), z)]) for z in (-half, half)])
-    points = rotate(shape.orientation, body)[:, :2]
-    return points[ConvexHull(points).vertices]
+        axis.fill(*(centre + footprint).T, facecolor=colour, edgecolor=colour, alpha=0.3, lw=0.8)
 
 
 def _timeline(path: Path, telemetry, modes: tuple[str, ...], safety_distance: float) -> None:
@@ -179,7 +158,7 @@ def _timeline(path: Path, telemetry, modes: tuple[str, ...], safety_distance: fl
     axes[1].set_title("Fuel")
     axes[2].semilogy(times[converged], np.maximum(error[converged], 1e-6), color="tab:blue", lw=0.8)
     axes[2].set(ylabel="error [m]", title="Localisation error |true - estimated|")
-    _obstacle_panel(axes[3], times, telemetry["nearest_obstacle"], safety_distance)
+    obstacle_panel(axes[3], times, telemetry["nearest_obstacle"], safety_distance)
     for axis in axes:
         axis.grid(alpha=0.3)
     figure.tight_layout()
@@ -187,8 +166,20 @@ def _timeline(path: Path, telemetry, modes: tuple[str, ...], safety_distance: fl
     plt.close(figure)
 
 
-def _obstacle_panel(axis, times, gap: np.ndarray, safety_distance: float) -> None:
-    """Surface gap to the nearest obstacle over time, with the safety distance and contact."""
+def obstacle_panel(axis, times: np.ndarray, gap: np.ndarray, safety_distance: float) -> None:
+    """Draw the surface gap to the nearest obstacle over time on ``axis``.
+
+    Parameters
+    ----------
+    axis : matplotlib Axes
+        The panel.
+    times : ndarray
+        Times, s.
+    gap : ndarray
+        Surface gap to the nearest obstacle at each time, m (infinite with none).
+    safety_distance : float
+        Gap marked as a dashed line, m; contact (0 m) is marked too.
+    """
     finite = np.isfinite(gap)
     axis.plot(times[finite], gap[finite], color="tab:red", lw=0.9, label="nearest obstacle")
     axis.axhline(safety_distance, color="k", ls="--", lw=1, label="safety distance")

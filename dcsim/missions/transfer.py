@@ -21,7 +21,8 @@ from __future__ import annotations
 
 import io
 import time as wallclock
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -43,6 +44,7 @@ from dcsim.messages import (
 )
 from dcsim.missions.base import Emit, Mission
 from dcsim.scenario.model import Scenario, TransferMissionSection
+from dcsim.transfer_plots import write_transfer_plots
 from dcsim.world import World
 
 _TRAJECTORY_HEADER = (
@@ -266,6 +268,23 @@ class TransferMission(Mission):
             "tracking_error": self.tracking_error,
             "goal_distance": float(np.linalg.norm(outputs["position"] - self.goal.position)),
         }
+
+    def plot(
+        self,
+        out_dir: Path,
+        telemetry: Mapping[str, np.ndarray],
+        events: Sequence[Mapping[str, Any]],
+    ) -> list[Path]:
+        """Draw ``path.png`` and ``timeline.png`` into ``out_dir/plots``.
+
+        See :func:`dcsim.transfer_plots.write_transfer_plots`: the path with every
+        obstacle in its true shape and the last planned trajectory (``trajectory.csv``,
+        written before the plots), and a timeline marked with the events' mode changes
+        and planner answers.
+        """
+        return write_transfer_plots(
+            out_dir, self.scenario, telemetry, events, self.modes, self.safety_distance
+        )
 
     def progress(self) -> str:
         """Whether the goal is reached."""
