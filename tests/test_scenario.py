@@ -24,15 +24,6 @@ from tests.conftest import REPO
 
 SCENARIOS = sorted((REPO / "scenarios").glob("*.yaml"))
 
-# A box goal's resolved scenario writes the default `mission.goal.radius` beside
-# `half_extents`, and reading it back refuses the pair: a known bug of the goal
-# section, so these files cannot be repeated from their run's scenario.yaml yet.
-# Strict, so the mark must go once the dump leaves the radius out.
-BOX_GOAL_ROUND_TRIP = pytest.mark.xfail(
-    strict=True, raises=ScenarioError, reason="a box goal's dump keeps the default radius"
-)
-BOX_GOAL_SCENARIOS = {"asteroid_escape.yaml"}
-
 
 @pytest.fixture(scope="module")
 def registry():
@@ -53,10 +44,7 @@ def problems(path, overrides=(), registry=None) -> list[str]:
 
 @pytest.mark.parametrize(
     "path",
-    [
-        pytest.param(p, marks=BOX_GOAL_ROUND_TRIP) if p.name in BOX_GOAL_SCENARIOS else p
-        for p in SCENARIOS
-    ],
+    SCENARIOS,
     ids=lambda p: p.name,
 )
 def test_shipped_scenarios_resolve_and_round_trip(path, registry):

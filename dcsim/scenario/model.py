@@ -487,8 +487,8 @@ class GoalSection(Section):
     """The goal region of a transfer: a sphere or a box, and what must hold on arrival."""
 
     position: Vec3 = quantity(unit="m", description="Centre of the goal region.")
-    radius: float = quantity(
-        1.0, unit="m", gt=0, description="Radius of a spherical region (without `half_extents`)."
+    radius: float | None = quantity(
+        None, unit="m", gt=0, description="Radius of a spherical region (or give `half_extents`)."
     )
     half_extents: Vec3 | None = quantity(
         None,
@@ -517,16 +517,16 @@ class GoalSection(Section):
 
     @model_validator(mode="after")
     def _one_region(self) -> GoalSection:
-        """A region is a sphere or a box, not both."""
-        if self.half_extents is not None and "radius" in self.model_fields_set:
-            raise ValueError("give either radius (a sphere) or half_extents (a box), not both")
+        """A region is a sphere or a box: exactly one of the two is given."""
+        if (self.radius is None) == (self.half_extents is None):
+            raise ValueError("give either radius (a sphere) or half_extents (a box)")
         return self
 
     def build(self) -> GoalRegion:
         """The goal region message."""
         return GoalRegion(
             position=self.position,
-            tolerance=0.0 if self.half_extents is not None else self.radius,
+            tolerance=0.0 if self.radius is None else self.radius,
             velocity=self.velocity,
             time=self.arrival_time,
             half_extents=self.half_extents,
