@@ -25,6 +25,9 @@ Messages
 Motion models
     :class:`MotionModel`, :class:`StaticMotion`, :class:`LinearMotion`,
     :class:`SphericalMotion`, :class:`ClohessyWiltshireMotion`, :func:`mean_motion`.
+Path clearance (the yardstick of path planners)
+    :func:`min_clearance`, :class:`Clearance`, :func:`surface_distance`,
+    :func:`resolution_step`.
 Plan cost
     :func:`plan_delta_v`, :func:`plan_duration`, :func:`plan_cost`, :func:`legs_delta_v`,
     :func:`leg_delta_v`.
@@ -43,6 +46,7 @@ Errors
     :class:`DcsimError` and its subclasses.
 """
 
+from dcsim.clearance import Clearance, min_clearance, resolution_step, surface_distance
 from dcsim.errors import (
     DcsimError,
     DuplicatePluginError,
@@ -116,6 +120,7 @@ __all__ = [
     "array_field",
     "BeaconRange",
     "Bounds",
+    "Clearance",
     "clip_norm",
     "ClohessyWiltshireMotion",
     "Command",
@@ -141,6 +146,7 @@ __all__ = [
     "mean_motion",
     "Message",
     "message",
+    "min_clearance",
     "MotionInput",
     "MotionModel",
     "NoPath",
@@ -169,6 +175,7 @@ __all__ = [
     "quaternion_conjugate",
     "quaternion_multiply",
     "Reference",
+    "resolution_step",
     "rest_to_rest_time",
     "RobotSpec",
     "RobotState",
@@ -183,6 +190,7 @@ __all__ = [
     "SphericalMotion",
     "StateEstimate",
     "StaticMotion",
+    "surface_distance",
     "Surroundings",
     "TaskPlanner",
     "TaskRequest",

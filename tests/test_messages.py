@@ -86,6 +86,9 @@ def test_trajectory_samples_linearly_and_holds_at_the_ends():
     position, velocity = trajectory.sample(20.0)
     np.testing.assert_allclose(position, [10, 0, 0])
     np.testing.assert_allclose(velocity, [0, 0, 0])
+    positions, velocities = trajectory.sample([-1.0, 2.5, 20.0])
+    np.testing.assert_allclose(positions, [[0, 0, 0], [2.5, 0, 0], [10, 0, 0]])
+    np.testing.assert_allclose(velocities, [[2, 0, 0], [1.5, 0, 0], [0, 0, 0]])
 
 
 def test_robot_state_checks_its_attitude_and_joints():

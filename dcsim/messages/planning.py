@@ -249,10 +249,20 @@ class Trajectory(Message):
                     f"Trajectory.{name} has {len(value)} rows, expected {rows} for {n} times"
                 )
 
-    def sample(self, t: float) -> tuple[Vector, Vector]:
-        """Reference ``(position, velocity)`` at time ``t`` (s), held at the ends."""
-        position = np.array([np.interp(t, self.times, self.positions[:, k]) for k in range(3)])
-        velocity = np.array([np.interp(t, self.times, self.velocities[:, k]) for k in range(3)])
+    def sample(self, t: ArrayLike) -> tuple[Vector, Vector]:
+        """Reference ``(position, velocity)`` at time(s) ``t`` (s), held at the ends.
+
+        Returns
+        -------
+        position, velocity : ndarray, shape (..., 3)
+            Linear between samples, m and m/s.
+        """
+        position = np.stack(
+            [np.interp(t, self.times, self.positions[:, k]) for k in range(3)], axis=-1
+        )
+        velocity = np.stack(
+            [np.interp(t, self.times, self.velocities[:, k]) for k in range(3)], axis=-1
+        )
         return position, velocity
 
     def state_at(self, t: float) -> RobotState:
