@@ -26,8 +26,8 @@ Motion models
     :class:`MotionModel`, :class:`StaticMotion`, :class:`LinearMotion`,
     :class:`SphericalMotion`, :class:`ClohessyWiltshireMotion`, :func:`mean_motion`.
 Path clearance (the yardstick of path planners)
-    :func:`min_clearance`, :class:`Clearance`, :func:`surface_distance`,
-    :func:`resolution_step`.
+    :func:`path_clearance`, :func:`min_clearance`, :class:`Clearance`,
+    :func:`surface_distance`, :func:`resolution_step`.
 Plan cost
     :func:`plan_delta_v`, :func:`plan_duration`, :func:`plan_cost`, :func:`legs_delta_v`,
     :func:`leg_delta_v`.
@@ -46,7 +46,13 @@ Errors
     :class:`DcsimError` and its subclasses.
 """
 
-from dcsim.clearance import Clearance, min_clearance, resolution_step, surface_distance
+from dcsim.clearance import (
+    Clearance,
+    min_clearance,
+    path_clearance,
+    resolution_step,
+    surface_distance,
+)
 from dcsim.errors import (
     DcsimError,
     DuplicatePluginError,
@@ -153,6 +159,7 @@ __all__ = [
     "ObjectKind",
     "ObjectTrack",
     "Observations",
+    "path_clearance",
     "PathPlanner",
     "PathProblem",
     "Plan",

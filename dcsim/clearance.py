@@ -12,7 +12,8 @@ The trajectory is sampled every ``step`` seconds and at each of its own samples.
 two time samples the robot and an obstacle move apart or together by at most their
 relative displacement over the step, so the sampled minimum overestimates the true one
 by at most half of it: choose ``step`` so that this is small against the clearance that
-matters (:func:`resolution_step` does).
+matters (:func:`resolution_step` does; :func:`path_clearance` puts the two together for a
+planner's answer to a :class:`PathProblem`).
 """
 
 from __future__ import annotations
@@ -23,7 +24,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from dcsim.geometry import Vector, quaternion_conjugate, rotate
-from dcsim.messages import ObjectTrack, Shape, ShapeKind, Trajectory
+from dcsim.messages import ObjectTrack, PathProblem, Shape, ShapeKind, Trajectory
+
+RESOLUTION = 0.1
+"""Default largest change of a gap between two samples of :func:`path_clearance`, in robot
+radii (at least :data:`MIN_RESOLUTION`)."""
+
+MIN_RESOLUTION = 0.01
+"""Least resolution of :func:`path_clearance`, m (for a robot of radius 0)."""
 
 
 @dataclass(frozen=True)
@@ -179,3 +187,28 @@ def resolution_step(
     )
     closing = robot + obstacle
     return duration if closing == 0 else min(duration, resolution / closing)
+
+
+def path_clearance(
+    trajectory: Trajectory, problem: PathProblem, resolution: float = RESOLUTION
+) -> Clearance:
+    """The swept clearance of a planned trajectory against its problem's obstacles.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A path planner's answer to ``problem``.
+    problem : PathProblem
+        Its obstacles and robot radius.
+    resolution : float
+        Largest change of a gap between two samples, in robot radii; at least
+        :data:`MIN_RESOLUTION` m.
+
+    Returns
+    -------
+    Clearance
+        As :func:`min_clearance`, at the step :func:`resolution_step` gives.
+    """
+    metres = max(resolution * problem.robot_radius, MIN_RESOLUTION)
+    step = resolution_step(trajectory, problem.obstacles, metres)
+    return min_clearance(trajectory, problem.obstacles, problem.robot_radius, step)

@@ -5,8 +5,23 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from dcsim.clearance import min_clearance, resolution_step, sample_times, surface_distance
-from dcsim.messages import ObjectKind, ObjectTrack, Shape, ShapeKind, Trajectory
+from dcsim.clearance import (
+    min_clearance,
+    path_clearance,
+    resolution_step,
+    sample_times,
+    surface_distance,
+)
+from dcsim.messages import (
+    GoalRegion,
+    ObjectKind,
+    ObjectTrack,
+    PathProblem,
+    RobotState,
+    Shape,
+    ShapeKind,
+    Trajectory,
+)
 from dcsim.motion import LinearMotion, StaticMotion
 
 SQRT2 = np.sqrt(2.0)
@@ -180,3 +195,18 @@ def test_resolution_step_bounds_the_closing_motion_between_samples():
     assert resolution_step(trajectory, [], 0.1) == pytest.approx(0.1)
     at_rest = line((1, 1, 1), (1, 1, 1), 4.0)
     assert resolution_step(at_rest, [], 0.1) == 4.0
+
+
+def test_path_clearance_samples_a_planned_trajectory_at_a_tenth_of_the_robot_radius():
+    trajectory = line((0, 0, 0), (20, 0, 0), 20.0)
+    sphere = obstacle((10.0, 3.0, 0.0), Shape(ShapeKind.SPHERE, radius=2.0))
+    problem = PathProblem(
+        start=RobotState(time=0.0, position=[0, 0, 0]),
+        goal=GoalRegion(position=[20, 0, 0], tolerance=1.0),
+        obstacles=(sphere,),
+        robot_radius=0.5,
+    )
+    result = path_clearance(trajectory, problem)
+    assert result.distance == pytest.approx(0.5) and result.samples == 401  # 0.05 s steps
+    point = PathProblem(start=problem.start, goal=problem.goal, obstacles=(sphere,))
+    assert path_clearance(trajectory, point).samples == 2001  # 1 cm at 1 m/s

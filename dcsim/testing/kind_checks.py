@@ -2,17 +2,15 @@
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from collections.abc import Callable
 
 import numpy as np
 
-from dcsim.clearance import min_clearance, resolution_step
+from dcsim.clearance import RESOLUTION, path_clearance
 from dcsim.geometry import quaternion_conjugate, quaternion_multiply, rotation_vector
 from dcsim.interfaces import Plugin
 from dcsim.messages import (
-    GoalRegion,
     NoPath,
     PathProblem,
     Reference,
@@ -40,9 +38,6 @@ _START_TEXT = "{:g} µm, {:g} ns and, when it gives attitudes, {:g} µrad".forma
 
 ACCELERATION_TOLERANCE = 0.01
 """Fraction by which the sampled acceleration may exceed ``max_acceleration``."""
-
-CLEARANCE_RESOLUTION = 0.1
-"""Largest change of a robot-obstacle gap between the collision check's samples, in robot radii."""
 
 # --------------------------------------------------------------------- localiser
 
@@ -227,15 +222,6 @@ def _fine_samples(trajectory: Trajectory, problem: PathProblem) -> tuple[np.ndar
     return times, *trajectory.sample(times)
 
 
-def _final_state(trajectory: Trajectory, goal: GoalRegion) -> RobotState:
-    """The trajectory's last state; one that leaves the attitude free arrives at the goal's
-    attitude (the transfer mission holds it)."""
-    final = trajectory.state_at(trajectory.times[-1])
-    if trajectory.attitudes is None and goal.attitude is not None:
-        return dataclasses.replace(final, attitude=goal.attitude)
-    return final
-
-
 def _turn_angle(a: np.ndarray, b: np.ndarray) -> float:
     """Angle of the rotation from attitude ``b`` to attitude ``a``, rad."""
     return float(np.linalg.norm(rotation_vector(quaternion_multiply(a, quaternion_conjugate(b)))))
@@ -272,7 +258,7 @@ def check_endpoints(plugin_class: type[Plugin]) -> None:
     ):
         trajectory, _ = _path(plugin_class, problem, what)
         _check_start(trajectory, problem.start, what)
-        final = _final_state(trajectory, problem.goal)
+        final = trajectory.end_state(problem.goal)
         if not problem.goal.contains(final):
             fail(
                 f"on {what} it ends at t = {final.time:.3f} s at {final.position}, moving at "
@@ -347,15 +333,13 @@ def check_acceleration(plugin_class: type[Plugin]) -> None:
     "collision_free",
     "against every obstacle's true shape (sphere, or turned box or cylinder) moving by its "
     "predicted motion, the robot's sphere never overlaps an obstacle; checked by "
-    "`dcsim.clearance.min_clearance` at every sample of the trajectory and at steps over which "
-    f"no gap changes by more than {CLEARANCE_RESOLUTION:g} robot radius",
+    "`dcsim.clearance.path_clearance` at every sample of the trajectory and at steps over "
+    f"which no gap changes by more than {RESOLUTION:g} robot radius",
     kinds=("path_planner",),
 )
 def check_collisions(plugin_class: type[Plugin]) -> None:
     trajectory, problem = _standard_path(plugin_class)
-    resolution = CLEARANCE_RESOLUTION * problem.robot_radius
-    step = resolution_step(trajectory, problem.obstacles, resolution)
-    closest = min_clearance(trajectory, problem.obstacles, problem.robot_radius, step)
+    closest = path_clearance(trajectory, problem)
     if closest.collides:
         fail(
             f"overlaps obstacle {closest.obstacle_id} by {-closest.distance:.3f} m at "
