@@ -165,9 +165,9 @@ def _plan_in_child(plugin: type, seed: int, problem: PathProblem, connection: Co
     """
     began = time.perf_counter()
     try:
-        answer: Any = plugin(None, component_rng(seed, "path_planner"))
+        planner = plugin(None, component_rng(seed, "path_planner"))
         began = time.perf_counter()
-        answer = answer.plan(problem)
+        answer: Any = planner.plan(problem)
     except Exception as error:  # the planner's own failure is a result, not the bench's
         answer = f"{type(error).__name__}: {error}"
     elapsed = time.perf_counter() - began
@@ -210,15 +210,23 @@ def plan_in_process(plugin: type, seed: int, problem: PathProblem) -> tuple[Any,
         if not receiver.poll(waited):
             return None, waited, math.nan
         answer, seconds = receiver.recv()
-        peak = receiver.recv() if receiver.poll(waited) else math.nan
-        return answer, seconds, peak
     except EOFError:
         child.join()
         return f"the planning process died (exit code {child.exitcode})", math.nan, math.nan
+    else:
+        return answer, seconds, _peak(receiver, waited)
     finally:
         child.kill()
         child.join()
         receiver.close()
+
+
+def _peak(receiver: Connection, timeout: float) -> float:
+    """The traced call's peak memory (bytes), or NaN if it does not come within ``timeout`` s."""
+    try:
+        return receiver.recv() if receiver.poll(timeout) else math.nan
+    except EOFError:
+        return math.nan
 
 
 def time_allowance(problem: PathProblem) -> float:

@@ -7,6 +7,7 @@ import os
 import signal
 import sqlite3
 import time
+import tracemalloc
 
 import numpy as np
 import pytest
@@ -40,6 +41,16 @@ class CrashingPlanner(StraightLinePlanner):
 
     def plan(self, problem):
         os.kill(os.getpid(), signal.SIGKILL)
+
+
+class TraceShyPlanner(StraightLinePlanner):
+    name = "trace-shy"
+    summary = "Answers, then dies in the traced call (test)"
+
+    def plan(self, problem):
+        if tracemalloc.is_tracing():
+            os.kill(os.getpid(), signal.SIGKILL)
+        return super().plan(problem)
 
 
 class HangingPlanner(StraightLinePlanner):
@@ -95,6 +106,8 @@ def test_crashes_hangs_and_exceptions_are_results_not_failures(quick):
     assert time.perf_counter() - began < 3.0
     raised, _, _ = plan_in_process(RaisingPlanner, 0, quick.problem)
     assert raised == "RuntimeError: lost in space"
+    answered, seconds, peak = plan_in_process(TraceShyPlanner, 0, quick.problem)
+    assert isinstance(answered, Trajectory) and seconds > 0 and np.isnan(peak)
 
 
 def test_answers_are_judged_by_status_arrival_and_swept_clearance(quick):
