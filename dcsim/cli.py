@@ -10,19 +10,24 @@ import json
 import re
 import sys
 import warnings
+from collections.abc import Sequence
 from datetime import datetime
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 
 from dcsim import __version__
 from dcsim.errors import DcsimError, PluginLoadWarning
 from dcsim.interfaces import PLUGIN_KINDS
-from dcsim.registry import PluginRegistry
+from dcsim.registry import PluginRegistry, RegisteredPlugin
 from dcsim.rundir import prepare_run_directory
 from dcsim.runsetup import prepare_run
 from dcsim.scenario import load_scenario
 from dcsim.scenario.model import MAX_SEED
+
+if TYPE_CHECKING:  # the bench modules are imported by their commands only
+    from dcsim.bench.path_planners import ProblemResult
 
 EXIT_USER_ERROR = 2
 
@@ -642,17 +647,16 @@ def bench_path_planners_command(
     swept clearance check. Prints a Markdown table for docs/benchmarks.md; writes OMPL
     benchmark logs and their Planner Arena database on request.
     """
-    import tempfile
-
     from dcsim.bench import path_reports
-    from dcsim.bench.ompl_log import write_database
+    from dcsim.bench.ompl_log import benchmark_parser
     from dcsim.bench.path_planners import bench_path_planners, select_planners
     from dcsim.bench.path_problems import load_problem
 
+    if database is not None:
+        benchmark_parser()  # refuse before the runs, not after them
     registry = _registry()
     chosen = select_planners(registry, _names(planners, "--planners"))
-    specs = _names(problems, "--problems") or []
-    bench_problems = [load_problem(spec) for spec in specs]
+    bench_problems = [load_problem(spec) for spec in _names(problems, "--problems") or []]
     names = [p.name for p in bench_problems]
     if len(set(names)) < len(names):
         raise click.BadParameter(f"two problems have one name: {names}", param_hint="--problems")
@@ -660,18 +664,35 @@ def bench_path_planners_command(
         bench_problems, chosen, runs, fly, registry, lambda line: click.echo(line, err=True)
     )
     click.echo(path_reports.markdown_table(results, fly))
-    with tempfile.TemporaryDirectory(prefix="dcsim-path-bench-") as tmp:
-        base = log if log is not None else Path(tmp) / "path_planners.log"
-        if log is not None or database is not None:
-            logs = path_reports.write_logs(results, chosen, runs, fly, base)
-            if log is not None:
-                click.echo(f"\nlogs: {', '.join(str(p) for p in logs)}")
-        if database is not None:
-            write_database(logs, database)
-            click.echo(f"database: {database}")
+    if log is not None or database is not None:
+        _write_records(results, chosen, runs, fly, log, database)
     if plot_path is not None:
         path_reports.plot(results, plot_path)
         click.echo(f"plot: {plot_path}")
+
+
+def _write_records(
+    results: Sequence[ProblemResult],
+    planners: Sequence[RegisteredPlugin],
+    runs: int,
+    fly: bool,
+    log: Path | None,
+    database: Path | None,
+) -> None:
+    """The path-planner bench's OMPL logs (in a temporary folder without ``log``) and database."""
+    import tempfile
+
+    from dcsim.bench.ompl_log import write_database
+    from dcsim.bench.path_reports import write_logs
+
+    click.echo("")
+    with tempfile.TemporaryDirectory(prefix="dcsim-path-bench-") as tmp:
+        logs = write_logs(results, planners, runs, fly, log or Path(tmp) / "path_planners.log")
+        if log is not None:
+            click.echo(f"logs: {', '.join(str(p) for p in logs)}")
+        if database is not None:
+            write_database(logs, database)
+            click.echo(f"database: {database}")
 
 
 def _names(text: str | None, option: str) -> list[str] | None:

@@ -13,7 +13,7 @@ from __future__ import annotations
 import contextlib
 import io
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -148,6 +148,23 @@ def benchmark_log(experiment: Experiment) -> str:
     return "\n".join(lines) + "\n"
 
 
+def benchmark_parser() -> Callable[..., None]:
+    """OMPL's benchmark-log parser, ``readBenchmarkLog(database, logs, moveitformat)``.
+
+    Raises
+    ------
+    DcsimError
+        If OMPL's Python package is not installed.
+    """
+    try:
+        from ompl.tools import readBenchmarkLog
+    except ImportError:
+        raise DcsimError(
+            "writing the database needs OMPL's Python package: pip install 'dcsim[bench]'"
+        ) from None
+    return readBenchmarkLog
+
+
 def write_database(logs: Sequence[Path], database: Path) -> None:
     """Parse benchmark logs with OMPL's own parser into a fresh SQLite database.
 
@@ -163,13 +180,8 @@ def write_database(logs: Sequence[Path], database: Path) -> None:
     DcsimError
         If OMPL's Python package is not installed.
     """
-    try:
-        from ompl.tools import readBenchmarkLog
-    except ImportError:
-        raise DcsimError(
-            "writing the database needs OMPL's Python package: pip install 'dcsim[bench]'"
-        ) from None
+    parse = benchmark_parser()
     database.parent.mkdir(parents=True, exist_ok=True)
     database.unlink(missing_ok=True)
     with contextlib.redirect_stdout(io.StringIO()):  # it prints a line per file and planner
-        readBenchmarkLog(str(database), [str(path) for path in logs], False)
+        parse(str(database), [str(path) for path in logs], False)

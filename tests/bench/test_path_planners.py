@@ -6,6 +6,7 @@ import dataclasses
 import os
 import signal
 import sqlite3
+import sys
 import time
 import tracemalloc
 
@@ -221,6 +222,13 @@ def test_the_command_writes_table_logs_database_and_plot(transfer_file, tmp_path
         assert db.execute("SELECT count(*) FROM runs").fetchone() == (4,)
         flown = db.execute("SELECT flown_reached, flown_collisions FROM runs WHERE solved = 1")
         assert flown.fetchall() == [(1, 0), (1, 0)]
+
+
+def test_the_command_refuses_a_database_without_ompl_before_any_run(monkeypatch, tmp_path):
+    monkeypatch.setitem(sys.modules, "ompl.tools", None)
+    result = CliRunner().invoke(cli, ["bench", "path-planners", "--db", str(tmp_path / "x.db")])
+    assert result.exit_code == 2 and "pip install 'dcsim[bench]'" in result.output
+    assert " seed 0: " not in result.output and not (tmp_path / "x.db").exists()
 
 
 def test_the_command_refuses_unknown_planners_and_problems():
