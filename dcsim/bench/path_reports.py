@@ -65,7 +65,7 @@ _FLIGHT_PROPERTIES = (
 
 
 def _run_values(run: PlanRun) -> list[Value]:
-    trajectory = run.status == "solved"
+    """The run's row (NaN, no trajectory's figures, is written "nan": NULL in the database)."""
     return [
         run.seed,
         run.time,
@@ -74,10 +74,10 @@ def _run_values(run: PlanRun) -> list[Value]:
         run.exact,
         run.approximate,
         None if run.collides is None else not run.collides,
-        run.length if trajectory else None,
-        run.duration if trajectory else None,
-        run.delta_v if trajectory else None,
-        run.clearance if trajectory else None,
+        run.length,
+        run.duration,
+        run.delta_v,
+        run.clearance,
     ]
 
 
