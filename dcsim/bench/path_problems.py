@@ -49,6 +49,7 @@ ROBOT_RADIUS = 1.0
 ORBIT_RADIUS = 6_778_137.0
 """Reference orbit of ``cw-spheres`` (400 km altitude), m."""
 FIRST_ID = 100
+"""Id of a family's first obstacle."""
 
 
 @dataclass(frozen=True)
