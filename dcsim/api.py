@@ -25,6 +25,9 @@ Messages
 Motion models
     :class:`MotionModel`, :class:`StaticMotion`, :class:`LinearMotion`,
     :class:`SphericalMotion`, :class:`ClohessyWiltshireMotion`, :func:`mean_motion`.
+Path clearance (the yardstick of path planners)
+    :func:`path_clearance`, :func:`min_clearance`, :class:`Clearance`,
+    :func:`surface_distance`, :func:`resolution_step`.
 Plan cost
     :func:`plan_delta_v`, :func:`plan_duration`, :func:`plan_cost`, :func:`legs_delta_v`,
     :func:`leg_delta_v`.
@@ -43,6 +46,13 @@ Errors
     :class:`DcsimError` and its subclasses.
 """
 
+from dcsim.clearance import (
+    Clearance,
+    min_clearance,
+    path_clearance,
+    resolution_step,
+    surface_distance,
+)
 from dcsim.errors import (
     DcsimError,
     DuplicatePluginError,
@@ -116,6 +126,7 @@ __all__ = [
     "array_field",
     "BeaconRange",
     "Bounds",
+    "Clearance",
     "clip_norm",
     "ClohessyWiltshireMotion",
     "Command",
@@ -141,12 +152,14 @@ __all__ = [
     "mean_motion",
     "Message",
     "message",
+    "min_clearance",
     "MotionInput",
     "MotionModel",
     "NoPath",
     "ObjectKind",
     "ObjectTrack",
     "Observations",
+    "path_clearance",
     "PathPlanner",
     "PathProblem",
     "Plan",
@@ -169,6 +182,7 @@ __all__ = [
     "quaternion_conjugate",
     "quaternion_multiply",
     "Reference",
+    "resolution_step",
     "rest_to_rest_time",
     "RobotSpec",
     "RobotState",
@@ -183,6 +197,7 @@ __all__ = [
     "SphericalMotion",
     "StateEstimate",
     "StaticMotion",
+    "surface_distance",
     "Surroundings",
     "TaskPlanner",
     "TaskRequest",

@@ -10,19 +10,24 @@ import json
 import re
 import sys
 import warnings
+from collections.abc import Sequence
 from datetime import datetime
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 
 from dcsim import __version__
 from dcsim.errors import DcsimError, PluginLoadWarning
 from dcsim.interfaces import PLUGIN_KINDS
-from dcsim.registry import PluginRegistry
+from dcsim.registry import PluginRegistry, RegisteredPlugin
 from dcsim.rundir import prepare_run_directory
 from dcsim.runsetup import prepare_run
 from dcsim.scenario import load_scenario
 from dcsim.scenario.model import MAX_SEED
+
+if TYPE_CHECKING:  # the bench modules are imported by their commands only
+    from dcsim.bench.path_planners import ProblemResult
 
 EXIT_USER_ERROR = 2
 
@@ -578,6 +583,126 @@ def bench_fmu_command(scenario: Path | None, duration: float, repeats: int) -> N
         scenario, duration, repeats, progress=lambda line: click.echo(line, err=True)
     )
     click.echo(markdown_table(result))
+
+
+@bench_group.command("path-planners")
+@click.option(
+    "--planners",
+    default=None,
+    help="Comma-separated path planners, each with its default parameters "
+    "(default: every registered one).",
+)
+@click.option(
+    "--problems",
+    default="static-spheres,cw-spheres,shapes",
+    show_default=True,
+    help="Comma-separated problems: a family (static-spheres, cw-spheres, shapes) with an "
+    "optional :SEED (default 0), or the path of a transfer scenario file.",
+)
+@click.option(
+    "--runs",
+    type=click.IntRange(min=1),
+    default=10,
+    show_default=True,
+    help="Runs of every planner on every problem (world seeds 0 to N - 1).",
+)
+@click.option(
+    "--db",
+    "database",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Write the SQLite database OMPL's parser makes of the logs (Planner Arena opens "
+    "it); replaced if it exists. Needs dcsim[bench].",
+)
+@click.option(
+    "--log",
+    "log",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Write OMPL benchmark logs, one per problem: FILE's stem, the problem, FILE's suffix "
+    "(--log out/bench.log writes out/bench.static-spheres-0.log, ...).",
+)
+@click.option(
+    "--fly",
+    is_flag=True,
+    help="Also fly every run that gave a trajectory through the transfer mission.",
+)
+@click.option(
+    "--plot",
+    "plot_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Save box plots of planning time, delta-v and length per problem and planner.",
+)
+def bench_path_planners_command(
+    planners: str | None,
+    problems: str,
+    runs: int,
+    database: Path | None,
+    log: Path | None,
+    fly: bool,
+    plot_path: Path | None,
+) -> None:
+    """Path planners side by side on seeded random fields and transfer scenarios.
+
+    Every planner plans every problem RUNS times, each run in a fresh process with its own
+    seed; the trajectory is judged by the goal region's tolerances and an independent
+    swept clearance check. Prints a Markdown table for docs/benchmarks.md; writes OMPL
+    benchmark logs and their Planner Arena database on request.
+    """
+    from dcsim.bench import path_reports
+    from dcsim.bench.ompl_log import benchmark_parser
+    from dcsim.bench.path_planners import bench_path_planners, select_planners
+    from dcsim.bench.path_problems import load_problem
+
+    if database is not None:
+        benchmark_parser()  # refuse before the runs, not after them
+    registry = _registry()
+    chosen = select_planners(registry, _names(planners, "--planners"))
+    bench_problems = [load_problem(spec) for spec in _names(problems, "--problems") or []]
+    names = [p.name for p in bench_problems]
+    if len(set(names)) < len(names):
+        raise click.BadParameter(f"two problems have one name: {names}", param_hint="--problems")
+    results = bench_path_planners(
+        bench_problems, chosen, runs, fly, registry, lambda line: click.echo(line, err=True)
+    )
+    click.echo(path_reports.markdown_table(results, fly))
+    if log is not None or database is not None:
+        _write_records(results, chosen, runs, fly, log, database)
+    if plot_path is not None:
+        path_reports.plot(results, plot_path)
+        click.echo(f"plot: {plot_path}")
+
+
+def _write_records(
+    results: Sequence[ProblemResult],
+    planners: Sequence[RegisteredPlugin],
+    runs: int,
+    fly: bool,
+    log: Path | None,
+    database: Path | None,
+) -> None:
+    """The path-planner bench's OMPL logs (in a temporary folder without ``log``) and database."""
+    import tempfile
+
+    from dcsim.bench.ompl_log import write_database
+    from dcsim.bench.path_reports import write_logs
+
+    click.echo("")
+    with tempfile.TemporaryDirectory(prefix="dcsim-path-bench-") as tmp:
+        logs = write_logs(results, planners, runs, fly, log or Path(tmp) / "path_planners.log")
+        if log is not None:
+            click.echo(f"logs: {', '.join(str(p) for p in logs)}")
+        if database is not None:
+            write_database(logs, database)
+            click.echo(f"database: {database}")
+
+
+def _names(text: str | None, option: str) -> list[str] | None:
+    """The comma-separated names of an option (None when it is not given)."""
+    if text is None:
+        return None
+    names = [name.strip() for name in text.split(",") if name.strip()]
+    if not names:
+        raise click.BadParameter("name at least one", param_hint=option)
+    return names
 
 
 @cli.group("fmu")

@@ -20,7 +20,7 @@ _NAME = re.compile(r"^[a-z][a-z0-9_-]*$")
 _SUMMARIES = {
     "localiser": "Gauss-Newton multilateration on beacon ranges",
     "task_planner": "Targets in order of distance, drop visits when full",
-    "path_planner": "Straight segment at constant speed, obstacle-checked",
+    "path_planner": "Straight segment, trapezoidal speed, obstacle-checked",
     "controller": "Proportional position control with velocity damping",
 }
 _SUFFIXES = {

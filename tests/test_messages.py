@@ -86,6 +86,22 @@ def test_trajectory_samples_linearly_and_holds_at_the_ends():
     position, velocity = trajectory.sample(20.0)
     np.testing.assert_allclose(position, [10, 0, 0])
     np.testing.assert_allclose(velocity, [0, 0, 0])
+    positions, velocities = trajectory.sample([-1.0, 2.5, 20.0])
+    np.testing.assert_allclose(positions, [[0, 0, 0], [2.5, 0, 0], [10, 0, 0]])
+    np.testing.assert_allclose(velocities, [[2, 0, 0], [1.5, 0, 0], [0, 0, 0]])
+
+
+def test_trajectory_end_state_takes_the_goal_attitude_when_it_leaves_the_attitude_free():
+    free = Trajectory(
+        times=[0, 10], positions=[[0, 0, 0], [10, 0, 0]], velocities=[[1, 0, 0], [0, 0, 0]]
+    )
+    turned = [0.0, 0.0, np.sin(np.pi / 4), np.cos(np.pi / 4)]
+    goal = GoalRegion(position=[10, 0, 0], tolerance=0.1, attitude=turned, attitude_tolerance=0.01)
+    assert free.end_state().time == 10.0
+    np.testing.assert_allclose(free.end_state().attitude, [0, 0, 0, 1])
+    assert goal.contains(free.end_state(goal))
+    held = dataclasses.replace(free, attitudes=[[0, 0, 0, 1], [0, 0, 0, 1]])
+    assert not goal.contains(held.end_state(goal))
 
 
 def test_robot_state_checks_its_attitude_and_joints():

@@ -6,6 +6,7 @@ quaternions are ``[x, y, z, w]``.
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 from collections.abc import Mapping
 from dataclasses import field
@@ -249,10 +250,20 @@ class Trajectory(Message):
                     f"Trajectory.{name} has {len(value)} rows, expected {rows} for {n} times"
                 )
 
-    def sample(self, t: float) -> tuple[Vector, Vector]:
-        """Reference ``(position, velocity)`` at time ``t`` (s), held at the ends."""
-        position = np.array([np.interp(t, self.times, self.positions[:, k]) for k in range(3)])
-        velocity = np.array([np.interp(t, self.times, self.velocities[:, k]) for k in range(3)])
+    def sample(self, t: ArrayLike) -> tuple[Vector, Vector]:
+        """Reference ``(position, velocity)`` at time(s) ``t`` (s), held at the ends.
+
+        Returns
+        -------
+        position, velocity : ndarray, shape (..., 3)
+            Linear between samples, m and m/s.
+        """
+        position = np.stack(
+            [np.interp(t, self.times, self.positions[:, k]) for k in range(3)], axis=-1
+        )
+        velocity = np.stack(
+            [np.interp(t, self.times, self.velocities[:, k]) for k in range(3)], axis=-1
+        )
         return position, velocity
 
     def state_at(self, t: float) -> RobotState:
@@ -267,6 +278,18 @@ class Trajectory(Message):
                 [np.interp(t, self.times, self.angular_velocities[:, k]) for k in range(3)]
             )
         return RobotState(t, position, attitude, velocity, angular)
+
+    def end_state(self, goal: GoalRegion | None = None) -> RobotState:
+        """The state at the last sample, to judge arrival with ``goal.contains``.
+
+        A trajectory that leaves the attitude free ends at ``goal``'s attitude when the
+        goal sets one: the transfer mission holds the goal's attitude while it flies such
+        a trajectory.
+        """
+        end = self.state_at(float(self.times[-1]))
+        if self.attitudes is None and goal is not None and goal.attitude is not None:
+            return dataclasses.replace(end, attitude=goal.attitude)
+        return end
 
     def attitude_at(self, t: float) -> Vector:
         """Attitude at time ``t`` (s) by slerp between the samples, held at the ends.

@@ -35,9 +35,11 @@ from dcsim.messages import (
     FrameDynamics,
     FrameKind,
     NoPath,
+    ObjectTrack,
     Observations,
     PathProblem,
     Reference,
+    RobotSpec,
     RobotState,
     StateEstimate,
     Trajectory,
@@ -143,7 +145,9 @@ class TransferMission(Mission):
     def _plan(self, start: RobotState, observations: Observations) -> None:
         """Ask the path planner for a trajectory from ``start``."""
         self._go("PLAN")
-        problem = self._problem(start, observations)
+        problem = transfer_problem(
+            self.scenario, start, observations.obstacles(), self.world.robot_spec()
+        )
         began = wallclock.perf_counter()
         result = self.call("path_planner", "plan", problem)
         self.planning_time += wallclock.perf_counter() - began
@@ -168,34 +172,6 @@ class TransferMission(Mission):
             statistics=dict(result.statistics),
         )
         self._go("FLY")
-
-    def _problem(self, start: RobotState, observations: Observations) -> PathProblem:
-        settings, spec = self.settings, self.world.robot_spec()
-        bounds = None
-        if settings.bounds is not None:
-            bounds = Bounds(settings.bounds.lower, settings.bounds.upper)
-        weights = settings.weights
-        max_delta_v = np.inf if settings.max_delta_v is None else settings.max_delta_v
-        return PathProblem(
-            start=start,
-            goal=self.goal,
-            obstacles=observations.obstacles(),
-            frame=self._frame(),
-            robot_radius=spec.radius,
-            max_speed=spec.max_speed,
-            max_acceleration=settings.acceleration_fraction * spec.max_force / spec.mass,
-            max_delta_v=max_delta_v,
-            max_angular_acceleration=spec.max_torque
-            / float(np.max(np.linalg.eigvalsh(spec.inertia))),
-            bounds=bounds,
-            weights=CostWeights(weights.delta_v, weights.length, weights.time),
-            time_budget=settings.planning_budget,
-        )
-
-    def _frame(self) -> FrameDynamics:
-        if self.scenario.world.frame == "lvlh":
-            return FrameDynamics(FrameKind.CLOHESSY_WILTSHIRE, self.scenario.mean_motion)
-        return FrameDynamics(FrameKind.INERTIAL)
 
     # ------------------------------------------------------------------ references
     def _follow(self, time: float) -> Reference:
@@ -311,6 +287,57 @@ class TransferMission(Mission):
         if not self.planned:
             return {}
         return {"trajectory.csv": trajectory_csv(self.planned[-1])}
+
+
+def transfer_problem(
+    scenario: Scenario, start: RobotState, obstacles: tuple[ObjectTrack, ...], robot: RobotSpec
+) -> PathProblem:
+    """The path problem the transfer mission poses from ``start``.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A transfer scenario: its goal, bounds, weights, limits, budget and frame.
+    start : RobotState
+        Where the path starts (the mission's estimate).
+    obstacles : tuple of ObjectTrack
+        The obstacles in sensor range.
+    robot : RobotSpec
+        The robot's mass, inertia, radius and limits (cargo included).
+
+    Returns
+    -------
+    PathProblem
+        With the acceleration limit ``acceleration_fraction`` of the thrust-limited one
+        and the angular acceleration the torque gives about the stiffest axis.
+    """
+    settings = scenario.mission
+    bounds = None
+    if settings.bounds is not None:
+        bounds = Bounds(settings.bounds.lower, settings.bounds.upper)
+    weights = settings.weights
+    max_delta_v = np.inf if settings.max_delta_v is None else settings.max_delta_v
+    return PathProblem(
+        start=start,
+        goal=settings.goal.build(),
+        obstacles=obstacles,
+        frame=_frame(scenario),
+        robot_radius=robot.radius,
+        max_speed=robot.max_speed,
+        max_acceleration=settings.acceleration_fraction * robot.max_force / robot.mass,
+        max_delta_v=max_delta_v,
+        max_angular_acceleration=robot.max_torque
+        / float(np.max(np.linalg.eigvalsh(robot.inertia))),
+        bounds=bounds,
+        weights=CostWeights(weights.delta_v, weights.length, weights.time),
+        time_budget=settings.planning_budget,
+    )
+
+
+def _frame(scenario: Scenario) -> FrameDynamics:
+    if scenario.world.frame == "lvlh":
+        return FrameDynamics(FrameKind.CLOHESSY_WILTSHIRE, scenario.mean_motion)
+    return FrameDynamics(FrameKind.INERTIAL)
 
 
 def trajectory_csv(trajectory: Trajectory) -> str:

@@ -3,11 +3,22 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 
 import numpy as np
 
+from dcsim.clearance import RESOLUTION, path_clearance
+from dcsim.geometry import quaternion_conjugate, quaternion_multiply, rotation_vector
 from dcsim.interfaces import Plugin
-from dcsim.messages import NoPath, Reference, StateEstimate, Surroundings, Trajectory
+from dcsim.messages import (
+    NoPath,
+    PathProblem,
+    Reference,
+    RobotState,
+    StateEstimate,
+    Surroundings,
+    Trajectory,
+)
 from dcsim.testing import problems
 from dcsim.testing.contracts import (
     LOCALISER_ERROR_BOUND,
@@ -18,6 +29,15 @@ from dcsim.testing.contracts import (
     run_plugin,
     standard_inputs,
 )
+
+START_TOLERANCES = (1e-6, 1e-9, 1e-6)
+"""How far a trajectory may start from the start state: position (m), time (s), attitude (rad)."""
+_START_TEXT = "{:g} µm, {:g} ns and, when it gives attitudes, {:g} µrad".format(
+    *np.multiply(START_TOLERANCES, (1e6, 1e9, 1e6))
+)
+
+ACCELERATION_TOLERANCE = 0.01
+"""Fraction by which the sampled acceleration may exceed ``max_acceleration``."""
 
 # --------------------------------------------------------------------- localiser
 
@@ -150,14 +170,21 @@ def check_completeness(plugin_class: type[Plugin]) -> None:
         fail(f"targets {sorted(missing)} were left out of the plan")
 
 
+_BUDGET_PROBLEMS: dict[str, Callable[[float], object]] = {
+    "task_planner": lambda budget: problems.task_request(targets=15, time_budget=budget),
+    "path_planner": problems.enclosed_goal_problem,
+}
+
+
 @contract(
     "honours_time_budget",
-    "a request for 15 targets with a 0.3 s budget is answered within the budget "
+    "a request for 15 targets (task planners), or a path problem whose goal is walled in by "
+    "60 obstacles (path planners), with a 0.3 s budget is answered within the budget "
     f"(plus 20 % and {TIME_SLACK} s)",
-    kinds=("task_planner",),
+    kinds=("task_planner", "path_planner"),
 )
-def check_task_budget(plugin_class: type[Plugin]) -> None:
-    request = problems.task_request(targets=15, time_budget=0.3)
+def check_budget(plugin_class: type[Plugin]) -> None:
+    request = _BUDGET_PROBLEMS[plugin_class.kind](0.3)
     plugin = make(plugin_class)
     start = time.perf_counter()
     plugin.plan(request)
@@ -169,51 +196,74 @@ def check_task_budget(plugin_class: type[Plugin]) -> None:
 # --------------------------------------------------------------------- path planner
 
 
-def _path(plugin_class: type[Plugin]) -> tuple[Trajectory, object]:
-    problem = problems.path_problem()
-    result = run_plugin(plugin_class, [problem], "the standard path problem")[0]
+def _path(
+    plugin_class: type[Plugin], problem: PathProblem, what: str
+) -> tuple[Trajectory, PathProblem]:
+    result = run_plugin(plugin_class, [problem], what)[0]
     if not isinstance(result, Trajectory):
-        fail(f"found no path on the standard problem, which has one: {result!r}")
+        fail(f"found no path on {what}, which has one: {result!r}")
     return result, problem
 
 
-def _fine_samples(trajectory: Trajectory, problem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _standard_path(plugin_class: type[Plugin]) -> tuple[Trajectory, PathProblem]:
+    return _path(plugin_class, problems.path_problem(), "the standard path problem")
+
+
+def _fine_samples(trajectory: Trajectory, problem: PathProblem) -> tuple[np.ndarray, ...]:
     """Times, positions and velocities ten times finer than the trajectory's own samples,
     and no farther apart than a quarter of the robot radius."""
-    times = [trajectory.times[0]]
-    for t0, t1, p0, p1 in zip(
-        trajectory.times,
-        trajectory.times[1:],
-        trajectory.positions,
-        trajectory.positions[1:],
-        strict=False,
-    ):
-        pieces = max(10, int(np.ceil(np.linalg.norm(p1 - p0) / (0.25 * problem.robot_radius))))
-        times.extend(np.linspace(t0, t1, pieces + 1)[1:])
-    times = np.array(times)
-    states = [trajectory.sample(t) for t in times]
-    return times, np.array([s[0] for s in states]), np.array([s[1] for s in states])
+    lengths = np.linalg.norm(np.diff(trajectory.positions, axis=0), axis=1)
+    pieces = np.maximum(10, np.ceil(lengths / (0.25 * problem.robot_radius))).astype(int)
+    segment = np.repeat(np.arange(len(pieces)), pieces)
+    first = np.repeat(np.cumsum(pieces) - pieces, pieces)
+    fraction = (np.arange(pieces.sum()) - first) / pieces[segment]
+    start, span = trajectory.times[:-1], np.diff(trajectory.times)
+    times = np.append(start[segment] + fraction * span[segment], trajectory.times[-1])
+    return times, *trajectory.sample(times)
+
+
+def _turn_angle(a: np.ndarray, b: np.ndarray) -> float:
+    """Angle of the rotation from attitude ``b`` to attitude ``a``, rad."""
+    return float(np.linalg.norm(rotation_vector(quaternion_multiply(a, quaternion_conjugate(b)))))
+
+
+def _check_start(trajectory: Trajectory, start: RobotState, what: str) -> None:
+    gap = float(np.linalg.norm(trajectory.positions[0] - start.position))
+    lag = float(trajectory.times[0] - start.time)
+    turn = (
+        0.0
+        if trajectory.attitudes is None
+        else _turn_angle(trajectory.attitudes[0], start.attitude)
+    )
+    position_tolerance, time_tolerance, attitude_tolerance = START_TOLERANCES
+    if gap > position_tolerance or abs(lag) > time_tolerance or turn > attitude_tolerance:
+        fail(
+            f"on {what} it starts {gap:.3g} m, {lag:.3g} s and {turn:.3g} rad from the start state"
+        )
 
 
 @contract(
     "reaches_the_goal",
-    "the trajectory starts at the start state and ends inside the goal region",
+    f"the trajectory starts at the start state (within {_START_TEXT}) and its final state "
+    "is inside the goal region within every "
+    "tolerance (`GoalRegion.contains`): on the standard problem, and on one whose goal asks "
+    "to arrive at rest, turned, at a set time (a trajectory that leaves the attitude free "
+    "arrives at the goal's attitude, which the transfer mission holds)",
     kinds=("path_planner",),
 )
 def check_endpoints(plugin_class: type[Plugin]) -> None:
-    trajectory, problem = _path(plugin_class)
-    start_gap = np.linalg.norm(trajectory.positions[0] - problem.start.position)
-    if start_gap > 1e-6 or abs(trajectory.times[0] - problem.start.time) > 1e-9:
-        fail(
-            f"starts {start_gap:.3g} m and {trajectory.times[0] - problem.start.time:.3g} s "
-            "away from the start state"
-        )
-    end_gap = np.linalg.norm(trajectory.positions[-1] - problem.goal.position)
-    if end_gap > problem.goal.tolerance:
-        fail(
-            f"ends {end_gap:.3f} m from the goal; "
-            f"the goal region's radius is {problem.goal.tolerance} m"
-        )
+    for problem, what in (
+        (problems.path_problem(), "the standard path problem"),
+        (problems.arrival_problem(), "the arrival problem"),
+    ):
+        trajectory, _ = _path(plugin_class, problem, what)
+        _check_start(trajectory, problem.start, what)
+        final = trajectory.end_state(problem.goal)
+        if not problem.goal.contains(final):
+            fail(
+                f"on {what} it ends at t = {final.time:.3f} s at {final.position}, moving at "
+                f"{final.velocity}, attitude {final.attitude}: outside {problem.goal!r}"
+            )
 
 
 @contract(
@@ -222,7 +272,7 @@ def check_endpoints(plugin_class: type[Plugin]) -> None:
     kinds=("path_planner",),
 )
 def check_bounds(plugin_class: type[Plugin]) -> None:
-    trajectory, problem = _path(plugin_class)
+    trajectory, problem = _standard_path(plugin_class)
     times, positions, _ = _fine_samples(trajectory, problem)
     outside = ~problem.bounds.contains(positions)
     if outside.any():
@@ -230,58 +280,104 @@ def check_bounds(plugin_class: type[Plugin]) -> None:
         fail(f"at t = {times[i]:.2f} s it is at {positions[i]}, outside {problem.bounds!r}")
 
 
+def _implied_delta_v(trajectory: Trajectory, start: RobotState) -> float:
+    """The velocity changes the samples imply: from the start's velocity to the first
+    sample's, then between samples (thrust in an inertial frame), m/s."""
+    velocities = np.vstack([start.velocity, trajectory.velocities])
+    return float(np.linalg.norm(np.diff(velocities, axis=0), axis=1).sum())
+
+
 @contract(
     "respects_limits",
-    "speeds never exceed max_speed and the reported delta-v is within max_delta_v",
+    "speeds never exceed max_speed, and neither the reported delta-v nor the one its "
+    "samples imply (the start's velocity change plus every change between samples, in the "
+    "standard problem's inertial frame) exceeds max_delta_v",
     kinds=("path_planner",),
 )
 def check_limits(plugin_class: type[Plugin]) -> None:
-    trajectory, problem = _path(plugin_class)
+    trajectory, problem = _standard_path(plugin_class)
     times, _, velocities = _fine_samples(trajectory, problem)
     speeds = np.linalg.norm(velocities, axis=1)
     if speeds.max() > problem.max_speed * (1 + 1e-6):
         i = int(np.argmax(speeds))
         fail(f"speed {speeds[i]:.4f} m/s at t = {times[i]:.2f} s exceeds {problem.max_speed} m/s")
-    if trajectory.delta_v > problem.max_delta_v:
+    implied = _implied_delta_v(trajectory, problem.start)
+    for delta_v, which in ((trajectory.delta_v, "reported"), (implied, "sampled")):
+        if delta_v > problem.max_delta_v * (1 + 1e-6):
+            fail(
+                f"needs {delta_v:.3f} m/s of delta-v ({which}); "
+                f"the limit is {problem.max_delta_v} m/s"
+            )
+
+
+@contract(
+    "respects_acceleration_limit",
+    "the acceleration between consecutive samples, ‖v(i+1) − v(i)‖ / (t(i+1) − t(i)) (exact "
+    "for velocities linear between samples, in the standard problem's inertial frame), never "
+    f"exceeds max_acceleration by more than {100 * ACCELERATION_TOLERANCE:g} %",
+    kinds=("path_planner",),
+)
+def check_acceleration(plugin_class: type[Plugin]) -> None:
+    trajectory, problem = _standard_path(plugin_class)
+    times = trajectory.times
+    rates = np.linalg.norm(np.diff(trajectory.velocities, axis=0), axis=1) / np.diff(times)
+    i = int(np.argmax(rates))
+    if rates[i] > problem.max_acceleration * (1 + ACCELERATION_TOLERANCE):
         fail(
-            f"needs {trajectory.delta_v:.3f} m/s of delta-v; the limit is {problem.max_delta_v} m/s"
+            f"accelerates at {rates[i]:.4g} m/s² between t = {times[i]:.2f} s and "
+            f"{times[i + 1]:.2f} s; the limit is {problem.max_acceleration} m/s²"
         )
 
 
 @contract(
     "collision_free",
-    "checked ten times finer than its own samples against the obstacles' predicted motion, "
-    "the trajectory keeps the robot and every obstacle apart",
+    "against every obstacle's true shape (sphere, or turned box or cylinder) moving by its "
+    "predicted motion, the robot's sphere never overlaps an obstacle; checked by "
+    "`dcsim.clearance.path_clearance` at every sample of the trajectory and at steps over "
+    f"which no gap changes by more than {RESOLUTION:g} robot radius",
     kinds=("path_planner",),
 )
 def check_collisions(plugin_class: type[Plugin]) -> None:
-    trajectory, problem = _path(plugin_class)
-    times, positions, _ = _fine_samples(trajectory, problem)
-    for obstacle in problem.obstacles:
-        gaps = (
-            np.linalg.norm(obstacle.predict(times)[0] - positions, axis=1)
-            - obstacle.radius
-            - problem.robot_radius
+    trajectory, problem = _standard_path(plugin_class)
+    closest = path_clearance(trajectory, problem)
+    if closest.collides:
+        fail(
+            f"overlaps obstacle {closest.obstacle_id} by {-closest.distance:.3f} m at "
+            f"t = {closest.time:.2f} s, at {closest.position}"
         )
-        if gaps.min() < 0:
-            i = int(np.argmin(gaps))
-            fail(f"overlaps obstacle {obstacle.id} by {-gaps[i]:.3f} m at t = {times[i]:.2f} s")
+
+
+_IMPOSSIBLE: tuple[tuple[str, Callable[[float], PathProblem]], ...] = (
+    ("a goal inside obstacle 9", problems.impossible_path_problem),
+    ("a start inside obstacle 9", problems.blocked_start_problem),
+    ("a goal walled in by 60 obstacles", problems.enclosed_goal_problem),
+    ("a goal outside the bounds", problems.outside_bounds_problem),
+)
+
+
+def _describe(result: object) -> str:
+    if isinstance(result, Trajectory):
+        return f"a trajectory ending at {result.positions[-1]} at t = {result.times[-1]:.1f} s"
+    return repr(result)
 
 
 @contract(
     "answers_no_path",
-    "with the goal inside an obstacle it answers NoPath with a reason, within its time budget",
+    "with the goal inside an obstacle, the start inside an obstacle, the goal walled in by "
+    "obstacles, or the goal outside the bounds, it answers NoPath with a reason, within its "
+    "time budget",
     kinds=("path_planner",),
 )
 def check_impossible(plugin_class: type[Plugin]) -> None:
-    problem = problems.impossible_path_problem(time_budget=1.0)
-    start = time.perf_counter()
-    result = run_plugin(plugin_class, [problem], "a problem whose goal is inside an obstacle")[0]
-    elapsed = time.perf_counter() - start
-    if not isinstance(result, NoPath) or not result.reason.strip():
-        fail(f"answered {result!r} for a goal inside obstacle 9")
-    if elapsed > 1.2 * problem.time_budget + TIME_SLACK:
-        fail(f"took {elapsed:.3f} s with a budget of {problem.time_budget} s")
+    for what, build in _IMPOSSIBLE:
+        problem = build(1.0)
+        start = time.perf_counter()
+        result = run_plugin(plugin_class, [problem], f"a problem with {what}")[0]
+        elapsed = time.perf_counter() - start
+        if not isinstance(result, NoPath) or not result.reason.strip():
+            fail(f"answered {_describe(result)} for {what}")
+        if elapsed > 1.2 * problem.time_budget + TIME_SLACK:
+            fail(f"took {elapsed:.3f} s with a budget of {problem.time_budget} s for {what}")
 
 
 # --------------------------------------------------------------------- controller

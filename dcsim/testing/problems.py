@@ -23,6 +23,8 @@ from dcsim.messages import (
     Prior,
     RobotSpec,
     RobotState,
+    Shape,
+    ShapeKind,
     StateEstimate,
     TaskRequest,
 )
@@ -139,9 +141,15 @@ def target_track(
 
 
 def obstacle_track(
-    obstacle_id: int, position, velocity=(0.0, 0.0, 0.0), radius: float = 1.0, time: float = 0.0
+    obstacle_id: int,
+    position,
+    velocity=(0.0, 0.0, 0.0),
+    radius: float = 1.0,
+    time: float = 0.0,
+    shape: Shape | None = None,
 ) -> ObjectTrack:
-    """An obstacle observed at ``time`` moving in a straight line."""
+    """An obstacle observed at ``time`` moving in a straight line (a sphere of ``radius``
+    unless ``shape`` is given)."""
     motion = LinearMotion(position, velocity, epoch=time)
     return ObjectTrack(
         obstacle_id,
@@ -150,8 +158,9 @@ def obstacle_track(
         position,
         velocity,
         mass=50.0,
-        radius=radius,
+        radius=0.0 if shape is not None else radius,
         motion=motion,
+        shape=shape,
     )
 
 
@@ -178,15 +187,26 @@ def task_request(targets: int = 6, time_budget: float = 1.0, capacity: int = 2) 
     )
 
 
+GOAL = np.array([40.0, 5.0, 0.0])
+"""Centre of the standard path problem's goal region, m."""
+
+
 def path_problem(time_budget: float = 1.0) -> PathProblem:
-    """The standard path problem: 40 m across a box, obstacles near but off the direct line."""
+    """The standard path problem: 40 m across a box, obstacles near but off the direct line.
+
+    Three spheres (two of them moving), a turned box and a turned cylinder.
+    """
+    box = Shape(ShapeKind.BOX, half_extents=(1.5, 1.0, 2.0), orientation=_turn((0, 0, 1), 30))
+    cylinder = Shape(ShapeKind.CYLINDER, radius=1.0, height=3.0, orientation=_turn((1, 0, 0), 60))
     return PathProblem(
         start=RobotState(time=0.0, position=[0.0, 0.0, 0.0]),
-        goal=GoalRegion(position=[40.0, 5.0, 0.0], tolerance=1.0),
+        goal=GoalRegion(position=GOAL, tolerance=1.0),
         obstacles=(
             obstacle_track(1, (20.0, 12.0, 0.0), radius=2.0),
             obstacle_track(2, (10.0, -8.0, 3.0), velocity=(0.0, -0.05, 0.0)),
             obstacle_track(3, (30.0, 3.0, 12.0), velocity=(0.0, 0.0, 0.1), radius=1.5),
+            obstacle_track(4, (25.0, -4.0, 0.0), shape=box),
+            obstacle_track(5, (12.0, 6.0, -3.0), shape=cylinder),
         ),
         robot_radius=ROBOT.radius,
         max_speed=ROBOT.max_speed,
@@ -197,8 +217,64 @@ def path_problem(time_budget: float = 1.0) -> PathProblem:
     )
 
 
+def _turn(axis, degrees: float) -> np.ndarray:
+    """The rotation ``[x, y, z, w]`` by ``degrees`` about the unit ``axis``."""
+    half = np.radians(degrees) / 2
+    return np.append(np.sin(half) * np.asarray(axis, dtype=float), np.cos(half))
+
+
+def arrival_problem(time_budget: float = 1.0) -> PathProblem:
+    """The standard path problem with a demanding goal: arrive at rest (within 0.01 m/s),
+    turned a quarter about z (within 1°), at t = 150 s (within 1 s)."""
+    problem = path_problem(time_budget)
+    goal = GoalRegion(
+        position=GOAL,
+        tolerance=1.0,
+        time=150.0,
+        attitude=_turn((0, 0, 1), 90),
+        attitude_tolerance=np.radians(1.0),
+        velocity_tolerance=0.01,
+        time_tolerance=1.0,
+    )
+    return dataclasses.replace(problem, goal=goal)
+
+
 def impossible_path_problem(time_budget: float = 1.0) -> PathProblem:
     """The standard path problem with the goal inside a static obstacle."""
     problem = path_problem(time_budget)
-    blocker = obstacle_track(9, (40.0, 5.0, 0.0), radius=3.0)
+    blocker = obstacle_track(9, GOAL, radius=3.0)
     return dataclasses.replace(problem, obstacles=(*problem.obstacles, blocker))
+
+
+def blocked_start_problem(time_budget: float = 1.0) -> PathProblem:
+    """The standard path problem with the start inside a static obstacle."""
+    problem = path_problem(time_budget)
+    blocker = obstacle_track(9, (0.0, 0.5, 0.0), radius=2.0)
+    return dataclasses.replace(problem, obstacles=(*problem.obstacles, blocker))
+
+
+def enclosed_goal_problem(time_budget: float = 1.0, shell: int = 60) -> PathProblem:
+    """The standard path problem with the goal walled in: ``shell`` static spheres of
+    radius 1.2 m, 4 m from the goal, leave no gap the robot (radius 0.5 m) fits through.
+
+    Centres are spread evenly on the sphere (a Fibonacci lattice): 60 of them are under
+    2 m apart, so every hole is narrower than the robot.
+    """
+    problem = path_problem(time_budget)
+    k = np.arange(shell) + 0.5
+    polar = np.arccos(1.0 - 2.0 * k / shell)
+    azimuth = np.pi * (1.0 + np.sqrt(5.0)) * k
+    directions = np.stack(
+        [np.sin(polar) * np.cos(azimuth), np.sin(polar) * np.sin(azimuth), np.cos(polar)], axis=-1
+    )
+    wall = tuple(
+        obstacle_track(100 + i, GOAL + 4.0 * d, radius=1.2) for i, d in enumerate(directions)
+    )
+    return dataclasses.replace(problem, obstacles=(*problem.obstacles, *wall))
+
+
+def outside_bounds_problem(time_budget: float = 1.0) -> PathProblem:
+    """The standard path problem with the goal beyond its bounds."""
+    problem = path_problem(time_budget)
+    goal = dataclasses.replace(problem.goal, position=[80.0, 5.0, 0.0])
+    return dataclasses.replace(problem, goal=goal)

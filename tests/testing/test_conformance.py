@@ -14,7 +14,7 @@ from dcsim_plugins.localisers.trilateration import TrilaterationLocaliser
 from dcsim_plugins.path_planners.straight_line import StraightLinePlanner
 from dcsim_plugins.task_planners.nearest import NearestTaskPlanner
 
-from dcsim.api import Command, PluginRegistry
+from dcsim.api import Command, GoalRegion, PluginRegistry, ShapeKind
 from dcsim.testing import ControllerContract, check_plugin, checks_for
 from tests.testing.peeking_plugin import PeekingController
 
@@ -109,6 +109,65 @@ class CarelessPathPlanner(StraightLinePlanner):
         return super().plan(dataclasses.replace(problem, obstacles=()))
 
 
+class AbruptPathPlanner(StraightLinePlanner):
+    name = "abrupt"
+    summary = "Accelerates at three times the limit (test)"
+
+    def plan(self, problem):
+        return super().plan(
+            dataclasses.replace(problem, max_acceleration=3 * problem.max_acceleration)
+        )
+
+
+class HurriedPathPlanner(StraightLinePlanner):
+    name = "hurried"
+    summary = "Flies at twice the speed limit (test)"
+
+    def plan(self, problem):
+        return super().plan(dataclasses.replace(problem, max_speed=2 * problem.max_speed))
+
+
+class CasualArrivalPlanner(StraightLinePlanner):
+    name = "casual"
+    summary = "Ignores the goal's time, attitude and velocity (test)"
+
+    def plan(self, problem):
+        goal = GoalRegion(position=problem.goal.position, tolerance=problem.goal.tolerance)
+        return super().plan(dataclasses.replace(problem, goal=goal))
+
+
+class ShortcutPathPlanner(StraightLinePlanner):
+    name = "shortcut"
+    summary = "Flies into the box it should avoid (test)"
+
+    def plan(self, problem):
+        box = next((o for o in problem.obstacles if o.shape.kind is ShapeKind.BOX), None)
+        if box is None:
+            return super().plan(problem)
+        goal = dataclasses.replace(problem.goal, position=box.position)
+        return super().plan(dataclasses.replace(problem, goal=goal, obstacles=()))
+
+
+class StartBlindPathPlanner(StraightLinePlanner):
+    name = "start-blind"
+    summary = "Ignores the obstacle it starts in (test)"
+
+    def plan(self, problem):
+        start = problem.start.position
+        clear = tuple(o for o in problem.obstacles if np.linalg.norm(o.position - start) > o.radius)
+        return super().plan(dataclasses.replace(problem, obstacles=clear))
+
+
+class SlowPathPlanner(StraightLinePlanner):
+    name = "slow-path"
+    summary = "Overruns short time budgets (test)"
+
+    def plan(self, problem):
+        if problem.time_budget < 0.5:
+            time.sleep(problem.time_budget + 0.5)
+        return super().plan(problem)
+
+
 @pytest.mark.parametrize(
     "plugin, failing",
     [
@@ -119,6 +178,12 @@ class CarelessPathPlanner(StraightLinePlanner):
         (FragilePathPlanner, {"handles_empty_inputs"}),
         (LostLocaliser, {"converges"}),
         (CarelessPathPlanner, {"answers_no_path"}),
+        (AbruptPathPlanner, {"respects_acceleration_limit"}),
+        (HurriedPathPlanner, {"respects_limits"}),
+        (CasualArrivalPlanner, {"reaches_the_goal"}),
+        (ShortcutPathPlanner, {"collision_free"}),
+        (StartBlindPathPlanner, {"answers_no_path"}),
+        (SlowPathPlanner, {"honours_time_budget"}),
         (PeekingController, {"uses_only_the_public_api"}),
     ],
     ids=lambda value: getattr(value, "name", None) or "-".join(sorted(value)),
@@ -138,6 +203,20 @@ def test_messages_say_what_the_plugin_did():
     assert "the limits are 5.0 N" in results["commands_within_limits"].message
     slow = {r.check: r for r in check_plugin(SlowPlanner)}["honours_time_budget"].message
     assert "with a budget of 0.3 s" in slow
+
+
+def test_path_planner_messages_say_what_the_plugin_did():
+    abrupt = {r.check: r for r in check_plugin(AbruptPathPlanner)}
+    assert "accelerates at 0.075 m/s²" in abrupt["respects_acceleration_limit"].message
+    assert "the limit is 0.025 m/s²" in abrupt["respects_acceleration_limit"].message
+    casual = {r.check: r for r in check_plugin(CasualArrivalPlanner)}
+    assert "on the arrival problem it ends at t = " in casual["reaches_the_goal"].message
+    shortcut = {r.check: r for r in check_plugin(ShortcutPathPlanner)}
+    assert "overlaps obstacle 4 by " in shortcut["collision_free"].message
+    blind = {r.check: r for r in check_plugin(StartBlindPathPlanner)}
+    assert "for a start inside obstacle 9" in blind["answers_no_path"].message
+    hurried = {r.check: r for r in check_plugin(HurriedPathPlanner)}
+    assert "exceeds 0.5 m/s" in hurried["respects_limits"].message
 
 
 def test_a_class_that_is_no_plugin_fails_only_the_metadata_check():
