@@ -115,7 +115,9 @@ def soak(
     registry = PluginRegistry.discover()
     setup = prepare_run(
         None,
-        ["stop.on_all_delivered=false", "world.duration=1e9", "stop.on_collision=false"],
+        # One simulated second per tick is more than the ticks need at the default
+        # 0.1 s control period, and stays within the scenario's bound on physics steps.
+        ["stop.on_all_delivered=false", f"world.duration={ticks}", "stop.on_collision=false"],
         registry=registry,
     )
     runner = Runner(setup, out_dir)
