@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 import textwrap
@@ -127,17 +128,44 @@ class FreshEnvironment:
         )
 
 
+# What a checkout holds besides its sources: left out of the copy a wheel is built from.
+NOT_SOURCES = shutil.ignore_patterns(
+    ".git", ".venv", "build", "dist", "*.egg-info", "__pycache__", "runs", ".*_cache", "*.fmu"
+)
+
+
+@dataclass
+class WheelBuild:
+    """A wheel built by pip, and what pip and the build backend printed."""
+
+    path: Path
+    output: str
+
+
 @pytest.fixture(scope="session")
-def wheel(tmp_path_factory) -> Path:
-    """dcsim built as a wheel from this checkout."""
+def wheel_build(tmp_path_factory) -> WheelBuild:
+    """dcsim built as a wheel from a copy of this checkout.
+
+    Built from a copy so that no build directory is shared with another test process
+    or left in the checkout.
+    """
+    source = tmp_path_factory.mktemp("source") / "dcsim"
+    shutil.copytree(REPO, source, ignore=NOT_SOURCES)
     out = tmp_path_factory.mktemp("wheel")
-    subprocess.run(
-        [sys.executable, "-m", "pip", "wheel", "--quiet", "--no-deps", "-w", str(out), str(REPO)],
-        check=True,
+    done = subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "--quiet", "--no-deps", "-w", str(out), str(source)],
         capture_output=True,
+        text=True,
         timeout=300,
     )
-    return next(out.glob("dcsim-*.whl"))
+    assert done.returncode == 0, done.stderr
+    return WheelBuild(next(out.glob("dcsim-*.whl")), done.stdout + done.stderr)
+
+
+@pytest.fixture(scope="session")
+def wheel(wheel_build) -> Path:
+    """dcsim built as a wheel from this checkout."""
+    return wheel_build.path
 
 
 @pytest.fixture(scope="session")

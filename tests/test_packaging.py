@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import configparser
+import re
 import zipfile
 from pathlib import Path
 
@@ -46,6 +47,16 @@ def _source_packages() -> set[str]:
 
 def test_every_package_directory_is_listed_in_setup_cfg():
     assert set(_setuptools_options()["packages"].split()) == _source_packages()
+
+
+def test_the_wheel_builds_without_a_warning(wheel_build):
+    assert not re.findall(r"\w*Warning: .*", wheel_build.output)
+
+
+def test_wheel_carries_every_module_and_data_file(wheel):
+    with zipfile.ZipFile(wheel) as archive:
+        names = set(archive.namelist())
+    assert _source_files() - names == set()
 
 
 def test_wheel_carries_the_default_scenario_plugins_and_entry_points(wheel):
