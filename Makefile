@@ -13,8 +13,10 @@ $(STAMP): pyproject.toml setup.cfg
 	$(BIN)/python -m pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
+# One pytest-xdist worker per core; tests marked with one xdist_group share a worker
+# (and the set-up they share). `.venv/bin/pytest` alone runs the suite in one process.
 test: $(STAMP)
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n auto --dist loadgroup
 
 run: $(STAMP)
 	$(BIN)/dcsim run
