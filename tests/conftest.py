@@ -1,4 +1,9 @@
-"""Shared fixtures: running the real console script and installing throw-away plugins."""
+"""Shared fixtures: the console script, throw-away plugins, the default run, the wheel.
+
+A set-up shared by tests of several modules is made once per pytest-xdist worker; the
+tests that read it carry its ``xdist_group`` mark so that ``--dist loadgroup`` runs
+them in one worker, which makes it once in all.
+"""
 
 from __future__ import annotations
 
@@ -13,8 +18,15 @@ from pathlib import Path
 
 import pytest
 
+from dcsim.registry import PluginRegistry
+from dcsim.runner import Runner
+from dcsim.runsetup import prepare_run
+
 REPO = Path(__file__).resolve().parents[1]
 DCSIM = Path(sys.executable).with_name("dcsim")
+
+SHARES_DEFAULT_RUN = pytest.mark.xdist_group("default-run")
+SHARES_WHEEL = pytest.mark.xdist_group("wheel")
 
 
 @dataclass
@@ -47,6 +59,17 @@ def dcsim_cli(tmp_path):
         return CliResult(done.returncode, done.stdout, done.stderr)
 
     return run
+
+
+@pytest.fixture(scope="session")
+def default_run(tmp_path_factory) -> tuple[Runner, dict, Path]:
+    """The default scenario flown to its end: the runner, the summary, the run directory.
+
+    Tests that read it are marked ``SHARES_DEFAULT_RUN``.
+    """
+    out = tmp_path_factory.mktemp("default")
+    runner = Runner(prepare_run(None, registry=PluginRegistry.discover()), out)
+    return runner, runner.run(), out
 
 
 def make_distribution(
@@ -146,8 +169,9 @@ class WheelBuild:
 def wheel_build(tmp_path_factory) -> WheelBuild:
     """dcsim built as a wheel from a copy of this checkout.
 
-    Built from a copy so that no build directory is shared with another test process
-    or left in the checkout.
+    Tests that read it, or ``fresh_env``, are marked ``SHARES_WHEEL``. Built from a
+    copy so that no build directory is shared with another test process or left in the
+    checkout.
     """
     source = tmp_path_factory.mktemp("source") / "dcsim"
     shutil.copytree(REPO, source, ignore=NOT_SOURCES)
