@@ -7,7 +7,7 @@ import re
 import zipfile
 from pathlib import Path
 
-from tests.conftest import REPO
+from tests.conftest import REPO, SHARES_WHEEL
 
 
 def _setuptools_options() -> configparser.SectionProxy:
@@ -49,16 +49,19 @@ def test_every_package_directory_is_listed_in_setup_cfg():
     assert set(_setuptools_options()["packages"].split()) == _source_packages()
 
 
+@SHARES_WHEEL
 def test_the_wheel_builds_without_a_warning(wheel_build):
     assert not re.findall(r"\w*Warning: .*", wheel_build.output)
 
 
+@SHARES_WHEEL
 def test_wheel_carries_every_module_and_data_file(wheel):
     with zipfile.ZipFile(wheel) as archive:
         names = set(archive.namelist())
     assert _source_files() - names == set()
 
 
+@SHARES_WHEEL
 def test_wheel_carries_the_default_scenario_plugins_and_entry_points(wheel):
     with zipfile.ZipFile(wheel) as archive:
         names = set(archive.namelist())
@@ -71,6 +74,7 @@ def test_wheel_carries_the_default_scenario_plugins_and_entry_points(wheel):
     assert "pd = dcsim_plugins.pd" in entry_points and "dcsim = dcsim.cli:main" in entry_points
 
 
+@SHARES_WHEEL
 def test_wheel_installs_into_a_fresh_environment_and_runs(fresh_env, tmp_path):
     run = fresh_env.run("dcsim", "run", "--out", "out", "--set", "world.duration=5", cwd=tmp_path)
     assert run.returncode == 0, run.stderr
