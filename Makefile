@@ -7,14 +7,16 @@ STAMP := $(VENV)/.installed
 
 .PHONY: test run docs clean
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml setup.cfg
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
+# One pytest-xdist worker per core; tests marked with one xdist_group share a worker
+# (and the set-up they share). `.venv/bin/pytest` alone runs the suite in one process.
 test: $(STAMP)
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n auto --dist loadgroup
 
 run: $(STAMP)
 	$(BIN)/dcsim run

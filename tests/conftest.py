@@ -1,8 +1,14 @@
-"""Shared fixtures: running the real console script and installing throw-away plugins."""
+"""Shared fixtures: the console script, throw-away plugins, the default run, the wheel.
+
+A set-up shared by tests of several modules is made once per pytest-xdist worker; the
+tests that read it carry its ``xdist_group`` mark so that ``--dist loadgroup`` runs
+them in one worker, which makes it once in all.
+"""
 
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 import textwrap
@@ -12,8 +18,15 @@ from pathlib import Path
 
 import pytest
 
+from dcsim.registry import PluginRegistry
+from dcsim.runner import Runner
+from dcsim.runsetup import prepare_run
+
 REPO = Path(__file__).resolve().parents[1]
 DCSIM = Path(sys.executable).with_name("dcsim")
+
+SHARES_DEFAULT_RUN = pytest.mark.xdist_group("default-run")
+SHARES_WHEEL = pytest.mark.xdist_group("wheel")
 
 
 @dataclass
@@ -46,6 +59,17 @@ def dcsim_cli(tmp_path):
         return CliResult(done.returncode, done.stdout, done.stderr)
 
     return run
+
+
+@pytest.fixture(scope="session")
+def default_run(tmp_path_factory) -> tuple[Runner, dict, Path]:
+    """The default scenario flown to its end: the runner, the summary, the run directory.
+
+    Tests that read it are marked ``SHARES_DEFAULT_RUN``.
+    """
+    out = tmp_path_factory.mktemp("default")
+    runner = Runner(prepare_run(None, registry=PluginRegistry.discover()), out)
+    return runner, runner.run(), out
 
 
 def make_distribution(
@@ -127,17 +151,45 @@ class FreshEnvironment:
         )
 
 
+# What a checkout holds besides its sources: left out of the copy a wheel is built from.
+NOT_SOURCES = shutil.ignore_patterns(
+    ".git", ".venv", "build", "dist", "*.egg-info", "__pycache__", "runs", ".*_cache", "*.fmu"
+)
+
+
+@dataclass
+class WheelBuild:
+    """A wheel built by pip, and what pip and the build backend printed."""
+
+    path: Path
+    output: str
+
+
 @pytest.fixture(scope="session")
-def wheel(tmp_path_factory) -> Path:
-    """dcsim built as a wheel from this checkout."""
+def wheel_build(tmp_path_factory) -> WheelBuild:
+    """dcsim built as a wheel from a copy of this checkout.
+
+    Tests that read it, or ``fresh_env``, are marked ``SHARES_WHEEL``. Built from a
+    copy so that no build directory is shared with another test process or left in the
+    checkout.
+    """
+    source = tmp_path_factory.mktemp("source") / "dcsim"
+    shutil.copytree(REPO, source, ignore=NOT_SOURCES)
     out = tmp_path_factory.mktemp("wheel")
-    subprocess.run(
-        [sys.executable, "-m", "pip", "wheel", "--quiet", "--no-deps", "-w", str(out), str(REPO)],
-        check=True,
+    done = subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "--quiet", "--no-deps", "-w", str(out), str(source)],
         capture_output=True,
+        text=True,
         timeout=300,
     )
-    return next(out.glob("dcsim-*.whl"))
+    assert done.returncode == 0, done.stderr
+    return WheelBuild(next(out.glob("dcsim-*.whl")), done.stdout + done.stderr)
+
+
+@pytest.fixture(scope="session")
+def wheel(wheel_build) -> Path:
+    """dcsim built as a wheel from this checkout."""
+    return wheel_build.path
 
 
 @pytest.fixture(scope="session")

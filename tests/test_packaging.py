@@ -2,27 +2,66 @@
 
 from __future__ import annotations
 
-import tomllib
+import configparser
+import re
 import zipfile
+from pathlib import Path
 
-from tests.conftest import REPO
+from tests.conftest import REPO, SHARES_WHEEL
+
+
+def _setuptools_options() -> configparser.SectionProxy:
+    config = configparser.ConfigParser()
+    config.read(REPO / "setup.cfg")
+    return config["options"]
+
+
+def _package_dirs() -> dict[str, Path]:
+    """Each top-level package's source directory, from setup.cfg's package_dir."""
+    pairs = [line.split("=") for line in _setuptools_options()["package_dir"].split("\n") if line]
+    return {name.strip(): REPO / directory.strip() for name, directory in pairs}
+
+
+def _source_files() -> set[str]:
+    """Every file under the package directories, as its path inside an installation."""
+    return {
+        "/".join([name, *path.relative_to(directory).parts])
+        for name, directory in _package_dirs().items()
+        for path in directory.rglob("*")
+        if path.is_file() and "__pycache__" not in path.parts
+    }
 
 
 def _source_packages() -> set[str]:
-    config = tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["setuptools"]
+    """Every directory holding files under the package directories.
+
+    Python imports each of them, a directory of data files as a namespace package, and
+    setuptools warns about any left out of ``packages``.
+    """
     found = set()
-    for name, directory in config["package-dir"].items():
-        for init in (REPO / directory).rglob("__init__.py"):
-            relative = init.parent.relative_to(REPO / directory)
-            found.add(".".join([name, *relative.parts]))
+    for installed in _source_files():
+        parts = installed.split("/")[:-1]
+        found.update(".".join(parts[:n]) for n in range(1, len(parts) + 1))
     return found
 
 
-def test_every_package_directory_is_listed_in_pyproject():
-    config = tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["setuptools"]
-    assert set(config["packages"]) == _source_packages()
+def test_every_package_directory_is_listed_in_setup_cfg():
+    assert set(_setuptools_options()["packages"].split()) == _source_packages()
 
 
+@SHARES_WHEEL
+def test_the_wheel_builds_without_a_warning(wheel_build):
+    assert not re.findall(r"\w*Warning: .*", wheel_build.output)
+
+
+@SHARES_WHEEL
+def test_wheel_carries_every_module_and_data_file(wheel):
+    with zipfile.ZipFile(wheel) as archive:
+        names = set(archive.namelist())
+    assert _source_files() - names == set()
+
+
+@SHARES_WHEEL
 def test_wheel_carries_the_default_scenario_plugins_and_entry_points(wheel):
     with zipfile.ZipFile(wheel) as archive:
         names = set(archive.namelist())
@@ -38,6 +77,7 @@ def test_wheel_carries_the_default_scenario_plugins_and_entry_points(wheel):
     )
 
 
+@SHARES_WHEEL
 def test_wheel_installs_into_a_fresh_environment_and_runs(fresh_env, tmp_path):
     run = fresh_env.run("dcsim", "run", "--out", "out", "--set", "world.duration=5", cwd=tmp_path)
     assert run.returncode == 0, run.stderr

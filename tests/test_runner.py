@@ -18,7 +18,7 @@ from dcsim.api import Command, Controller, PluginParams, PluginRegistry, hookimp
 from dcsim.registry import PluginOrigin
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
-from tests.conftest import DCSIM, REPO
+from tests.conftest import DCSIM, REPO, SHARES_DEFAULT_RUN
 
 TEST_ORIGIN = PluginOrigin("tests", "0", "tests")
 
@@ -95,13 +95,7 @@ def modes(events):
     return [(e["previous"], e["mode"]) for e in events if e["event"] == "mode"]
 
 
-@pytest.fixture(scope="module")
-def default_run(tmp_path_factory):
-    out = tmp_path_factory.mktemp("default")
-    runner, summary = run(out=out)
-    return runner, summary, out
-
-
+@SHARES_DEFAULT_RUN
 def test_default_run_delivers_every_target_without_collision(default_run):
     _, summary, out = default_run
     assert summary["status"] == "completed" and summary["reason"] == "all targets delivered"
@@ -115,6 +109,7 @@ def test_default_run_delivers_every_target_without_collision(default_run):
     assert (out / "plots" / "timeline.png").stat().st_size > 10_000
 
 
+@SHARES_DEFAULT_RUN
 def test_default_run_follows_the_executer_state_machine(default_run):
     runner, _, _ = default_run
     events = runner.recorder.events
@@ -135,6 +130,7 @@ def test_default_run_follows_the_executer_state_machine(default_run):
         assert all(t > plan["t"] for t in times) and np.all(np.diff(times) > 0)
 
 
+@SHARES_DEFAULT_RUN
 def test_every_delivery_is_flown_on_a_planned_path_timed_by_the_plan(default_run):
     _, _, out = default_run
     events = [json.loads(line) for line in (out / "events.jsonl").read_text().splitlines()]

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import pytest
 from fmpy import simulate_fmu
@@ -18,22 +20,24 @@ from dcsim.scenario import load_scenario
 from dcsim.scenario.model import point_to_cartesian
 from dcsim.seeding import component_rng
 from dcsim.world import World, WorldInputs
+from tests.conftest import SHARES_DEFAULT_RUN
 
 PERIOD = 0.1  # s, the default scenario's control period
 VECTORS = {"position": "x y z", "velocity": "vx vy vz", "attitude": "qx qy qz qw"}
 
 
-def native(seed: int = 0, duration: float | None = None) -> dict[str, np.ndarray]:
-    """Telemetry of `dcsim run` on the default scenario."""
-    overrides = [] if duration is None else [f"world.duration={duration}"]
-    runner = Runner(prepare_run(None, overrides, seed))
+def native(seed: int, duration: float) -> dict[str, np.ndarray]:
+    """Telemetry of `dcsim run` on the default scenario, cut to ``duration`` seconds."""
+    runner = Runner(prepare_run(None, [f"world.duration={duration}"], seed))
     runner.run()
     return runner.recorder.telemetry()
 
 
 @pytest.fixture(scope="module")
-def native_run():
-    return native()
+def native_run(default_run):
+    """Telemetry of `dcsim run` on the default scenario."""
+    runner, _, _ = default_run
+    return runner.recorder.telemetry()
 
 
 def fmu_row(fmu: FmuInstance) -> dict[str, float]:
@@ -70,6 +74,33 @@ def open_closed_loop(path, name="a", **start) -> FmuInstance:
     return fmu
 
 
+@dataclass
+class Flight:
+    """The closed-loop FMU flown over the default run's ticks, then 50 periods more."""
+
+    rows: list[dict[str, float]]  # the outputs at each tick of the run
+    status: dict[str, int]  # the run's status variables at its last tick
+    after: dict[str, float]  # outputs 50 periods after the last tick
+
+
+@pytest.fixture(scope="module")
+def flight(closed_loop_fmu, native_run) -> Flight:
+    """One flight shared by the tests of the run and of what comes after it."""
+    fmu = open_closed_loop(closed_loop_fmu)
+    ticks = len(native_run["time"])
+    rows = [fmu_row(fmu)]
+    for i in range(1, ticks):
+        fmu.step((i - 1) * PERIOD, PERIOD)
+        rows.append(fmu_row(fmu))
+    status = fmu.get(["run_status", "delivered", "captured", "collisions"])
+    for i in range(ticks - 1, ticks + 50):
+        fmu.step(i * PERIOD, PERIOD)
+    after = fmu.get(["run_status", "delta_v", "position.x", "velocity.x"])
+    fmu.terminate()
+    fmu.close()
+    return Flight(rows, status, after)
+
+
 # ----------------------------------------------------------------- validity
 
 
@@ -99,6 +130,7 @@ def test_docs_list_the_variables():
     assert block(text, r.BEGIN_PLANT, r.END_PLANT) == plant, stale
 
 
+@SHARES_DEFAULT_RUN
 def test_simulate_fmu_runs_both_variants(closed_loop_fmu, plant_fmu, native_run):
     closed = simulate_fmu(str(closed_loop_fmu), stop_time=20.0, step_size=PERIOD)
     assert closed["time"][-1] == pytest.approx(20.0)
@@ -113,29 +145,19 @@ def test_simulate_fmu_runs_both_variants(closed_loop_fmu, plant_fmu, native_run)
 # ----------------------------------------------------------------- equality with dcsim run
 
 
-def test_closed_loop_reproduces_dcsim_run_tick_by_tick(closed_loop_fmu, native_run):
-    fmu = open_closed_loop(closed_loop_fmu)
-    rows = len(native_run["time"])
-    for i in range(rows):
-        if i:
-            fmu.step((i - 1) * PERIOD, PERIOD)
-        assert_rows_equal(fmu_row(fmu), telemetry_row(native_run, i), f"row {i}")
-    status = fmu.get(["run_status", "delivered", "captured", "collisions"])
-    assert status == {"run_status": 1, "delivered": 4, "captured": 4, "collisions": 0}
-    fmu.terminate()
-    fmu.close()
+@SHARES_DEFAULT_RUN
+def test_closed_loop_reproduces_dcsim_run_tick_by_tick(flight, native_run):
+    for i, row in enumerate(flight.rows):
+        assert_rows_equal(row, telemetry_row(native_run, i), f"row {i}")
+    assert flight.status == {"run_status": 1, "delivered": 4, "captured": 4, "collisions": 0}
 
 
-def test_after_the_run_ends_the_world_coasts(closed_loop_fmu, native_run):
-    fmu = open_closed_loop(closed_loop_fmu)
-    rows = len(native_run["time"])
-    for i in range(rows + 50):
-        fmu.step(i * PERIOD, PERIOD)
-    after = fmu.get(["run_status", "delta_v", "position.x", "velocity.x"])
+@SHARES_DEFAULT_RUN
+def test_after_the_run_ends_the_world_coasts(flight, native_run):
+    after = flight.after
     assert after["run_status"] == 1
     assert after["delta_v"] == pytest.approx(native_run["delta_v"][-1], abs=1e-12)  # no thrust
     assert after["position.x"] != native_run["x"][-1]  # but it drifts on
-    fmu.close()
 
 
 # ----------------------------------------------------------------- instances, reset, inputs
@@ -187,6 +209,7 @@ def test_non_finite_input_gets_an_error_status_and_a_message(closed_loop_fmu, ba
     fmu.close()
 
 
+@SHARES_DEFAULT_RUN
 def test_step_not_a_multiple_of_the_period_holds_the_last_boundary(closed_loop_fmu, native_run):
     fmu = open_closed_loop(closed_loop_fmu)
     for k in range(1, 9):  # communication points 0.25, 0.5, ... 2.0 s

@@ -12,11 +12,12 @@ from dcsim.registry import PluginRegistry
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
 from dcsim.testing import checks_for
+from tests.conftest import SHARES_DEFAULT_RUN
 
 TOLERANCE = 1e-9  # m, m/s: the FMU computes pd's gains in closed form, pd with acker
 
 
-def fly(overrides=()):
+def fly(overrides):
     runner = Runner(prepare_run(None, overrides, registry=PluginRegistry.discover()))
     return runner.run(), runner.recorder.telemetry()
 
@@ -45,8 +46,10 @@ def test_keeps_the_controller_contracts(example_controller, check):
     check.run(example_controller)
 
 
-def test_example_pd_fmu_flies_the_default_mission_like_pd(pd_fmu):
-    pd_summary, pd_run = fly()
+@SHARES_DEFAULT_RUN
+def test_example_pd_fmu_flies_the_default_mission_like_pd(pd_fmu, default_run):
+    runner, pd_summary, _ = default_run
+    pd_run = runner.recorder.telemetry()
     fmu_summary, fmu_run = fly(with_fmu(pd_fmu))
     assert fmu_summary["status"] == "completed"
     assert fmu_summary["delivered"] == pd_summary["delivered"] == 4

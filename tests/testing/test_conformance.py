@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 import subprocess
 import sys
 import time
@@ -15,7 +16,7 @@ from dcsim_plugins.path_planners.straight_line import StraightLinePlanner
 from dcsim_plugins.task_planners.nearest import NearestTaskPlanner
 
 from dcsim.api import Command, GoalRegion, PluginRegistry, ShapeKind
-from dcsim.testing import ControllerContract, check_plugin, checks_for
+from dcsim.testing import CheckResult, ControllerContract, check_plugin, checks_for
 from tests.testing.peeking_plugin import PeekingController
 
 # `fmu` needs an FMU to exist at all; tests/fmu/test_fmu_controller.py runs these checks
@@ -168,13 +169,24 @@ class SlowPathPlanner(StraightLinePlanner):
         return super().plan(problem)
 
 
+# SlowPlanner's checks sleep through its budgets for some 15 s: the tests reading them
+# share one pass, in one pytest-xdist worker.
+SHARES_SLOW_CHECKS = pytest.mark.xdist_group("slow-planner-checks")
+
+
+@functools.cache
+def results_of(plugin: type) -> dict[str, CheckResult]:
+    """Every check's result on ``plugin``, by check name (one pass per test process)."""
+    return {r.check: r for r in check_plugin(plugin)}
+
+
 @pytest.mark.parametrize(
     "plugin, failing",
     [
         (MutatingLocaliser, {"does_not_mutate_inputs"}),
         (NondeterministicPlanner, {"deterministic"}),
         (OverreachingController, {"commands_within_limits"}),
-        (SlowPlanner, {"honours_time_budget"}),
+        pytest.param(SlowPlanner, {"honours_time_budget"}, marks=SHARES_SLOW_CHECKS),
         (FragilePathPlanner, {"handles_empty_inputs"}),
         (LostLocaliser, {"converges"}),
         (CarelessPathPlanner, {"answers_no_path"}),
@@ -189,7 +201,7 @@ class SlowPathPlanner(StraightLinePlanner):
     ids=lambda value: getattr(value, "name", None) or "-".join(sorted(value)),
 )
 def test_broken_plugins_are_reported_by_the_right_check(plugin, failing):
-    results = {r.check: r for r in check_plugin(plugin)}
+    results = results_of(plugin)
     failed = {name for name, r in results.items() if not r.passed}
     assert failing <= failed, results
     for name in failing:
@@ -197,11 +209,12 @@ def test_broken_plugins_are_reported_by_the_right_check(plugin, failing):
         assert f"plugin '{plugin.name}' breaks '{name}'" in message and "contract: " in message
 
 
+@SHARES_SLOW_CHECKS
 def test_messages_say_what_the_plugin_did():
-    results = {r.check: r for r in check_plugin(OverreachingController)}
+    results = results_of(OverreachingController)
     assert "asks 10.000 N" in results["commands_within_limits"].message
     assert "the limits are 5.0 N" in results["commands_within_limits"].message
-    slow = {r.check: r for r in check_plugin(SlowPlanner)}["honours_time_budget"].message
+    slow = results_of(SlowPlanner)["honours_time_budget"].message
     assert "with a budget of 0.3 s" in slow
 
 

@@ -5,9 +5,11 @@ from __future__ import annotations
 import json
 
 from dcsim.testing import checks_for
-from tests.conftest import REPO
+from tests.conftest import REPO, SHARES_WHEEL
 
 EXAMPLE = REPO / "docs" / "examples" / "dcsim-lqr"
+
+pytestmark = SHARES_WHEEL
 
 
 def test_example_plugin_installs_lists_flies_and_conforms(fresh_env, tmp_path):
