@@ -191,9 +191,10 @@ def plot(result: SoakResult, path: Path) -> None:
 
     ticks = np.array([s.tick for s in result.samples])
     figure, (memory, speed) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
-    memory.plot(ticks, [s.resident_bytes / 2**20 for s in result.samples], color="tab:blue")
+    resident = [s.resident_bytes / 2**20 for s in result.samples]
+    memory.plot(ticks, resident, color="tab:blue")
     memory.set_ylabel("resident memory [MB]")
-    memory.set_ylim(bottom=0)
+    memory.set_ylim(0, 1.2 * max(resident))
     speed.plot(ticks, [1e6 * s.tick_seconds for s in result.samples], color="tab:orange")
     speed.set_ylabel("time per tick [µs]")
     speed.set_ylim(bottom=0)
