@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shutil
 
 from dcsim.testing import checks_for
 from tests.conftest import REPO, SHARES_WHEEL
@@ -13,8 +14,10 @@ pytestmark = SHARES_WHEEL
 
 
 def test_example_plugin_installs_lists_flies_and_conforms(fresh_env, tmp_path):
+    # A copy, so that building it leaves no build/ or egg-info in the checkout.
+    example = shutil.copytree(EXAMPLE, tmp_path / "dcsim-lqr")
     installed = fresh_env.run(
-        "python", "-m", "pip", "install", "--quiet", str(EXAMPLE), cwd=tmp_path
+        "python", "-m", "pip", "install", "--quiet", str(example), cwd=tmp_path
     )
     assert installed.returncode == 0, installed.stderr
     listing = json.loads(fresh_env.run("dcsim", "plugins", "--json", cwd=tmp_path).stdout)
