@@ -128,6 +128,10 @@ def test_an_estimate_is_a_robot_state_with_covariance():
     assert isinstance(estimate, RobotState)
     np.testing.assert_array_equal(estimate.covariance, np.eye(6))
     np.testing.assert_array_equal(estimate.attitude, [0, 0, 0, 1])
+    state = estimate.as_state(5.0)
+    assert type(state) is RobotState and state.time == 5.0
+    np.testing.assert_array_equal(state.position, [1, 0, 0])
+    assert estimate.as_state().time == 2.0
 
 
 def test_reference_attitude_is_optional_and_command_carries_joint_torques():

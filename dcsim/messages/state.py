@@ -88,6 +88,18 @@ class StateEstimate(RobotState):
         if rows != columns:
             raise ValueError(f"StateEstimate.covariance must be square, got {rows}×{columns}")
 
+    def as_state(self, time: float | None = None) -> RobotState:
+        """The estimated state alone, at ``time`` (s) if given, else at the estimate's time."""
+        return RobotState(
+            self.time if time is None else time,
+            self.position,
+            self.attitude,
+            self.velocity,
+            self.angular_velocity,
+            self.joint_positions,
+            self.joint_velocities,
+        )
+
 
 @message
 class Prior(Message):

@@ -27,8 +27,6 @@ from dcsim.geometry import unit
 from dcsim.interfaces import Plugin
 from dcsim.messages import (
     DropVisit,
-    FrameDynamics,
-    FrameKind,
     GoalRegion,
     NoPath,
     ObjectKind,
@@ -38,7 +36,6 @@ from dcsim.messages import (
     Plan,
     PlanTask,
     Reference,
-    RobotState,
     StateEstimate,
     TaskRequest,
     Trajectory,
@@ -195,12 +192,6 @@ class DebrisMission(Mission):
             self.settings.acceleration_fraction * self.robot.max_force / self.world.assembly_mass()
         )
 
-    def _frame(self) -> FrameDynamics:
-        """The free dynamics of the world's frame, for the path planner."""
-        if self.scenario.world.frame == "lvlh":
-            return FrameDynamics(FrameKind.CLOHESSY_WILTSHIRE, self.scenario.mean_motion)
-        return FrameDynamics(FrameKind.INERTIAL)
-
     def _holding(self) -> Reference:
         if self.hold is None:
             self.hold = np.array(self.estimate.position)
@@ -211,18 +202,11 @@ class DebrisMission(Mission):
 
     def _plan_path(self, goal: GoalRegion, max_speed: float | None = None) -> Trajectory | None:
         """Ask the path planner for a way to ``goal`` at up to ``max_speed`` (the robot's)."""
-        estimate = self.estimate
         problem = PathProblem(
-            start=RobotState(
-                self.time,
-                estimate.position,
-                estimate.attitude,
-                estimate.velocity,
-                estimate.angular_velocity,
-            ),
+            start=self.estimate.as_state(self.time),
             goal=goal,
             obstacles=self._obstacles(),
-            frame=self._frame(),
+            frame=self.scenario.frame_dynamics,
             robot_radius=self.world.robot_spec().radius,
             max_speed=self.robot.max_speed if max_speed is None else max_speed,
             max_acceleration=self._max_acceleration(),

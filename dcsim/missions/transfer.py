@@ -32,8 +32,6 @@ from dcsim.interfaces import Plugin
 from dcsim.messages import (
     Bounds,
     CostWeights,
-    FrameDynamics,
-    FrameKind,
     NoPath,
     ObjectTrack,
     Observations,
@@ -111,7 +109,7 @@ class TransferMission(Mission):
 
     def tick(self, time: float, estimate: StateEstimate, observations: Observations) -> Reference:
         """Plan when needed, follow the trajectory, and check arrival."""
-        state = _state_of(estimate)
+        state = estimate.as_state()
         if self.goal.contains(state):
             if self.reached_at is None:
                 self.reached_at = time
@@ -321,7 +319,7 @@ def transfer_problem(
         start=start,
         goal=settings.goal.build(),
         obstacles=obstacles,
-        frame=_frame(scenario),
+        frame=scenario.frame_dynamics,
         robot_radius=robot.radius,
         max_speed=robot.max_speed,
         max_acceleration=settings.acceleration_fraction * robot.max_force / robot.mass,
@@ -332,12 +330,6 @@ def transfer_problem(
         weights=CostWeights(weights.delta_v, weights.length, weights.time),
         time_budget=settings.planning_budget,
     )
-
-
-def _frame(scenario: Scenario) -> FrameDynamics:
-    if scenario.world.frame == "lvlh":
-        return FrameDynamics(FrameKind.CLOHESSY_WILTSHIRE, scenario.mean_motion)
-    return FrameDynamics(FrameKind.INERTIAL)
 
 
 def trajectory_csv(trajectory: Trajectory) -> str:
@@ -373,16 +365,3 @@ def _padded(values: np.ndarray | None, rows: int) -> np.ndarray:
     if values is not None:
         padded[:-1] = values
     return padded
-
-
-def _state_of(estimate: StateEstimate) -> RobotState:
-    """The estimate as a plain robot state."""
-    return RobotState(
-        estimate.time,
-        estimate.position,
-        estimate.attitude,
-        estimate.velocity,
-        estimate.angular_velocity,
-        estimate.joint_positions,
-        estimate.joint_velocities,
-    )

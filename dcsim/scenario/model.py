@@ -23,7 +23,7 @@ from pydantic import (
 )
 
 from dcsim.geometry import Vector, spherical_to_cartesian
-from dcsim.messages.planning import GoalRegion
+from dcsim.messages.planning import FrameDynamics, FrameKind, GoalRegion
 from dcsim.messages.sensing import Shape, ShapeKind
 from dcsim.motion import (
     STANDARD_GRAVITATIONAL_PARAMETER_EARTH,
@@ -652,6 +652,13 @@ class Scenario(Section):
     def mean_motion(self) -> float:
         """Mean motion of the reference orbit, rad/s (used by ``cw`` motions)."""
         return self.world.orbit.mean_motion
+
+    @property
+    def frame_dynamics(self) -> FrameDynamics:
+        """The free dynamics of the world's frame, as path planners are told them."""
+        if self.world.frame == "lvlh":
+            return FrameDynamics(FrameKind.CLOHESSY_WILTSHIRE, self.mean_motion)
+        return FrameDynamics(FrameKind.INERTIAL)
 
 
 @functools.cache
