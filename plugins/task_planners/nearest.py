@@ -8,11 +8,14 @@ cruise speed of ``speed_fraction`` of the speed limit less the target's speed (t
 profile the ``straight-line`` path planner flies). When the collector is full it first
 visits the drop point (also at its earliest reachable time). Pickup times are spaced by at least
 ``min_time_step``. Targets that cannot be reached within ``horizon`` are left out.
-The plan's cost is its impulsive delta-v (:func:`dcsim.api.plan_delta_v`).
+The plan's cost is its impulsive delta-v (:func:`dcsim.api.plan_delta_v`). Once 70 % of
+the request's time budget is spent no further pickup is added, and the plan ends at its
+last drop visit that can be reached.
 """
 
 from __future__ import annotations
 
+import time as wallclock
 from collections.abc import Callable
 
 import numpy as np
@@ -31,6 +34,10 @@ from dcsim.api import (
 )
 
 Predictor = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
+
+
+_BUDGET_SHARE = 0.7
+"""Share of the time budget after which no further pickup is added."""
 
 
 class NearestParams(PluginParams):
@@ -116,6 +123,9 @@ class NearestTaskPlanner(TaskPlanner):
         tasks: list[PlanTask] = []
         drops: list[DropVisit] = []
         committed = (0, 0)  # tasks and drops that end in a feasible drop visit
+        # Stop adding pickups once most of the budget is spent, keeping time to close the
+        # plan with its drop visit.
+        deadline = wallclock.perf_counter() + _BUDGET_SHARE * request.time_budget
 
         def search(predict: Predictor, after: float) -> float | None:
             return earliest_intercept(
@@ -142,7 +152,7 @@ class NearestTaskPlanner(TaskPlanner):
 
         if carried >= request.capacity and not visit_drop():
             return Plan()
-        while remaining:
+        while remaining and wallclock.perf_counter() < deadline:
             times = {
                 target_id: search(track.predict, t + p.min_time_step)
                 for target_id, track in remaining.items()
