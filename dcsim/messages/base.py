@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 T = TypeVar("T", bound=type)
+_NO_SHARED_DEFAULT = object()
 
 
 def array_field(
@@ -32,23 +33,32 @@ def array_field(
         If true the field may be None (its default unless ``default`` is given), meaning
         "not given"; otherwise None is rejected.
     """
-    metadata = {"shape": shape, "optional": optional}
     if default is None:
+        metadata = {"shape": shape, "optional": optional, "default": _NO_SHARED_DEFAULT}
         return field(default=None, metadata=metadata) if optional else field(metadata=metadata)
-    value = np.asarray(default, dtype=float)
-    frozen, default_shape = tuple(value.ravel()), value.shape
-    return field(default_factory=lambda: np.array(frozen).reshape(default_shape), metadata=metadata)
+    shared = np.array(default, dtype=float)
+    shared.setflags(write=False)
+    metadata = {"shape": shape, "optional": optional, "default": shared}
+    return field(default_factory=lambda: shared, metadata=metadata)
 
 
-_ARRAY_FIELDS: dict[type, tuple[tuple[str, tuple[int, ...], bool], ...]] = {}
+_ArrayField = tuple[str, tuple[int, ...], bool, bool, object]
+_ARRAY_FIELDS: dict[type, tuple[_ArrayField, ...]] = {}
 
 
-def _array_fields(cls: type) -> tuple[tuple[str, tuple[int, ...], bool], ...]:
-    """Names, shapes and optionality of a message class's array fields (cached per class)."""
+def _array_fields(cls: type) -> tuple[_ArrayField, ...]:
+    """Name, shape, optionality, whether the shape is fully fixed (no ``-1``) and the
+    shared read-only default of each array field of a message class (cached per class)."""
     found = _ARRAY_FIELDS.get(cls)
     if found is None:
         found = tuple(
-            (f.name, f.metadata["shape"], f.metadata["optional"])
+            (
+                f.name,
+                f.metadata["shape"],
+                f.metadata["optional"],
+                -1 not in f.metadata["shape"],
+                f.metadata["default"],
+            )
             for f in fields(cls)
             if "shape" in f.metadata
         )
@@ -56,18 +66,21 @@ def _array_fields(cls: type) -> tuple[tuple[str, tuple[int, ...], bool], ...]:
     return found
 
 
+def _shape_fits(shape: tuple[int, ...], wanted: tuple[int, ...]) -> bool:
+    """Whether ``shape`` is ``wanted`` where ``-1`` in ``wanted`` accepts any length."""
+    return len(shape) == len(wanted) and all(w in (-1, s) for w, s in zip(wanted, shape))
+
+
 class Message:
     """Base of every message: converts array fields and compares by value."""
 
     def __post_init__(self) -> None:
-        for name, shape, optional in _array_fields(type(self)):
+        for name, shape, optional, fixed, default in _array_fields(type(self)):
             raw = getattr(self, name)
-            if raw is None and optional:
-                continue
+            if raw is default or (raw is None and optional):
+                continue  # a default is shared, read-only and of the right shape
             value = np.array(raw, dtype=float)
-            if value.ndim != len(shape) or any(
-                want not in (-1, got) for want, got in zip(shape, value.shape, strict=True)
-            ):
+            if value.shape != shape and (fixed or not _shape_fits(value.shape, shape)):
                 raise ValueError(
                     f"{type(self).__name__}.{name} must have shape {shape}, got {value.shape}"
                 )

@@ -8,24 +8,36 @@ acceleration noise of standard deviation ``σ_a``, giving ``Q = σ_a² B Bᵀ``.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import lru_cache
 
 import numpy as np
 
 from dcsim.api import BeaconRange
 
 
+@lru_cache(maxsize=16)
 def transition(dt: float) -> tuple[np.ndarray, np.ndarray]:
-    """State transition ``F`` (6×6) and acceleration input ``B`` (6×3) over ``dt`` s."""
+    """State transition ``F`` (6×6) and acceleration input ``B`` (6×3) over ``dt`` s.
+
+    Filters ask for the same step every control period, so the read-only matrices are
+    made once per step length.
+    """
     eye = np.eye(3)
     f = np.block([[eye, dt * eye], [np.zeros((3, 3)), eye]])
     b = np.vstack([0.5 * dt**2 * eye, dt * eye])
-    return f, b
+    return _read_only(f), _read_only(b)
 
 
+@lru_cache(maxsize=16)
 def process_noise(dt: float, acceleration_sigma: float) -> np.ndarray:
-    """``Q = σ_a² B Bᵀ`` for white acceleration noise over ``dt`` s (6×6)."""
+    """``Q = σ_a² B Bᵀ`` for white acceleration noise over ``dt`` s (6×6, read-only)."""
     _, b = transition(dt)
-    return acceleration_sigma**2 * b @ b.T
+    return _read_only(acceleration_sigma**2 * b @ b.T)
+
+
+def _read_only(matrix: np.ndarray) -> np.ndarray:
+    matrix.setflags(write=False)
+    return matrix
 
 
 def beacon_arrays(ranges: Sequence[BeaconRange]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
