@@ -328,4 +328,11 @@ def _cw_state(p0: ArrayLike, v0: ArrayLike, n: ArrayLike, tau: np.ndarray) -> tu
     vx = 3 * n * s * x0 + c * u0 + 2 * s * v0
     vy = -6 * n * (1 - c) * x0 - 2 * s * u0 + (4 * c - 3) * v0
     vz = -n * s * z0 + c * w0
-    return np.stack([x, y, z], axis=-1), np.stack([vx, vy, vz], axis=-1)
+    return _columns(x, y, z), _columns(vx, vy, vz)
+
+
+def _columns(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> Vector:
+    """``x``, ``y`` and ``z`` (broadcast together) as the last axis of one array."""
+    out = np.empty(np.broadcast_shapes(np.shape(x), np.shape(y), np.shape(z)) + (3,))
+    out[..., 0], out[..., 1], out[..., 2] = x, y, z
+    return out

@@ -52,6 +52,9 @@ class SpaceObject:
         object.__setattr__(self, "radius", self.shape.bounding_radius)
 
 
+_FREE = int(ObjectStatus.FREE)
+
+
 def build_objects(scenario: Scenario) -> list[SpaceObject]:
     """The scenario's targets and obstacles as world objects (targets first)."""
     n = scenario.mean_motion
@@ -112,9 +115,9 @@ class ObjectField:
 
     def free_mask(self) -> np.ndarray:
         """Boolean mask of the objects that are free."""
-        return self.status == ObjectStatus.FREE
+        return self.status == _FREE
 
     def count(self, status: ObjectStatus, targets_only: bool = True) -> int:
         """Number of objects (targets only, by default) with ``status``."""
-        mask = self.status == status
+        mask = self.status == int(status)  # a plain int: numpy probes an enum at length
         return int(np.count_nonzero(mask & self.is_target if targets_only else mask))
