@@ -68,7 +68,9 @@ def _array_fields(cls: type) -> tuple[_ArrayField, ...]:
 
 def _shape_fits(shape: tuple[int, ...], wanted: tuple[int, ...]) -> bool:
     """Whether ``shape`` is ``wanted`` where ``-1`` in ``wanted`` accepts any length."""
-    return len(shape) == len(wanted) and all(w in (-1, s) for w, s in zip(wanted, shape))
+    if len(shape) != len(wanted):
+        return False
+    return all(w in (-1, s) for w, s in zip(wanted, shape, strict=True))
 
 
 class Message:

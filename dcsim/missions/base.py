@@ -20,7 +20,6 @@ import numpy as np
 
 from dcsim.interfaces import Plugin
 from dcsim.messages import Observations, Reference, StateEstimate, Surroundings
-from dcsim.plots import write_plots
 from dcsim.plugin_calls import call_plugin
 from dcsim.scenario.model import MissionSettings, Scenario
 
@@ -120,6 +119,8 @@ class Mission(ABC):
         modes, propellant, localisation error and obstacle gap
         (:func:`dcsim.plots.write_plots`). ``telemetry`` is thinned for plotting.
         """
+        from dcsim.plots import write_plots  # on use: it loads matplotlib
+
         return write_plots(
             out_dir, self.scenario, telemetry, events, self.modes, self.safety_distance
         )

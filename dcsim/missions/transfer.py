@@ -44,7 +44,6 @@ from dcsim.messages import (
 )
 from dcsim.missions.base import Emit, Mission
 from dcsim.scenario.model import Scenario, TransferMissionSection
-from dcsim.transfer_plots import write_transfer_plots
 from dcsim.world import World
 
 _TRAJECTORY_HEADER = (
@@ -256,6 +255,8 @@ class TransferMission(Mission):
         written before the plots), and a timeline marked with the events' mode changes
         and planner answers.
         """
+        from dcsim.transfer_plots import write_transfer_plots  # on use: it loads matplotlib
+
         return write_transfer_plots(
             out_dir, self.scenario, telemetry, events, self.modes, self.safety_distance
         )

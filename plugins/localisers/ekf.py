@@ -12,7 +12,7 @@ deviation is below ``convergence_sigma``.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from dcsim_plugins.localisers.range_models import (
@@ -23,7 +23,6 @@ from dcsim_plugins.localisers.range_models import (
     range_jacobian,
     transition,
 )
-from filterpy.kalman import ExtendedKalmanFilter
 
 from dcsim.api import (
     BeaconRange,
@@ -35,6 +34,9 @@ from dcsim.api import (
     hookimpl,
     quantity,
 )
+
+if TYPE_CHECKING:
+    from filterpy.kalman import ExtendedKalmanFilter
 
 
 class EKFParams(PluginParams):
@@ -88,6 +90,8 @@ class EKFLocaliser(Localiser):
         self._correct(beacons, measured, variances)
 
     def _new_filter(self) -> ExtendedKalmanFilter:
+        from filterpy.kalman import ExtendedKalmanFilter  # imported on use: it loads scipy.stats
+
         return ExtendedKalmanFilter(dim_x=6, dim_z=1, dim_u=3)
 
     def _correct(self, beacons: np.ndarray, measured: np.ndarray, variances: np.ndarray) -> None:

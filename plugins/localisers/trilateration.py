@@ -14,7 +14,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from dcsim.api import (
     BeaconRange,
@@ -98,6 +97,8 @@ class TrilaterationLocaliser(Localiser):
         beacons = np.array([r.beacon_position for r in ranges])
         measured = np.array([r.range for r in ranges])
         sigma = max(max(r.sigma for r in ranges), 1e-6)
+        from scipy.optimize import least_squares  # imported on use: it is slow to load
+
         fit = least_squares(
             lambda p: np.linalg.norm(beacons - p, axis=1) - measured,
             self._position,

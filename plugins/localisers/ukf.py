@@ -7,6 +7,8 @@ linearised.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from dcsim_plugins.localisers.ekf import EKFLocaliser, EKFParams
 from dcsim_plugins.localisers.range_models import (
@@ -14,13 +16,15 @@ from dcsim_plugins.localisers.range_models import (
     process_noise,
     transition,
 )
-from filterpy.kalman import MerweScaledSigmaPoints, UnscentedKalmanFilter
 
 from dcsim.api import (
     MotionInput,
     hookimpl,
     quantity,
 )
+
+if TYPE_CHECKING:
+    from filterpy.kalman import UnscentedKalmanFilter
 
 
 class UKFParams(EKFParams):
@@ -43,6 +47,8 @@ class UKFLocaliser(EKFLocaliser):
     params: UKFParams
 
     def _new_filter(self) -> UnscentedKalmanFilter:
+        from filterpy.kalman import MerweScaledSigmaPoints, UnscentedKalmanFilter  # on use
+
         points = MerweScaledSigmaPoints(6, alpha=self.params.alpha, beta=2.0, kappa=0.0)
         return UnscentedKalmanFilter(6, 1, 1.0, hx=None, fx=_propagate, points=points)
 

@@ -108,7 +108,7 @@ def test_static_optimum_equals_exhaustive_search_with_scanned_leg_times():
 def test_grid_optimum_equals_exhaustive_search_over_the_grid():
     rng = np.random.default_rng(1)
     request = make_request(rng.uniform(-4, 4, (3, 3)), rng.normal(0, 0.02, (3, 3)), accel=0.1)
-    step, horizon = 10.0, 150.0
+    step, horizon = 12.5, 150.0
     grid = step * np.arange(1, int(horizon / step) + 1)
     best = np.inf
     for order in itertools.permutations(range(3)):
