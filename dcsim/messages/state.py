@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from dcsim.geometry import Vector
+from dcsim.geometry import Vector, length
 from dcsim.messages.base import Message, array_field, message
 
 _UNIT_TOLERANCE = 1e-6
@@ -49,7 +49,7 @@ class RobotState(Message):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        norm = float(np.linalg.norm(self.attitude))
+        norm = length(self.attitude)
         if abs(norm - 1.0) > _UNIT_TOLERANCE:
             raise ValueError(
                 f"{type(self).__name__}.attitude must be a unit quaternion, its norm is {norm:g}"

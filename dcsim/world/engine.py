@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from dcsim.geometry import clip_norm
+from dcsim.geometry import clip_norm, length
 from dcsim.messages import BeaconRange, DropPoint, MotionInput, ObjectTrack, Observations, RobotSpec
 from dcsim.scenario.model import Scenario
 from dcsim.world.bodies import ObjectBodies, create_collector, surface_gap
@@ -413,14 +413,12 @@ class World:
         period = self.control_period
         position, velocity, _, _ = self.collector_state()
         spheres = self._assembly_spheres()
-        reach = max(np.linalg.norm(c - position) + r for c, r in spheres)
-        push = np.linalg.norm(force) + np.linalg.norm(self.inputs.disturbance_force)
+        reach = max(length(c - position) + r for c, r in spheres)
+        push = length(force) + length(self.inputs.disturbance_force)
         accel = push / self._period_mass
         if self._mean_motion is not None:
-            accel += 2 * float(
-                np.linalg.norm(cw_acceleration(self._mean_motion, position, velocity))
-            )
-        sweep = np.linalg.norm(velocity) * period + accel * period**2
+            accel += 2 * length(cw_acceleration(self._mean_motion, position, velocity))
+        sweep = length(velocity) * period + accel * period**2
         now = self.field.free_states(self.time)[0][free]
         later = self.field.free_states((self._steps + self.steps_per_control) * self.physics_step)[
             0

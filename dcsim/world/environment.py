@@ -13,6 +13,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from dcsim.geometry import length
 from dcsim.world.pybullet_client import pb
 
 STANDARD_GRAVITY = 9.80665
@@ -115,7 +116,7 @@ class Propellant:
             The thrust (N, world frame) of each physics step of the period.
         """
         steps, dt = self._steps, self._dt
-        magnitude = float(np.linalg.norm(force))
+        magnitude = length(force)
         per_step = magnitude * dt / (self._specific_impulse * STANDARD_GRAVITY)
         fractions = np.zeros(steps)
         if per_step > 0:
