@@ -5,9 +5,10 @@ Not a plugin itself. Its pieces:
 :class:`ObstacleField`
     Is a robot sphere at a point and time clear of every obstacle's true shape? A
     vectorised bounding-sphere test over all obstacles first, then the exact distance
-    (``dcsim.api.surface_distance``) for the few boxes and cylinders whose bounding
-    sphere is touched. Obstacles in straight-line or no motion (``StaticMotion``,
-    ``LinearMotion`` or none) are predicted in closed form, others by ``predict``.
+    (``dcsim.api.body_surface_distance``, in the shape's frame) for the few boxes and
+    cylinders whose bounding sphere is touched. Obstacles in straight-line or no motion
+    (``StaticMotion``, ``LinearMotion`` or none) are predicted in closed form, others
+    by ``predict``.
 :func:`endpoint_refusal`
     "No path" with a reason when the start is outside the bounds or inside an obstacle,
     or when every probe point of the goal region is.
@@ -42,6 +43,9 @@ from dcsim.api import (
     PathProblem,
     ShapeKind,
     StaticMotion,
+    body_surface_distance,
+    quaternion_conjugate,
+    rotate,
     surface_distance,
 )
 
@@ -88,6 +92,9 @@ class ObstacleField:
         self.static_centres = self.origin.copy()
         self.bounding = np.array([t.radius for t in self.tracks], dtype=float)
         self.round = np.array([t.shape.kind is ShapeKind.SPHERE for t in self.tracks], dtype=bool)
+        self.to_body = [  # world-to-body rotation matrices (fixed while the obstacles move)
+            rotate(quaternion_conjugate(t.shape.orientation), np.eye(3)).T for t in self.tracks
+        ]
         self.max_obstacle_speed = self._fastest(problem)
 
     def _fastest(self, problem: PathProblem) -> float:
@@ -122,12 +129,11 @@ class ObstacleField:
         reach = self.reach + margin
         if gaps.min() >= reach:
             return True
-        point = np.array([(x, y, z)])
         for i in np.flatnonzero(gaps < reach):
             if self.round[i]:
                 return False
-            centre = point + offsets[i]
-            if surface_distance(self.tracks[i].shape, centre, point)[0] < reach:
+            body = self.to_body[i] @ -offsets[i]
+            if body_surface_distance(self.tracks[i].shape, body[None])[0] < reach:
                 return False
         return True
 
@@ -147,7 +153,8 @@ class ObstacleField:
             if self.round[i]:
                 return False
             rows = near[:, i]
-            exact = surface_distance(self.tracks[i].shape, centres[rows, i], points[rows])
+            body = (points[rows] - centres[rows, i]) @ self.to_body[i].T
+            exact = body_surface_distance(self.tracks[i].shape, body)
             if np.any(exact < reach[rows]):
                 return False
         return True
