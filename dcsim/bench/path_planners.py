@@ -26,6 +26,7 @@ without stopping): flown delta-v, largest tracking error, collisions, arrival.
 from __future__ import annotations
 
 import copy
+import json
 import math
 import multiprocessing
 import numbers
@@ -35,6 +36,8 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from multiprocessing.connection import Connection
 from typing import Any
+
+import yaml
 
 from dcsim.bench.path_problems import BenchProblem
 from dcsim.clearance import path_clearance
@@ -54,6 +57,51 @@ KILL_MARGIN = 1.0
 """Seconds past the time allowance after which a planning process is killed."""
 
 Progress = Callable[[str], None]
+
+
+@dataclass(frozen=True)
+class PlannerChoice:
+    """A registered path planner with the parameters the bench gives it.
+
+    Attributes
+    ----------
+    entry : RegisteredPlugin
+        The planner.
+    params : mapping
+        Its parameters (the rest at their defaults); empty for all defaults.
+    """
+
+    entry: RegisteredPlugin
+    params: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def cls(self) -> type:
+        """The plugin class."""
+        return self.entry.cls
+
+    @property
+    def origin(self) -> Any:
+        """Where the plugin came from."""
+        return self.entry.origin
+
+    @property
+    def plugin(self) -> str:
+        """The plugin's registered name."""
+        return self.entry.name
+
+    @property
+    def name(self) -> str:
+        """The label of its runs: the plugin's name, then ``:key=value`` per parameter."""
+        return self.plugin + "".join(f":{k}={v}" for k, v in self.params.items())
+
+    def settings(self) -> dict[str, Any]:
+        """Every parameter's value, defaults included (plain data)."""
+        return self.cls.Params.parse(self.plugin, dict(self.params) or None).model_dump(mode="json")
+
+
+def planner_choice(entry: RegisteredPlugin | PlannerChoice) -> PlannerChoice:
+    """``entry`` as a :class:`PlannerChoice` (a registered plugin gets its defaults)."""
+    return entry if isinstance(entry, PlannerChoice) else PlannerChoice(entry)
 
 
 @dataclass(frozen=True)
@@ -157,7 +205,13 @@ class ProblemResult:
     started: str
 
 
-def _plan_in_child(plugin: type, seed: int, problem: PathProblem, connection: Connection) -> None:
+def _plan_in_child(
+    plugin: type,
+    seed: int,
+    problem: PathProblem,
+    connection: Connection,
+    params: Mapping[str, Any] | None = None,
+) -> None:
     """Time one plan call and send its answer; then trace a second call's memory and send it.
 
     The second call (a fresh instance with the same generator) runs under tracemalloc,
@@ -165,7 +219,7 @@ def _plan_in_child(plugin: type, seed: int, problem: PathProblem, connection: Co
     """
     began = time.perf_counter()
     try:
-        planner = plugin(None, component_rng(seed, "path_planner"))
+        planner = plugin(params, component_rng(seed, "path_planner"))
         began = time.perf_counter()
         answer: Any = planner.plan(problem)
     except Exception as error:  # the planner's own failure is a result, not the bench's
@@ -175,12 +229,14 @@ def _plan_in_child(plugin: type, seed: int, problem: PathProblem, connection: Co
         connection.send((answer, elapsed))
     except Exception as error:  # an answer that cannot be pickled
         connection.send((f"its answer cannot be sent back: {error}", elapsed))
-    connection.send(_traced_peak(plugin, seed, problem))
+    connection.send(_traced_peak(plugin, seed, problem, params))
 
 
-def _traced_peak(plugin: type, seed: int, problem: PathProblem) -> float:
+def _traced_peak(
+    plugin: type, seed: int, problem: PathProblem, params: Mapping[str, Any] | None
+) -> float:
     """Peak Python memory allocated during a plan call of a fresh instance, bytes."""
-    planner = plugin(None, component_rng(seed, "path_planner"))
+    planner = plugin(params, component_rng(seed, "path_planner"))
     tracemalloc.start()
     try:
         planner.plan(problem)
@@ -191,8 +247,11 @@ def _traced_peak(plugin: type, seed: int, problem: PathProblem) -> float:
         tracemalloc.stop()
 
 
-def plan_in_process(plugin: type, seed: int, problem: PathProblem) -> tuple[Any, float, float]:
-    """One plan call in a forked process: ``(answer, seconds, peak bytes)``.
+def plan_in_process(
+    plugin: type, seed: int, problem: PathProblem, params: Mapping[str, Any] | None = None
+) -> tuple[Any, float, float]:
+    """One plan call (with ``params``, None for the defaults) in a forked process:
+    ``(answer, seconds, peak bytes)``.
 
     The answer is a :class:`Trajectory`, a :class:`NoPath`, an error message (str), or
     None when the process had to be killed: then the seconds are the time waited for it
@@ -201,7 +260,7 @@ def plan_in_process(plugin: type, seed: int, problem: PathProblem) -> tuple[Any,
     """
     context = multiprocessing.get_context("fork")
     receiver, sender = context.Pipe(duplex=False)
-    child = context.Process(target=_plan_in_child, args=(plugin, seed, problem, sender))
+    child = context.Process(target=_plan_in_child, args=(plugin, seed, problem, sender, params))
     child.daemon = True
     child.start()
     sender.close()
@@ -275,15 +334,22 @@ def evaluate(
     )
 
 
-def fly(document: ScenarioDocument, planner: str, seed: int, registry: PluginRegistry) -> Flight:
-    """Fly a problem's transfer scenario with ``planner`` (defaults) under world seed ``seed``.
+def fly(
+    document: ScenarioDocument,
+    planner: str,
+    seed: int,
+    registry: PluginRegistry,
+    params: Mapping[str, Any] | None = None,
+) -> Flight:
+    """Fly a problem's transfer scenario with ``planner`` (``params``, None for the
+    defaults) under world seed ``seed``.
 
     Collisions do not stop the flight, so that every one is counted.
     """
     flown = copy.deepcopy(document)
     for assignment in (
         f"path_planner.plugin={planner}",
-        "path_planner.params={}",
+        f"path_planner.params={json.dumps(dict(params or {}))}",
         f"world.seed={seed}",
         "stop.on_collision=false",
     ):
@@ -300,7 +366,7 @@ def fly(document: ScenarioDocument, planner: str, seed: int, registry: PluginReg
 
 def bench_problem(
     bench: BenchProblem,
-    planners: Sequence[RegisteredPlugin],
+    planners: Sequence[RegisteredPlugin | PlannerChoice],
     runs: int,
     flights: bool,
     registry: PluginRegistry,
@@ -310,12 +376,14 @@ def bench_problem(
     started = time.strftime("%Y-%m-%d %H:%M:%S")
     began = time.perf_counter()
     results = []
-    for entry in planners:
+    for entry in map(planner_choice, planners):
+        params = dict(entry.params) or None
         for seed in range(runs):
-            answer, seconds, peak = plan_in_process(entry.cls, seed, bench.problem)
+            answer, seconds, peak = plan_in_process(entry.cls, seed, bench.problem, params)
             run = evaluate(entry.name, bench, seed, answer, seconds, peak)
             if flights and run.status == "solved":
-                run = replace(run, flight=fly(bench.document, entry.name, seed, registry))
+                flight = fly(bench.document, entry.plugin, seed, registry, params)
+                run = replace(run, flight=flight)
             results.append(run)
             progress(
                 f"{bench.name} {entry.name} seed {seed}: {run.status} "
@@ -324,28 +392,47 @@ def bench_problem(
     return ProblemResult(bench, results, time.perf_counter() - began, started)
 
 
-def select_planners(
-    registry: PluginRegistry, names: Sequence[str] | None
-) -> list[RegisteredPlugin]:
+def select_planners(registry: PluginRegistry, names: Sequence[str] | None) -> list[PlannerChoice]:
     """The named path planners, or every registered one (in name order) when None.
+
+    A name may carry parameters, each as ``:key=value`` (the value read as YAML):
+    ``ompl-control:controls=discrete:planner=est``.
 
     Raises
     ------
     DcsimError
-        If a name is unknown or ambiguous, or no path planner is registered.
+        If a name is unknown or ambiguous, a parameter is malformed or invalid, or no
+        path planner is registered.
     """
     if names is None:
-        chosen = sorted(registry.plugins("path_planner"), key=lambda entry: entry.name)
+        chosen = [
+            PlannerChoice(entry)
+            for entry in sorted(registry.plugins("path_planner"), key=lambda entry: entry.name)
+        ]
     else:
-        chosen = [registry.get("path_planner", name) for name in names]
+        chosen = [_choice(registry, name) for name in names]
     if not chosen:
         raise DcsimError("no path planner is installed")
     return chosen
 
 
+def _choice(registry: PluginRegistry, spec: str) -> PlannerChoice:
+    """The planner and parameters of ``NAME[:key=value...]``."""
+    name, *assignments = spec.split(":")
+    params = {}
+    for assignment in assignments:
+        key, equals, value = assignment.partition("=")
+        if not equals or not key:
+            raise DcsimError(f"'{assignment}' in '{spec}' is not key=value")
+        params[key] = yaml.safe_load(value)
+    choice = PlannerChoice(registry.get("path_planner", name), params)
+    choice.settings()  # an invalid parameter is an error now, not in every run
+    return choice
+
+
 def bench_path_planners(
     problems: Sequence[BenchProblem],
-    planners: Sequence[RegisteredPlugin],
+    planners: Sequence[RegisteredPlugin | PlannerChoice],
     runs: int,
     flights: bool,
     registry: PluginRegistry,
