@@ -632,6 +632,13 @@ def bench_fmu_command(scenario: Path | None, duration: float, repeats: int) -> N
     type=click.Path(dir_okay=False, path_type=Path),
     help="Save box plots of planning time, delta-v and length per problem and planner.",
 )
+@click.option(
+    "--memory/--no-memory",
+    default=True,
+    show_default=True,
+    help="Trace a second plan call of every run for its peak Python memory (it takes "
+    "several times as long as the timed call).",
+)
 def bench_path_planners_command(
     planners: str | None,
     problems: str,
@@ -640,6 +647,7 @@ def bench_path_planners_command(
     log: Path | None,
     fly: bool,
     plot_path: Path | None,
+    memory: bool,
 ) -> None:
     """Path planners side by side on seeded random fields and transfer scenarios.
 
@@ -663,7 +671,13 @@ def bench_path_planners_command(
     if len(set(names)) < len(names):
         raise click.BadParameter(f"two problems have one name: {names}", param_hint="--problems")
     results = bench_path_planners(
-        bench_problems, chosen, runs, fly, registry, lambda line: click.echo(line, err=True)
+        bench_problems,
+        chosen,
+        runs,
+        fly,
+        registry,
+        lambda line: click.echo(line, err=True),
+        memory,
     )
     click.echo(path_reports.markdown_table(results, fly))
     click.echo("")

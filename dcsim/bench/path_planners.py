@@ -211,8 +211,10 @@ def _plan_in_child(
     problem: PathProblem,
     connection: Connection,
     params: Mapping[str, Any] | None = None,
+    memory: bool = True,
 ) -> None:
-    """Time one plan call and send its answer; then trace a second call's memory and send it.
+    """Time one plan call and send its answer; then trace a second call's memory and send
+    it (NaN without ``memory``).
 
     The second call (a fresh instance with the same generator) runs under tracemalloc,
     whose bookkeeping would otherwise slow the timed call down severalfold.
@@ -229,7 +231,7 @@ def _plan_in_child(
         connection.send((answer, elapsed))
     except Exception as error:  # an answer that cannot be pickled
         connection.send((f"its answer cannot be sent back: {error}", elapsed))
-    connection.send(_traced_peak(plugin, seed, problem, params))
+    connection.send(_traced_peak(plugin, seed, problem, params) if memory else math.nan)
 
 
 def _traced_peak(
@@ -248,10 +250,14 @@ def _traced_peak(
 
 
 def plan_in_process(
-    plugin: type, seed: int, problem: PathProblem, params: Mapping[str, Any] | None = None
+    plugin: type,
+    seed: int,
+    problem: PathProblem,
+    params: Mapping[str, Any] | None = None,
+    memory: bool = True,
 ) -> tuple[Any, float, float]:
     """One plan call (with ``params``, None for the defaults) in a forked process:
-    ``(answer, seconds, peak bytes)``.
+    ``(answer, seconds, peak bytes)``; the peak is NaN without ``memory``.
 
     The answer is a :class:`Trajectory`, a :class:`NoPath`, an error message (str), or
     None when the process had to be killed: then the seconds are the time waited for it
@@ -260,7 +266,9 @@ def plan_in_process(
     """
     context = multiprocessing.get_context("fork")
     receiver, sender = context.Pipe(duplex=False)
-    child = context.Process(target=_plan_in_child, args=(plugin, seed, problem, sender, params))
+    child = context.Process(
+        target=_plan_in_child, args=(plugin, seed, problem, sender, params, memory)
+    )
     child.daemon = True
     child.start()
     sender.close()
@@ -371,15 +379,17 @@ def bench_problem(
     flights: bool,
     registry: PluginRegistry,
     progress: Progress = print,
+    memory: bool = True,
 ) -> ProblemResult:
-    """Every planner on one problem, ``runs`` seeds each (0 to runs − 1)."""
+    """Every planner on one problem, ``runs`` seeds each (0 to runs − 1); ``memory``
+    traces a second call of each run for its peak memory."""
     started = time.strftime("%Y-%m-%d %H:%M:%S")
     began = time.perf_counter()
     results = []
     for entry in map(planner_choice, planners):
         params = dict(entry.params) or None
         for seed in range(runs):
-            answer, seconds, peak = plan_in_process(entry.cls, seed, bench.problem, params)
+            answer, seconds, peak = plan_in_process(entry.cls, seed, bench.problem, params, memory)
             run = evaluate(entry.name, bench, seed, answer, seconds, peak)
             if flights and run.status == "solved":
                 flight = fly(bench.document, entry.plugin, seed, registry, params)
@@ -437,6 +447,7 @@ def bench_path_planners(
     flights: bool,
     registry: PluginRegistry,
     progress: Progress = print,
+    memory: bool = True,
 ) -> list[ProblemResult]:
     """Every planner on every problem, ``runs`` seeds each, problem by problem."""
-    return [bench_problem(p, planners, runs, flights, registry, progress) for p in problems]
+    return [bench_problem(p, planners, runs, flights, registry, progress, memory) for p in problems]

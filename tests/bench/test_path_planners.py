@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import signal
 import sqlite3
@@ -295,3 +296,8 @@ def test_the_family_table_pools_a_familys_problems(quick):
     assert table[0].startswith("| family | planner | runs | success | time median [ms] |")
     assert table[2].startswith("| static-spheres | straight-line | 4 | 4 |")
     assert table[2].endswith("| – | – | 91.0 | 1.60 |")  # no statistics; 60 m in 91 s
+
+
+def test_memory_tracing_can_be_left_out(quick):
+    answer, seconds, peak = plan_in_process(StraightLinePlanner, 0, quick.problem, memory=False)
+    assert isinstance(answer, Trajectory) and seconds > 0 and math.isnan(peak)
