@@ -48,12 +48,15 @@ Validity
     segments between the checked steps are clear too.
 Goal
     A state counts as arrived when it is inside the goal region within every tolerance,
-    or when it lies within ``connect_radius`` of the region and a closing manoeuvre
-    reaches the goal from it (:func:`closing_manoeuvre`): position and velocity cubic in
-    time into the region at the goal's velocity (and time, if it sets one), attitude
-    turned onto the goal's by a cubic rotation vector, within every limit and clear of
-    the obstacles. ``connect_radius = 0`` plans as the source does, by propagation
-    alone.
+    or when a closing manoeuvre (:class:`ClosingManoeuvre`) reaches the goal from it:
+    position and velocity cubic in time into the region at the goal's velocity (and
+    time, if it sets one; else the shortest duration that keeps the limits), attitude
+    turned onto the goal's by a cubic rotation vector (its rate is reported as the
+    angular velocity: exact when the turn and the start's spin share an axis), within
+    every limit and clear of the obstacles. It is tried from each node within
+    ``connect_radius`` of the region that is closer to it than every node tried before,
+    in an inertial frame only (it leaves out the Clohessy–Wiltshire terms).
+    ``connect_radius = 0`` plans as the source does, by propagation alone.
 
 The solution is every propagation step of the path (and of the closing manoeuvre), with
 the force and torque held over each step, so the transfer mission flies it by

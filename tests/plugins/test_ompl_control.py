@@ -19,6 +19,7 @@ from dcsim_plugins.path_planners.ompl_control import (
 from dcsim.api import (
     Bounds,
     GoalRegion,
+    LinearMotion,
     NoPath,
     ObjectKind,
     ObjectTrack,
@@ -248,3 +249,21 @@ def test_parameters_hold_the_sources_values_by_default():
     assert (params.step, params.integrator, params.planner) == (0.3, "euler", "rrt")
     weights = (params.position_weight, params.attitude_weight)
     assert weights + (params.velocity_weight, params.rate_weight) == (0.05, 5.0, 0.3, 0.5)
+
+
+def test_moving_obstacles_are_checked_where_they_are_at_each_states_time():
+    # a sphere crossing the way at 0.5 m/s, at the middle about when a direct flight passes
+    crossing = ObjectTrack(
+        2,
+        ObjectKind.OBSTACLE,
+        0.0,
+        (6.0, -4.0, 0.0),
+        (0.0, 0.5, 0.0),
+        radius=1.0,
+        motion=LinearMotion((6.0, -4.0, 0.0), (0.0, 0.5, 0.0)),
+    )
+    problem = small_problem(obstacles=(crossing,))
+    for connect_radius in (0.0, 50.0):
+        trajectory = plan(problem, connect_radius=connect_radius)
+        assert isinstance(trajectory, Trajectory), trajectory
+        assert not path_clearance(trajectory, problem).collides
