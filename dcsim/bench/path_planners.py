@@ -37,6 +37,7 @@ from dataclasses import dataclass, field, replace
 from multiprocessing.connection import Connection
 from typing import Any
 
+import numpy as np
 import yaml
 
 from dcsim.bench.path_problems import BenchProblem
@@ -49,6 +50,7 @@ from dcsim.runsetup import build_run
 from dcsim.scenario import ScenarioDocument, resolve_plugins, validate
 from dcsim.seeding import component_rng
 from dcsim.testing.contracts import TIME_SLACK
+from dcsim.testing.kind_checks import START_TOLERANCES
 
 STATUSES = ("solved", "no path", "error", "timeout")
 """A run's status: a trajectory in time, "no path", an exception or a crash, too late."""
@@ -145,7 +147,9 @@ class PlanRun:
     peak_memory : float
         Peak Python memory allocated during the call (tracemalloc), bytes.
     exact : bool
-        The trajectory ends inside the goal region, within every tolerance.
+        The trajectory starts at the start state (within the conformance suite's
+        tolerances of position and time) and ends inside the goal region, within every
+        tolerance.
     approximate : bool
         A trajectory that does not.
     length, duration, delta_v : float
@@ -326,10 +330,14 @@ def evaluate(
         return replace(head, status="no path", reason=answer.reason)
     if not isinstance(answer, Trajectory):
         return replace(head, reason=f"returned {type(answer).__name__}")
-    exact = problem.goal.contains(answer.end_state(problem.goal))
+    gap = float(np.linalg.norm(answer.positions[0] - problem.start.position))
+    lag = abs(float(answer.times[0] - problem.start.time))
+    starts = gap <= START_TOLERANCES[0] and lag <= START_TOLERANCES[1]
+    exact = starts and problem.goal.contains(answer.end_state(problem.goal))
     closest = path_clearance(answer, problem)
     return replace(
         head,
+        reason="" if starts else f"starts {gap:.3g} m and {lag:.3g} s from the start state",
         status="solved",
         exact=exact,
         approximate=not exact,

@@ -301,3 +301,19 @@ def test_the_family_table_pools_a_familys_problems(quick):
 def test_memory_tracing_can_be_left_out(quick):
     answer, seconds, peak = plan_in_process(StraightLinePlanner, 0, quick.problem, memory=False)
     assert isinstance(answer, Trajectory) and seconds > 0 and math.isnan(peak)
+
+
+class MisplacedPlanner(StraightLinePlanner):
+    name = "misplaced"
+    summary = "Starts its trajectory 1 m off the start (test)"
+
+    def plan(self, problem):
+        trajectory = super().plan(problem)
+        return dataclasses.replace(trajectory, positions=trajectory.positions + [0.0, 1.0, 0.0])
+
+
+def test_a_trajectory_that_does_not_start_at_the_start_is_no_success(quick):
+    answer, seconds, peak = plan_in_process(MisplacedPlanner, 0, quick.problem, memory=False)
+    run = evaluate("misplaced", quick, 0, answer, seconds, peak)
+    assert run.status == "solved" and not run.exact and not run.success
+    assert run.reason == "starts 1 m and 0 s from the start state"
