@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -15,6 +17,7 @@ from dcsim_plugins.path_planners.ompl_control import (
     OmplControlPlanner,
     discrete_control,
 )
+from dcsim_plugins.path_planners.ompl_support import in_worker, seed_ompl
 
 from dcsim.api import (
     Bounds,
@@ -267,3 +270,41 @@ def test_moving_obstacles_are_checked_where_they_are_at_each_states_time():
         trajectory = plan(problem, connect_radius=connect_radius)
         assert isinstance(trajectory, Trajectory), trajectory
         assert not path_clearance(trajectory, problem).collides
+
+
+def draw(seed):
+    """A number from OMPL's generator, seeded with ``seed`` (in a worker process)."""
+    from ompl import util as ou
+
+    seed_ompl(seed)
+    return ou.RNG().uniform01()
+
+
+FALLBACK = """
+import time
+
+from ompl import base as ob
+from ompl import util as ou
+
+from dcsim_plugins.path_planners.ompl_support import in_worker, seed_ompl
+
+
+def draw(seed):
+    seed_ompl(seed)
+    return ou.RNG().uniform01()
+
+
+if __name__ == "__main__":
+    ob.RealVectorStateSpace(1).allocDefaultStateSampler()  # OMPL's generator now runs here
+    print(*(in_worker(draw, (7,), time.monotonic() + 30) for _ in range(2)))
+"""
+
+
+def test_seeds_take_in_workers_even_when_ompl_already_runs_in_the_planning_process(tmp_path):
+    script = tmp_path / "fallback.py"
+    script.write_text(FALLBACK)
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert "Random number generation already started" in done.stderr  # the fork's seed failed
+    first, second = map(float, done.stdout.split())
+    assert first == second == in_worker(draw, (7,), time.monotonic() + 30)
