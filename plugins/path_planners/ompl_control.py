@@ -49,8 +49,10 @@ Validity
 Goal
     A state counts as arrived when it is inside the goal region within every tolerance,
     or when a closing manoeuvre (:class:`ClosingManoeuvre`) reaches the goal from it:
-    position and velocity cubic in time into the region at the goal's velocity (and
-    time, if it sets one; else the shortest duration that keeps the limits), attitude
+    position and velocity cubic in time into the region at the goal's velocity (when
+    the goal leaves it free: at the node's velocity, or else at constant acceleration),
+    at the goal's time if
+    it sets one, else after the shortest duration that keeps the limits; attitude
     turned onto the goal's by a cubic rotation vector (its rate is reported as the
     angular velocity: exact when the turn and the start's spin share an axis), within
     every limit and clear of the obstacles. It is tried from each node within
@@ -499,20 +501,37 @@ class ClosingManoeuvre:
         goal, a = self.goal, np.asarray(x)
         p0, v0 = a[P], a[V]
         p1 = self.aim(p0)
-        v1 = goal.velocity if math.isfinite(goal.velocity_tolerance) else v0
         if goal.time is not None:
             spans = np.array([goal.time - a[T]])
         else:
             spans = self.step * _DURATIONS
         spans = spans[spans >= self.step]
-        feasible = spans[self._feasible(p0, v0, p1, v1, spans)]
-        return None if not len(feasible) else self._build(a, p1, v1, float(feasible[0]))
+        for ends in self._end_velocities(p0, v0, p1, spans):
+            feasible = np.flatnonzero(self._feasible(p0, v0, p1, ends, spans))
+            closing = None
+            if len(feasible):
+                closing = self._build(a, p1, ends[feasible[0]], float(spans[feasible[0]]))
+            if closing is not None:
+                return closing
+        return None
+
+    def _end_velocities(
+        self, p0: np.ndarray, v0: np.ndarray, p1: np.ndarray, spans: np.ndarray
+    ) -> list[np.ndarray]:
+        """The end velocities (k, 3) m/s tried for each duration of ``spans`` (k,) s: the
+        goal's, or, when it leaves the velocity free, the node's own and then the one of
+        constant acceleration."""
+        count = len(spans)
+        if math.isfinite(self.goal.velocity_tolerance):
+            return [np.broadcast_to(self.goal.velocity, (count, 3))]
+        return [np.broadcast_to(v0, (count, 3)), 2 * (p1 - p0) / spans[:, None] - v0]
 
     def _feasible(
         self, p0: np.ndarray, v0: np.ndarray, p1: np.ndarray, v1: np.ndarray, spans: np.ndarray
     ) -> np.ndarray:
-        """Which cubics of durations ``spans`` (s) keep within the acceleration limit at
-        their ends (where it peaks) and the speed limit at nine points."""
+        """Which cubics of durations ``spans`` (k,) s, ending at velocities ``v1`` (k, 3)
+        m/s, keep within the acceleration limit at their ends (where it peaks) and the
+        speed limit at nine points."""
         s = spans[:, None]
         drift = (p1 - p0) / s**2
         first = 6 * drift - (4 * v0 + 2 * v1) / s
