@@ -93,6 +93,7 @@ from dcsim_plugins.path_planners.ompl_support import (
 )
 from ompl import base as ob
 from ompl import control as oc
+from pydantic import field_validator
 
 from dcsim.api import (
     FrameKind,
@@ -105,6 +106,7 @@ from dcsim.api import (
     quantity,
     quaternion_conjugate,
     quaternion_multiply,
+    rotate,
     rotation_vector,
 )
 
@@ -171,6 +173,14 @@ class OmplControlParams(PluginParams):
         0.01, unit="N m", gt=0, description="Torque when max_angular_acceleration is inf."
     )
     clearance: float = quantity(0.05, unit="m", ge=0, description="Margin beyond the robot radius.")
+
+    @field_validator("inertia")
+    @classmethod
+    def _positive_moments(cls, value: tuple[float, float, float]) -> tuple[float, float, float]:
+        """Every principal moment of inertia must be positive."""
+        if min(value) <= 0:
+            raise ValueError(f"every principal moment must be positive, got {value}")
+        return value
 
 
 # ------------------------------------------------------------------ the model
@@ -925,7 +935,7 @@ class Setup:
         inertia = np.diag(self.model.inertia)
         out = []
         for q, alpha in zip(closing.states[:-1, Q], closing.angular_accelerations, strict=True):
-            rotation = _matrix(q)
+            rotation = rotate(q, np.eye(3)).T  # body to world
             out.append((rotation @ inertia @ rotation.T @ alpha).tolist())
         return out
 
@@ -945,18 +955,6 @@ class Setup:
             "closing_attempts": float(self.closing.attempts),
             "exact": float(exact),
         }
-
-
-def _matrix(q: np.ndarray) -> np.ndarray:
-    """Body-to-world rotation matrix of the unit quaternion ``[x, y, z, w]``."""
-    x, y, z, w = q
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
 
 
 def solve(params: OmplControlParams, problem: PathProblem, seed: int, deadline: float) -> Solution:

@@ -27,6 +27,7 @@ from dcsim.api import (
     ObjectKind,
     ObjectTrack,
     PathProblem,
+    PluginParameterError,
     RobotState,
     StaticMotion,
     Trajectory,
@@ -308,3 +309,8 @@ def test_seeds_take_in_workers_even_when_ompl_already_runs_in_the_planning_proce
     assert "Random number generation already started" in done.stderr  # the fork's seed failed
     first, second = map(float, done.stdout.split())
     assert first == second == in_worker(draw, (7,), time.monotonic() + 30)
+
+
+def test_a_moment_of_inertia_must_be_positive():
+    with pytest.raises(PluginParameterError, match="every principal moment must be positive"):
+        OmplControlPlanner({"inertia": [0.1, 0.0, 0.1]}, np.random.default_rng(0))
