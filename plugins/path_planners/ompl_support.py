@@ -17,11 +17,11 @@ Not a plugin itself. Its pieces:
     process (``ompl.util.RNG.setSeed`` is ignored after the first sample), so each plan
     runs in a fresh child forked from the planning process, which itself never samples:
     the child's seed always takes, and the same seed gives the same plan. A fork costs
-    about 12 ms (docs/benchmarks.md gives the command). If OMPL's generator was
+    about 7 ms (docs/benchmarks.md gives the command). If OMPL's generator was
     already running in the planning process (other code sampled there first), the child
     reports that its seed did not take and the solve is repeated in a child of a
     forkserver that has imported only this module: the first such plan costs about
-    0.8 s more, each later one about 80 ms more plus the import of the program's main
+    0.7 s more, each later one about 90 ms more plus the import of the program's main
     module, which multiprocessing repeats in every such child.
 """
 
