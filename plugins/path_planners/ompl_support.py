@@ -47,7 +47,6 @@ from dcsim.api import (
     body_surface_distance,
     quaternion_conjugate,
     rotate,
-    surface_distance,
 )
 
 WORKER_SLACK = 0.5
@@ -122,21 +121,24 @@ class ObstacleField:
     def clear(self, x: float, y: float, z: float, t: float, margin: float = 0.0) -> bool:
         """Whether the robot sphere at ``(x, y, z)`` (m) at time ``t`` (s), grown by
         ``margin`` (m), is clear of every obstacle."""
-        if not self.count:
-            return True
+        return not self.count or self._first_hit(x, y, z, t, self.reach + margin) is None
+
+    def _first_hit(self, x: float, y: float, z: float, t: float, reach: float) -> int | None:
+        """Index of an obstacle whose surface is nearer than ``reach`` (m) to ``(x, y, z)``
+        (m) at time ``t`` (s), or None."""
         offsets = self.centres(t) - (x, y, z)
-        gaps = np.sqrt(np.einsum("ij,ij->i", offsets, offsets))
+        squares = offsets * offsets
+        gaps = np.sqrt(np.add.reduce(squares, axis=1))
         gaps -= self.bounding
-        reach = self.reach + margin
-        if gaps.min() >= reach:
-            return True
+        if np.minimum.reduce(gaps) >= reach:
+            return None
         for i in np.flatnonzero(gaps < reach):
             if self.round[i]:
-                return False
+                return int(i)
             body = self.to_body[i] @ -offsets[i]
             if body_surface_distance(self.tracks[i].shape, body[None])[0] < reach:
-                return False
-        return True
+                return int(i)
+        return None
 
     def clear_path(self, points: np.ndarray, times: np.ndarray, margins: np.ndarray) -> bool:
         """Whether the robot sphere is clear at every one of ``points`` (k, 3) m at
@@ -162,12 +164,10 @@ class ObstacleField:
 
     def blocker(self, point: np.ndarray, t: float) -> int | None:
         """Id of an obstacle the robot sphere at ``point`` (m) at ``t`` (s) overlaps."""
-        for track in self.tracks:
-            centre = track.predict(t)[0]
-            gap = surface_distance(track.shape, centre[None], np.asarray(point)[None])[0]
-            if gap < self.reach:
-                return track.id
-        return None
+        if not self.count:
+            return None
+        hit = self._first_hit(*map(float, point), t, self.reach)
+        return None if hit is None else self.tracks[hit].id
 
 
 def _is_affine(motion: object) -> bool:
