@@ -65,6 +65,8 @@ from dcsim.api import (
     rest_to_rest_time,
 )
 
+Samples = tuple[np.ndarray, np.ndarray, np.ndarray]
+"""Times (s), positions (m) and velocities (m/s) of a piece of trajectory."""
 MOVING_REFUSAL = "no path: moving obstacles need ompl-control or a time-aware planner"
 """The answer to a problem with moving obstacles."""
 _PLANNERS = {
@@ -121,7 +123,9 @@ class Waypoints:
     statistics: dict[str, float]
 
 
-def planning_box(problem: PathProblem, start: np.ndarray, goal: np.ndarray) -> tuple:
+def planning_box(
+    problem: PathProblem, start: np.ndarray, goal: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Lower and upper corners (m) positions are planned in."""
     if problem.bounds is not None:
         return np.asarray(problem.bounds.lower), np.asarray(problem.bounds.upper)
@@ -213,7 +217,7 @@ class Timing:
     def __init__(self, speed: float, acceleration: float) -> None:
         self.speed, self.acceleration = speed, acceleration
 
-    def segment(self, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def segment(self, a: np.ndarray, b: np.ndarray) -> Samples:
         """Times since the segment's start (s), positions (m) and velocities (m/s) of the
         rest-to-rest flight from ``a`` to ``b``."""
         length = float(np.linalg.norm(b - a))
@@ -226,7 +230,7 @@ class Timing:
         direction = (b - a) / length
         return tau, a + np.outer(distance, direction), np.outer(speed, direction)
 
-    def braking(self, position: np.ndarray, velocity: np.ndarray) -> tuple:
+    def braking(self, position: np.ndarray, velocity: np.ndarray) -> Samples:
         """Times (s), positions (m) and velocities (m/s) of braking to rest along
         ``velocity`` at the acceleration limit, from ``position``."""
         speed = float(np.linalg.norm(velocity))
@@ -243,7 +247,7 @@ class Timing:
         return tau, positions, velocity * fraction
 
 
-def _chain(pieces: list[tuple[np.ndarray, np.ndarray, np.ndarray]], t0: float) -> tuple:
+def _chain(pieces: list[Samples], t0: float) -> Samples:
     """Times, positions and velocities of consecutive pieces, joined end to start."""
     times, positions, velocities = [np.array([t0])], [pieces[0][1][:1]], [pieces[0][2][:1]]
     clock = t0
@@ -303,7 +307,7 @@ class OmplGeometricPlanner(PathPlanner):
         return self._timed(problem, timing, braking, found)
 
     def _timed(
-        self, problem: PathProblem, timing: Timing, braking: tuple, found: Waypoints
+        self, problem: PathProblem, timing: Timing, braking: Samples, found: Waypoints
     ) -> Trajectory | NoPath:
         """The waypoints flown rest to rest after braking, waiting for the goal's time."""
         pieces = [braking] if len(braking[0]) > 1 else []
