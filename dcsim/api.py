@@ -27,7 +27,7 @@ Motion models
     :class:`SphericalMotion`, :class:`ClohessyWiltshireMotion`, :func:`mean_motion`.
 Path clearance (the yardstick of path planners)
     :func:`path_clearance`, :func:`min_clearance`, :class:`Clearance`,
-    :func:`surface_distance`, :func:`resolution_step`.
+    :func:`surface_distance`, :func:`body_surface_distance`, :func:`resolution_step`.
 Plan cost
     :func:`plan_delta_v`, :func:`plan_duration`, :func:`plan_cost`, :func:`legs_delta_v`,
     :func:`leg_delta_v`.
@@ -48,6 +48,7 @@ Errors
 
 from dcsim.clearance import (
     Clearance,
+    body_surface_distance,
     min_clearance,
     path_clearance,
     resolution_step,
@@ -125,6 +126,7 @@ from dcsim.registry import PluginRegistry
 __all__ = [
     "array_field",
     "BeaconRange",
+    "body_surface_distance",
     "Bounds",
     "Clearance",
     "clip_norm",

@@ -81,7 +81,28 @@ def surface_distance(shape: Shape, centres: np.ndarray, points: np.ndarray) -> n
     offsets = np.asarray(points, dtype=float) - np.asarray(centres, dtype=float)
     if shape.kind is ShapeKind.SPHERE:
         return np.linalg.norm(offsets, axis=-1) - shape.radius
-    body = rotate(quaternion_conjugate(shape.orientation), offsets)
+    return body_surface_distance(shape, rotate(quaternion_conjugate(shape.orientation), offsets))
+
+
+def body_surface_distance(shape: Shape, offsets: np.ndarray) -> np.ndarray:
+    """Signed distance to the surface of a shape from points given in its body frame.
+
+    Parameters
+    ----------
+    shape : Shape
+        Sphere, box or cylinder (its orientation is not used: the offsets are already
+        in its body frame).
+    offsets : ndarray (N, 3)
+        Points relative to the shape's centre, along its body axes, m.
+
+    Returns
+    -------
+    ndarray (N,)
+        Distance to the surface, m; negative inside the shape.
+    """
+    body = np.asarray(offsets, dtype=float)
+    if shape.kind is ShapeKind.SPHERE:
+        return np.linalg.norm(body, axis=-1) - shape.radius
     if shape.kind is ShapeKind.BOX:
         excess = np.abs(body) - shape.half_extents
     else:

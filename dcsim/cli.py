@@ -20,14 +20,14 @@ import click
 from dcsim import __version__
 from dcsim.errors import DcsimError, PluginLoadWarning
 from dcsim.interfaces import PLUGIN_KINDS
-from dcsim.registry import PluginRegistry, RegisteredPlugin
+from dcsim.registry import PluginRegistry
 from dcsim.rundir import prepare_run_directory
 from dcsim.runsetup import prepare_run
 from dcsim.scenario import load_scenario
 from dcsim.scenario.model import MAX_SEED
 
 if TYPE_CHECKING:  # the bench modules are imported by their commands only
-    from dcsim.bench.path_planners import ProblemResult
+    from dcsim.bench.path_planners import PlannerChoice, ProblemResult
 
 EXIT_USER_ERROR = 2
 
@@ -589,15 +589,16 @@ def bench_fmu_command(scenario: Path | None, duration: float, repeats: int) -> N
 @click.option(
     "--planners",
     default=None,
-    help="Comma-separated path planners, each with its default parameters "
-    "(default: every registered one).",
+    help="Comma-separated path planners (default: every registered one), each with its "
+    "default parameters or some set as NAME:key=value:key=value.",
 )
 @click.option(
     "--problems",
     default="static-spheres,cw-spheres,shapes",
     show_default=True,
-    help="Comma-separated problems: a family (static-spheres, cw-spheres, shapes) with an "
-    "optional :SEED (default 0), or the path of a transfer scenario file.",
+    help="Comma-separated problems: a family (static-spheres, cw-spheres, shapes, "
+    "asteroid-escape) with an optional :SEED (default 0) or :FIRST..LAST seeds, or the path "
+    "of a transfer scenario file.",
 )
 @click.option(
     "--runs",
@@ -631,6 +632,13 @@ def bench_fmu_command(scenario: Path | None, duration: float, repeats: int) -> N
     type=click.Path(dir_okay=False, path_type=Path),
     help="Save box plots of planning time, delta-v and length per problem and planner.",
 )
+@click.option(
+    "--memory/--no-memory",
+    default=True,
+    show_default=True,
+    help="Trace a second plan call of every run for its peak Python memory (it takes "
+    "several times as long as the timed call).",
+)
 def bench_path_planners_command(
     planners: str | None,
     problems: str,
@@ -639,6 +647,7 @@ def bench_path_planners_command(
     log: Path | None,
     fly: bool,
     plot_path: Path | None,
+    memory: bool,
 ) -> None:
     """Path planners side by side on seeded random fields and transfer scenarios.
 
@@ -650,20 +659,29 @@ def bench_path_planners_command(
     from dcsim.bench import path_reports
     from dcsim.bench.ompl_log import benchmark_parser
     from dcsim.bench.path_planners import bench_path_planners, select_planners
-    from dcsim.bench.path_problems import load_problem
+    from dcsim.bench.path_problems import expand_specs, load_problem
 
     if database is not None:
         benchmark_parser()  # refuse before the runs, not after them
     registry = _registry()
     chosen = select_planners(registry, _names(planners, "--planners"))
-    bench_problems = [load_problem(spec) for spec in _names(problems, "--problems") or []]
+    specs = expand_specs(_names(problems, "--problems") or [])
+    bench_problems = [load_problem(spec) for spec in specs]
     names = [p.name for p in bench_problems]
     if len(set(names)) < len(names):
         raise click.BadParameter(f"two problems have one name: {names}", param_hint="--problems")
     results = bench_path_planners(
-        bench_problems, chosen, runs, fly, registry, lambda line: click.echo(line, err=True)
+        bench_problems,
+        chosen,
+        runs,
+        fly,
+        registry,
+        lambda line: click.echo(line, err=True),
+        memory,
     )
     click.echo(path_reports.markdown_table(results, fly))
+    click.echo("")
+    click.echo(path_reports.family_table(results, fly))
     if log is not None or database is not None:
         _write_records(results, chosen, runs, fly, log, database)
     if plot_path is not None:
@@ -673,7 +691,7 @@ def bench_path_planners_command(
 
 def _write_records(
     results: Sequence[ProblemResult],
-    planners: Sequence[RegisteredPlugin],
+    planners: Sequence[PlannerChoice],
     runs: int,
     fly: bool,
     log: Path | None,

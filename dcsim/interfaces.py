@@ -133,9 +133,19 @@ class TaskPlanner(Plugin):
 
 
 class PathPlanner(Plugin):
-    """Finds a time-stamped trajectory to a goal region among moving obstacles."""
+    """Finds a time-stamped trajectory to a goal region among moving obstacles.
+
+    Attributes
+    ----------
+    handles_moving_obstacles : bool
+        Whether the planner plans around obstacles in motion (the default). A planner
+        that declares False answers every problem with a moving obstacle with a
+        :class:`NoPath` saying so; the conformance suite then poses its path checks with
+        the obstacles held where they are at the start, and checks that refusal.
+    """
 
     kind = "path_planner"
+    handles_moving_obstacles: ClassVar[bool] = True
 
     @abstractmethod
     def plan(self, problem: PathProblem) -> Trajectory | NoPath:

@@ -70,7 +70,8 @@ def test_a_throw_away_module_registers_through_the_hook():
 def test_unknown_name_suggests_the_closest():
     registry = PluginRegistry.discover()
     with pytest.raises(
-        PluginNotFoundError, match=r"available: straight-line\); did you mean 'straight-line'\?"
+        PluginNotFoundError,
+        match=r"available: ompl-control, ompl-geometric, straight-line\); did you mean 'straight-line'\?",
     ):
         registry.get("path_planner", "straight_line")
 

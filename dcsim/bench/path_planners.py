@@ -26,6 +26,7 @@ without stopping): flown delta-v, largest tracking error, collisions, arrival.
 from __future__ import annotations
 
 import copy
+import json
 import math
 import multiprocessing
 import numbers
@@ -35,6 +36,9 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from multiprocessing.connection import Connection
 from typing import Any
+
+import numpy as np
+import yaml
 
 from dcsim.bench.path_problems import BenchProblem
 from dcsim.clearance import path_clearance
@@ -46,6 +50,7 @@ from dcsim.runsetup import build_run
 from dcsim.scenario import ScenarioDocument, resolve_plugins, validate
 from dcsim.seeding import component_rng
 from dcsim.testing.contracts import TIME_SLACK
+from dcsim.testing.kind_checks import START_TOLERANCES
 
 STATUSES = ("solved", "no path", "error", "timeout")
 """A run's status: a trajectory in time, "no path", an exception or a crash, too late."""
@@ -54,6 +59,51 @@ KILL_MARGIN = 1.0
 """Seconds past the time allowance after which a planning process is killed."""
 
 Progress = Callable[[str], None]
+
+
+@dataclass(frozen=True)
+class PlannerChoice:
+    """A registered path planner with the parameters the bench gives it.
+
+    Attributes
+    ----------
+    entry : RegisteredPlugin
+        The planner.
+    params : mapping
+        Its parameters (the rest at their defaults); empty for all defaults.
+    """
+
+    entry: RegisteredPlugin
+    params: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def cls(self) -> type:
+        """The plugin class."""
+        return self.entry.cls
+
+    @property
+    def origin(self) -> Any:
+        """Where the plugin came from."""
+        return self.entry.origin
+
+    @property
+    def plugin(self) -> str:
+        """The plugin's registered name."""
+        return self.entry.name
+
+    @property
+    def name(self) -> str:
+        """The label of its runs: the plugin's name, then ``:key=value`` per parameter."""
+        return self.plugin + "".join(f":{k}={v}" for k, v in self.params.items())
+
+    def settings(self) -> dict[str, Any]:
+        """Every parameter's value, defaults included (plain data)."""
+        return self.cls.Params.parse(self.plugin, dict(self.params) or None).model_dump(mode="json")
+
+
+def planner_choice(entry: RegisteredPlugin | PlannerChoice) -> PlannerChoice:
+    """``entry`` as a :class:`PlannerChoice` (a registered plugin gets its defaults)."""
+    return entry if isinstance(entry, PlannerChoice) else PlannerChoice(entry)
 
 
 @dataclass(frozen=True)
@@ -97,7 +147,9 @@ class PlanRun:
     peak_memory : float
         Peak Python memory allocated during the call (tracemalloc), bytes.
     exact : bool
-        The trajectory ends inside the goal region, within every tolerance.
+        The trajectory starts at the start state (within the conformance suite's
+        tolerances of position and time) and ends inside the goal region, within every
+        tolerance.
     approximate : bool
         A trajectory that does not.
     length, duration, delta_v : float
@@ -157,15 +209,23 @@ class ProblemResult:
     started: str
 
 
-def _plan_in_child(plugin: type, seed: int, problem: PathProblem, connection: Connection) -> None:
-    """Time one plan call and send its answer; then trace a second call's memory and send it.
+def _plan_in_child(
+    plugin: type,
+    seed: int,
+    problem: PathProblem,
+    connection: Connection,
+    params: Mapping[str, Any] | None = None,
+    memory: bool = True,
+) -> None:
+    """Time one plan call and send its answer; then trace a second call's memory and send
+    it (NaN without ``memory``).
 
     The second call (a fresh instance with the same generator) runs under tracemalloc,
     whose bookkeeping would otherwise slow the timed call down severalfold.
     """
     began = time.perf_counter()
     try:
-        planner = plugin(None, component_rng(seed, "path_planner"))
+        planner = plugin(params, component_rng(seed, "path_planner"))
         began = time.perf_counter()
         answer: Any = planner.plan(problem)
     except Exception as error:  # the planner's own failure is a result, not the bench's
@@ -175,12 +235,14 @@ def _plan_in_child(plugin: type, seed: int, problem: PathProblem, connection: Co
         connection.send((answer, elapsed))
     except Exception as error:  # an answer that cannot be pickled
         connection.send((f"its answer cannot be sent back: {error}", elapsed))
-    connection.send(_traced_peak(plugin, seed, problem))
+    connection.send(_traced_peak(plugin, seed, problem, params) if memory else math.nan)
 
 
-def _traced_peak(plugin: type, seed: int, problem: PathProblem) -> float:
+def _traced_peak(
+    plugin: type, seed: int, problem: PathProblem, params: Mapping[str, Any] | None
+) -> float:
     """Peak Python memory allocated during a plan call of a fresh instance, bytes."""
-    planner = plugin(None, component_rng(seed, "path_planner"))
+    planner = plugin(params, component_rng(seed, "path_planner"))
     tracemalloc.start()
     try:
         planner.plan(problem)
@@ -191,8 +253,15 @@ def _traced_peak(plugin: type, seed: int, problem: PathProblem) -> float:
         tracemalloc.stop()
 
 
-def plan_in_process(plugin: type, seed: int, problem: PathProblem) -> tuple[Any, float, float]:
-    """One plan call in a forked process: ``(answer, seconds, peak bytes)``.
+def plan_in_process(
+    plugin: type,
+    seed: int,
+    problem: PathProblem,
+    params: Mapping[str, Any] | None = None,
+    memory: bool = True,
+) -> tuple[Any, float, float]:
+    """One plan call (with ``params``, None for the defaults) in a forked process:
+    ``(answer, seconds, peak bytes)``; the peak is NaN without ``memory``.
 
     The answer is a :class:`Trajectory`, a :class:`NoPath`, an error message (str), or
     None when the process had to be killed: then the seconds are the time waited for it
@@ -201,7 +270,9 @@ def plan_in_process(plugin: type, seed: int, problem: PathProblem) -> tuple[Any,
     """
     context = multiprocessing.get_context("fork")
     receiver, sender = context.Pipe(duplex=False)
-    child = context.Process(target=_plan_in_child, args=(plugin, seed, problem, sender))
+    child = context.Process(
+        target=_plan_in_child, args=(plugin, seed, problem, sender, params, memory)
+    )
     child.daemon = True
     child.start()
     sender.close()
@@ -259,10 +330,14 @@ def evaluate(
         return replace(head, status="no path", reason=answer.reason)
     if not isinstance(answer, Trajectory):
         return replace(head, reason=f"returned {type(answer).__name__}")
-    exact = problem.goal.contains(answer.end_state(problem.goal))
+    gap = float(np.linalg.norm(answer.positions[0] - problem.start.position))
+    lag = abs(float(answer.times[0] - problem.start.time))
+    starts = gap <= START_TOLERANCES[0] and lag <= START_TOLERANCES[1]
+    exact = starts and problem.goal.contains(answer.end_state(problem.goal))
     closest = path_clearance(answer, problem)
     return replace(
         head,
+        reason="" if starts else f"starts {gap:.3g} m and {lag:.3g} s from the start state",
         status="solved",
         exact=exact,
         approximate=not exact,
@@ -275,15 +350,22 @@ def evaluate(
     )
 
 
-def fly(document: ScenarioDocument, planner: str, seed: int, registry: PluginRegistry) -> Flight:
-    """Fly a problem's transfer scenario with ``planner`` (defaults) under world seed ``seed``.
+def fly(
+    document: ScenarioDocument,
+    planner: str,
+    seed: int,
+    registry: PluginRegistry,
+    params: Mapping[str, Any] | None = None,
+) -> Flight:
+    """Fly a problem's transfer scenario with ``planner`` (``params``, None for the
+    defaults) under world seed ``seed``.
 
     Collisions do not stop the flight, so that every one is counted.
     """
     flown = copy.deepcopy(document)
     for assignment in (
         f"path_planner.plugin={planner}",
-        "path_planner.params={}",
+        f"path_planner.params={json.dumps(dict(params or {}))}",
         f"world.seed={seed}",
         "stop.on_collision=false",
     ):
@@ -300,22 +382,26 @@ def fly(document: ScenarioDocument, planner: str, seed: int, registry: PluginReg
 
 def bench_problem(
     bench: BenchProblem,
-    planners: Sequence[RegisteredPlugin],
+    planners: Sequence[RegisteredPlugin | PlannerChoice],
     runs: int,
     flights: bool,
     registry: PluginRegistry,
     progress: Progress = print,
+    memory: bool = True,
 ) -> ProblemResult:
-    """Every planner on one problem, ``runs`` seeds each (0 to runs − 1)."""
+    """Every planner on one problem, ``runs`` seeds each (0 to runs − 1); ``memory``
+    traces a second call of each run for its peak memory."""
     started = time.strftime("%Y-%m-%d %H:%M:%S")
     began = time.perf_counter()
     results = []
-    for entry in planners:
+    for entry in map(planner_choice, planners):
+        params = dict(entry.params) or None
         for seed in range(runs):
-            answer, seconds, peak = plan_in_process(entry.cls, seed, bench.problem)
+            answer, seconds, peak = plan_in_process(entry.cls, seed, bench.problem, params, memory)
             run = evaluate(entry.name, bench, seed, answer, seconds, peak)
             if flights and run.status == "solved":
-                run = replace(run, flight=fly(bench.document, entry.name, seed, registry))
+                flight = fly(bench.document, entry.plugin, seed, registry, params)
+                run = replace(run, flight=flight)
             results.append(run)
             progress(
                 f"{bench.name} {entry.name} seed {seed}: {run.status} "
@@ -324,32 +410,52 @@ def bench_problem(
     return ProblemResult(bench, results, time.perf_counter() - began, started)
 
 
-def select_planners(
-    registry: PluginRegistry, names: Sequence[str] | None
-) -> list[RegisteredPlugin]:
+def select_planners(registry: PluginRegistry, names: Sequence[str] | None) -> list[PlannerChoice]:
     """The named path planners, or every registered one (in name order) when None.
+
+    A name may carry parameters, each as ``:key=value`` (the value read as YAML):
+    ``ompl-control:controls=discrete:planner=est``.
 
     Raises
     ------
     DcsimError
-        If a name is unknown or ambiguous, or no path planner is registered.
+        If a name is unknown or ambiguous, a parameter is malformed or invalid, or no
+        path planner is registered.
     """
     if names is None:
-        chosen = sorted(registry.plugins("path_planner"), key=lambda entry: entry.name)
+        chosen = [
+            PlannerChoice(entry)
+            for entry in sorted(registry.plugins("path_planner"), key=lambda entry: entry.name)
+        ]
     else:
-        chosen = [registry.get("path_planner", name) for name in names]
+        chosen = [_choice(registry, name) for name in names]
     if not chosen:
         raise DcsimError("no path planner is installed")
     return chosen
 
 
+def _choice(registry: PluginRegistry, spec: str) -> PlannerChoice:
+    """The planner and parameters of ``NAME[:key=value...]``."""
+    name, *assignments = spec.split(":")
+    params = {}
+    for assignment in assignments:
+        key, equals, value = assignment.partition("=")
+        if not equals or not key:
+            raise DcsimError(f"'{assignment}' in '{spec}' is not key=value")
+        params[key] = yaml.safe_load(value)
+    choice = PlannerChoice(registry.get("path_planner", name), params)
+    choice.settings()  # an invalid parameter is an error now, not in every run
+    return choice
+
+
 def bench_path_planners(
     problems: Sequence[BenchProblem],
-    planners: Sequence[RegisteredPlugin],
+    planners: Sequence[RegisteredPlugin | PlannerChoice],
     runs: int,
     flights: bool,
     registry: PluginRegistry,
     progress: Progress = print,
+    memory: bool = True,
 ) -> list[ProblemResult]:
     """Every planner on every problem, ``runs`` seeds each, problem by problem."""
-    return [bench_problem(p, planners, runs, flights, registry, progress) for p in problems]
+    return [bench_problem(p, planners, runs, flights, registry, progress, memory) for p in problems]

@@ -13,6 +13,12 @@ acceleration; a 1.5 m goal 60 m away, planning budget 1 s):
   about a 400 km orbit (σ = 0.02 m/s per axis), the transfer along-track;
 - ``shapes``: 16 boxes and cylinders of random size and orientation, at rest.
 
+and the escape experiment of the kinodynamic RRT course project (source 002):
+
+- ``asteroid-escape``: ``scenarios/asteroid_escape.yaml`` (a 1 kg ship, 0.5 N thrust,
+  up 19 m above a 40 m force field and out through its bottom) with 40 asteroids drawn
+  from the seed (:mod:`dcsim.bench.asteroids`) and a 10 s planning budget.
+
 Obstacles start in a slab 10–50 m along the way, ±15 m across, none within 2 m of the
 start or of the goal region.
 """
@@ -20,13 +26,14 @@ start or of the goal region.
 from __future__ import annotations
 
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from dcsim.bench.asteroids import escape_scenario
 from dcsim.errors import DcsimError
 from dcsim.messages import PathProblem, RobotState
 from dcsim.missions.transfer import transfer_problem
@@ -193,6 +200,7 @@ FAMILIES: dict[str, Callable[[int], dict[str, Any]]] = {
     "static-spheres": static_spheres,
     "cw-spheres": cw_spheres,
     "shapes": shapes,
+    "asteroid-escape": escape_scenario,
 }
 """The random families by name: each gives a transfer scenario's data for a seed."""
 
@@ -230,6 +238,19 @@ def _family_spec(spec: str) -> tuple[str, int] | None:
     if match is None or match[1] not in FAMILIES:
         return None
     return match[1], int(match[2] or 0)
+
+
+def expand_specs(specs: Sequence[str]) -> list[str]:
+    """Problem specs with every ``FAMILY:A..B`` replaced by ``FAMILY:A`` to ``FAMILY:B``."""
+    expanded = []
+    for spec in specs:
+        match = re.fullmatch(r"([a-z-]+):(\d+)\.\.(\d+)", spec)
+        if match is None or match[1] not in FAMILIES:
+            expanded.append(spec)
+            continue
+        first, last = int(match[2]), int(match[3])
+        expanded += [f"{match[1]}:{seed}" for seed in range(first, last + 1)]
+    return expanded
 
 
 def load_problem(spec: str) -> BenchProblem:

@@ -39,7 +39,13 @@ import numpy as np
 from dcsim import __version__
 from dcsim.bench.figures import pyplot, save
 from dcsim.bench.ompl_log import Experiment, PlannerBlock, Value, benchmark_log
-from dcsim.bench.path_planners import STATUSES, PlanRun, ProblemResult
+from dcsim.bench.path_planners import (
+    STATUSES,
+    PlannerChoice,
+    PlanRun,
+    ProblemResult,
+    planner_choice,
+)
 from dcsim.messages import PathProblem
 from dcsim.registry import RegisteredPlugin
 
@@ -93,7 +99,9 @@ def statistic_property(name: str) -> str:
     return "planner " + " ".join(re.findall(r"[0-9A-Za-z]+", name))
 
 
-def planner_block(entry: RegisteredPlugin, runs: Sequence[PlanRun], flights: bool) -> PlannerBlock:
+def planner_block(
+    entry: RegisteredPlugin | PlannerChoice, runs: Sequence[PlanRun], flights: bool
+) -> PlannerBlock:
     """One planner's runs on one problem as a block of the log."""
     statistics = sorted({name for run in runs for name in run.statistics})
     properties = [*_RUN_PROPERTIES, *((statistic_property(n), "REAL") for n in statistics)]
@@ -103,10 +111,9 @@ def planner_block(entry: RegisteredPlugin, runs: Sequence[PlanRun], flights: boo
     for run in runs:
         row = _run_values(run) + [run.statistics.get(name) for name in statistics]
         rows.append(row + _flight_values(run) if flights else row)
-    defaults = entry.cls.Params.parse(entry.name, None).model_dump(mode="json")
     settings = {
         "distribution": f"{entry.origin.distribution} {entry.origin.version}",
-        **{name: str(value) for name, value in defaults.items()},
+        **{name: str(value) for name, value in planner_choice(entry).settings().items()},
     }
     return PlannerBlock(entry.name, settings, properties, rows)
 
@@ -147,13 +154,16 @@ def _machine() -> str:
 
 
 def experiment(
-    result: ProblemResult, planners: Sequence[RegisteredPlugin], runs: int, flights: bool
+    result: ProblemResult,
+    planners: Sequence[RegisteredPlugin | PlannerChoice],
+    runs: int,
+    flights: bool,
 ) -> Experiment:
     """One problem's runs as an OMPL experiment."""
     problem = result.problem.problem
     blocks = [
         planner_block(entry, [r for r in result.runs if r.planner == entry.name], flights)
-        for entry in planners
+        for entry in map(planner_choice, planners)
     ]
     return Experiment(
         name=result.problem.name,
@@ -224,6 +234,55 @@ def markdown_table(results: Sequence[ProblemResult], flights: bool) -> str:
     return "\n".join(lines)
 
 
+def _family(name: str) -> str:
+    """A problem's family: its name without a trailing ``-SEED``."""
+    return re.sub(r"-\d+$", "", name)
+
+
+def _percentile(values: Sequence[float], q: float, scale: float = 1.0) -> str:
+    finite = [v for v in values if math.isfinite(v)]
+    return f"{scale * float(np.percentile(finite, q)):.1f}" if finite else "–"
+
+
+def family_table(results: Sequence[ProblemResult], flights: bool) -> str:
+    """Per problem family and planner, over all its problems and runs: success count,
+    planning time (median, 95th percentile), the statistics ``nodes_added`` and
+    ``iterations`` (medians, where the planner reports them), and the trajectory's
+    duration and delta-v (medians over successes); with flights, how many reached the
+    goal and how many collided."""
+    header = (
+        "| family | planner | runs | success | time median [ms] | time p95 [ms] "
+        "| nodes added median | iterations median | duration median [s] "
+        "| delta-v median [m/s] |"
+    )
+    rule = "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+    if flights:
+        header += " flown to the goal | flights with a collision |"
+        rule += "---:|---:|"
+    groups: dict[tuple[str, str], list[PlanRun]] = {}
+    for result in results:
+        for run in result.runs:
+            groups.setdefault((_family(result.problem.name), run.planner), []).append(run)
+    lines = [header, rule]
+    for (family, planner), runs in groups.items():
+        won = [r for r in runs if r.success]
+        line = (
+            f"| {family} | {planner} | {len(runs)} | {len(won)} "
+            f"| {_median([r.time for r in runs], 1e3, 1)} "
+            f"| {_percentile([r.time for r in runs], 95, 1e3)} "
+            f"| {_median([r.statistics.get('nodes_added', math.nan) for r in runs], digits=0)} "
+            f"| {_median([r.statistics.get('iterations', math.nan) for r in runs], digits=0)} "
+            f"| {_median([r.duration for r in won], digits=1)} "
+            f"| {_median([r.delta_v for r in won])} |"
+        )
+        if flights:
+            flown = [r.flight for r in runs if r.flight is not None]
+            reached = sum(f.reached and not f.collisions for f in flown)
+            line += f" {reached} / {len(flown)} | {sum(f.collisions > 0 for f in flown)} |"
+        lines.append(line)
+    return "\n".join(lines)
+
+
 def _flight_cells(flights: list) -> str:
     if not flights:
         return " – | – | – | – |"
@@ -264,7 +323,7 @@ def plot(results: Sequence[ProblemResult], path: Path) -> None:
 
 def write_logs(
     results: Sequence[ProblemResult],
-    planners: Sequence[RegisteredPlugin],
+    planners: Sequence[RegisteredPlugin | PlannerChoice],
     runs: int,
     flights: bool,
     base: Path,

@@ -153,18 +153,20 @@ def _feed_controller(plugin: Controller, inputs: list) -> list:
     return [plugin.command(*tick) for tick in ticks]
 
 
-def _path_inputs(empty: bool) -> list:
+def _path_inputs(empty: bool, plugin_class: type[Plugin] | None) -> list:
     problem = problems.path_problem()
+    if plugin_class is not None:
+        problem = problems.posed(plugin_class, problem)
     if empty:
         problem = dataclasses.replace(problem, obstacles=(), bounds=None)
     return [problem]
 
 
-_INPUTS: dict[str, Callable[[bool], list]] = {
-    "localiser": _localiser_inputs,
-    "task_planner": lambda empty: [problems.task_request(targets=0 if empty else 6)],
+_INPUTS: dict[str, Callable[[bool, Any], list]] = {
+    "localiser": lambda empty, _: _localiser_inputs(empty),
+    "task_planner": lambda empty, _: [problems.task_request(targets=0 if empty else 6)],
     "path_planner": _path_inputs,
-    "controller": _controller_inputs,
+    "controller": lambda empty, _: _controller_inputs(empty),
 }
 _FEEDS: dict[str, Callable[[Any, list], list]] = {
     "localiser": _feed_localiser,
@@ -174,9 +176,12 @@ _FEEDS: dict[str, Callable[[Any, list], list]] = {
 }
 
 
-def standard_inputs(kind: str, empty: bool = False) -> list:
-    """The standard inputs of a kind (``empty``: no beacons, targets or obstacles)."""
-    return _INPUTS[kind](empty)
+def standard_inputs(
+    kind: str, empty: bool = False, plugin_class: type[Plugin] | None = None
+) -> list:
+    """The standard inputs of a kind (``empty``: no beacons, targets or obstacles), as
+    posed to ``plugin_class`` if given (:func:`dcsim.testing.problems.posed`)."""
+    return _INPUTS[kind](empty, plugin_class)
 
 
 def feed(plugin: Plugin, inputs: list) -> list:
@@ -301,8 +306,16 @@ def check_invalid_parameters(plugin_class: type[Plugin]) -> None:
     "two instances with the same seed, given the same inputs, give identical outputs",
 )
 def check_determinism(plugin_class: type[Plugin]) -> None:
-    first = run_plugin(plugin_class, standard_inputs(plugin_class.kind), "the standard problem")
-    second = run_plugin(plugin_class, standard_inputs(plugin_class.kind), "the standard problem")
+    first = run_plugin(
+        plugin_class,
+        standard_inputs(plugin_class.kind, plugin_class=plugin_class),
+        "the standard problem",
+    )
+    second = run_plugin(
+        plugin_class,
+        standard_inputs(plugin_class.kind, plugin_class=plugin_class),
+        "the standard problem",
+    )
     if not _same(first, second):
         i = _first_difference(first, second)
         fail(
@@ -315,7 +328,7 @@ def check_determinism(plugin_class: type[Plugin]) -> None:
     "every input (lists, messages and their arrays) is unchanged after the plugin used it",
 )
 def check_no_mutation(plugin_class: type[Plugin]) -> None:
-    inputs = standard_inputs(plugin_class.kind)
+    inputs = standard_inputs(plugin_class.kind, plugin_class=plugin_class)
     pristine = copy.deepcopy(inputs)
     run_plugin(plugin_class, inputs, "the standard problem")
     given, kept = _flatten(inputs), _flatten(pristine)
@@ -371,7 +384,9 @@ def _check_output(kind: str, output: Any) -> str | None:
 )
 def check_outputs(plugin_class: type[Plugin]) -> None:
     for output in run_plugin(
-        plugin_class, standard_inputs(plugin_class.kind), "the standard problem"
+        plugin_class,
+        standard_inputs(plugin_class.kind, plugin_class=plugin_class),
+        "the standard problem",
     ):
         problem = _check_output(plugin_class.kind, output)
         if problem:
@@ -406,7 +421,9 @@ def check_public_api(plugin_class: type[Plugin]) -> None:
 )
 def check_empty_inputs(plugin_class: type[Plugin]) -> None:
     outputs = run_plugin(
-        plugin_class, standard_inputs(plugin_class.kind, empty=True), "empty inputs"
+        plugin_class,
+        standard_inputs(plugin_class.kind, empty=True, plugin_class=plugin_class),
+        "empty inputs",
     )
     for output in outputs:
         problem = _check_output(plugin_class.kind, output)

@@ -185,6 +185,8 @@ _BUDGET_PROBLEMS: dict[str, Callable[[float], object]] = {
 )
 def check_budget(plugin_class: type[Plugin]) -> None:
     request = _BUDGET_PROBLEMS[plugin_class.kind](0.3)
+    if plugin_class.kind == "path_planner":
+        request = problems.posed(plugin_class, request)
     plugin = make(plugin_class)
     start = time.perf_counter()
     plugin.plan(request)
@@ -199,6 +201,7 @@ def check_budget(plugin_class: type[Plugin]) -> None:
 def _path(
     plugin_class: type[Plugin], problem: PathProblem, what: str
 ) -> tuple[Trajectory, PathProblem]:
+    problem = problems.posed(plugin_class, problem)
     result = run_plugin(plugin_class, [problem], what)[0]
     if not isinstance(result, Trajectory):
         fail(f"found no path on {what}, which has one: {result!r}")
@@ -256,7 +259,7 @@ def check_endpoints(plugin_class: type[Plugin]) -> None:
         (problems.path_problem(), "the standard path problem"),
         (problems.arrival_problem(), "the arrival problem"),
     ):
-        trajectory, _ = _path(plugin_class, problem, what)
+        trajectory, problem = _path(plugin_class, problem, what)
         _check_start(trajectory, problem.start, what)
         final = trajectory.end_state(problem.goal)
         if not problem.goal.contains(final):
@@ -370,7 +373,7 @@ def _describe(result: object) -> str:
 )
 def check_impossible(plugin_class: type[Plugin]) -> None:
     for what, build in _IMPOSSIBLE:
-        problem = build(1.0)
+        problem = problems.posed(plugin_class, build(1.0))
         start = time.perf_counter()
         result = run_plugin(plugin_class, [problem], f"a problem with {what}")[0]
         elapsed = time.perf_counter() - start
@@ -378,6 +381,34 @@ def check_impossible(plugin_class: type[Plugin]) -> None:
             fail(f"answered {_describe(result)} for {what}")
         if elapsed > 1.2 * problem.time_budget + TIME_SLACK:
             fail(f"took {elapsed:.3f} s with a budget of {problem.time_budget} s for {what}")
+
+
+_STATIC_ONLY_TEXT = "static obstacles only (`handles_moving_obstacles = False`)"
+
+
+@contract(
+    "declares_obstacle_motion",
+    "a planner that handles moving obstacles (the default) is held to the checks above on "
+    "the standard problems as they are; one that declares it handles "
+    f"{_STATIC_ONLY_TEXT} gets every path check above with the obstacles held still where "
+    "they are at the start, and must answer the standard problem, whose obstacles move, "
+    "with NoPath whose reason names the moving obstacles, within its time budget",
+    kinds=("path_planner",),
+)
+def check_obstacle_motion(plugin_class: type[Plugin]) -> None:
+    if getattr(plugin_class, "handles_moving_obstacles", True):
+        return  # the checks above posed it the moving obstacles
+    problem = problems.path_problem()
+    start = time.perf_counter()
+    result = run_plugin(plugin_class, [problem], "the standard path problem")[0]
+    elapsed = time.perf_counter() - start
+    if not isinstance(result, NoPath) or "moving" not in result.reason:
+        fail(
+            f"declares it handles {_STATIC_ONLY_TEXT} but answered {_describe(result)} "
+            "for the standard problem, whose obstacles move (a NoPath naming them is expected)"
+        )
+    if elapsed > 1.2 * problem.time_budget + TIME_SLACK:
+        fail(f"took {elapsed:.3f} s with a budget of {problem.time_budget} s to refuse")
 
 
 # --------------------------------------------------------------------- controller

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from dcsim.interfaces import Plugin
 from dcsim.messages import (
     BeaconRange,
     Bounds,
@@ -278,3 +279,30 @@ def outside_bounds_problem(time_budget: float = 1.0) -> PathProblem:
     problem = path_problem(time_budget)
     goal = dataclasses.replace(problem.goal, position=[80.0, 5.0, 0.0])
     return dataclasses.replace(problem, goal=goal)
+
+
+def held_still(problem: PathProblem) -> PathProblem:
+    """``problem`` with every obstacle held at rest where it is at the start time."""
+    t = problem.start.time
+    still = []
+    for track in problem.obstacles:
+        position = track.predict(t)[0]
+        still.append(
+            dataclasses.replace(
+                track,
+                time=t,
+                position=position,
+                velocity=(0.0, 0.0, 0.0),
+                motion=StaticMotion(position),
+            )
+        )
+    return dataclasses.replace(problem, obstacles=tuple(still))
+
+
+def posed(plugin_class: type[Plugin], problem: PathProblem) -> PathProblem:
+    """A path problem as the conformance suite poses it to ``plugin_class``: unchanged, or
+    with its obstacles held still (:func:`held_still`) for a planner that declares it
+    handles static obstacles only (``handles_moving_obstacles = False``)."""
+    if getattr(plugin_class, "handles_moving_obstacles", True):
+        return problem
+    return held_still(problem)

@@ -61,8 +61,20 @@ class StraightLineParams(PluginParams):
     )
 
 
-class _Profile:
-    """Trapezoidal distance ``s(τ)`` over ``[0, T]``: ramps at ``a``, cruise at ``v``."""
+class Profile:
+    """Trapezoidal distance ``s(τ)`` over ``[0, T]``: ramps at ``a``, cruise at ``v``.
+
+    Parameters
+    ----------
+    length : float
+        Distance covered, m.
+    duration : float
+        ``T``, s.
+    speed : float
+        Cruise speed ``v``, m/s.
+    acceleration : float
+        Ramp acceleration ``a``, m/s² (``inf``: no ramps).
+    """
 
     def __init__(self, length: float, duration: float, speed: float, acceleration: float) -> None:
         self.length, self.duration, self.speed = length, duration, speed
@@ -157,7 +169,7 @@ class StraightLinePlanner(PathPlanner):
             duration=profile.duration,
         )
 
-    def _profile(self, problem: PathProblem, headroom: float) -> _Profile | NoPath:
+    def _profile(self, problem: PathProblem, headroom: float) -> Profile | NoPath:
         """The speed profile in the goal's frame: length, duration, cruise speed."""
         start, goal = problem.start, problem.goal
         accel = problem.max_acceleration
@@ -177,7 +189,7 @@ class StraightLinePlanner(PathPlanner):
                     f"reaching the goal by t = {goal.time:g} s needs {float(needed):.4g} s at the "
                     f"speed and acceleration limits, only {duration:.4g} s are left"
                 )
-            return _Profile(length, max(duration, _MIN_DURATION), speed, accel)
+            return Profile(length, max(duration, _MIN_DURATION), speed, accel)
         limit = self.params.speed_fraction * headroom
         duration = 0.0
         for _ in range(50):  # the goal's own motion during the flight moves the aim point
@@ -190,7 +202,7 @@ class StraightLinePlanner(PathPlanner):
             if converged:
                 break
         speed = limit if np.isinf(accel) else min(limit, float(np.sqrt(accel * length)))
-        return _Profile(length, max(duration, _MIN_DURATION), speed, accel)
+        return Profile(length, max(duration, _MIN_DURATION), speed, accel)
 
     def _first_conflict(
         self, problem: PathProblem, times: np.ndarray, path: np.ndarray

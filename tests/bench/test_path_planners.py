@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import signal
 import sqlite3
@@ -12,21 +13,26 @@ import tracemalloc
 
 import numpy as np
 import pytest
+import yaml
 from click.testing import CliRunner
 from dcsim_plugins.path_planners.straight_line import StraightLinePlanner
 
 from dcsim.bench import path_reports
+from dcsim.bench.asteroids import escape_scenario
 from dcsim.bench.ompl_log import write_database
 from dcsim.bench.path_planners import (
     PlanRun,
     bench_path_planners,
     evaluate,
     plan_in_process,
+    select_planners,
 )
-from dcsim.bench.path_problems import load_problem
+from dcsim.bench.path_problems import expand_specs, load_problem
 from dcsim.cli import cli
+from dcsim.errors import DcsimError
 from dcsim.messages import NoPath, Trajectory
-from dcsim.registry import PluginOrigin, RegisteredPlugin
+from dcsim.registry import PluginOrigin, PluginRegistry, RegisteredPlugin
+from tests.conftest import REPO
 
 
 def entry(cls) -> RegisteredPlugin:
@@ -236,3 +242,78 @@ def test_the_command_refuses_unknown_planners_and_problems():
     assert unknown.exit_code == 2 and "no path_planner plugin named 'rrt-nope'" in unknown.output
     bad = CliRunner().invoke(cli, ["bench", "path-planners", "--problems", "mars:x"])
     assert bad.exit_code == 2 and "'mars:x' is neither a problem family" in bad.output
+
+
+# ----------------------------------------------------------------- variants and families
+
+
+def test_planners_can_be_named_with_parameters():
+    registry = PluginRegistry.discover()
+    plain, tuned = select_planners(
+        registry, ["straight-line", "straight-line:clearance=1.5:check_obstacles=false"]
+    )
+    assert (plain.name, tuned.name) == (
+        "straight-line",
+        "straight-line:clearance=1.5:check_obstacles=False",
+    )
+    assert tuned.params == {"clearance": 1.5, "check_obstacles": False}
+    assert tuned.settings()["clearance"] == 1.5 and plain.settings()["clearance"] == 0.5
+    for spec in ("straight-line:clearance", "straight-line:clearance=-1"):
+        with pytest.raises(DcsimError):
+            select_planners(registry, [spec])
+
+
+def test_a_planners_parameters_reach_its_runs(quick):
+    tuned = select_planners(PluginRegistry.discover(), ["straight-line:speed_fraction=0.4"])
+    plain = select_planners(PluginRegistry.discover(), ["straight-line"])
+    (result,) = bench_path_planners([quick], [*plain, *tuned], 1, False, None, lambda _: None)
+    slow, fast = result.runs[1], result.runs[0]
+    assert slow.planner == "straight-line:speed_fraction=0.4"
+    assert slow.duration > 1.5 * fast.duration
+
+
+def test_seed_ranges_expand_and_the_escape_family_is_the_scenario_file():
+    assert expand_specs(["asteroid-escape:3..5", "shapes", "x.yaml"]) == [
+        "asteroid-escape:3",
+        "asteroid-escape:4",
+        "asteroid-escape:5",
+        "shapes",
+        "x.yaml",
+    ]
+    scenario = yaml.safe_load((REPO / "scenarios" / "asteroid_escape.yaml").read_text())
+    family = escape_scenario(2023)
+    for key in ("world", "robot", "obstacles", "path_planner", "controller", "stop"):
+        assert family[key] == scenario[key], key
+    assert family["mission"] == {**scenario["mission"], "planning_budget": 10.0}
+    assert escape_scenario(1)["obstacles"] != family["obstacles"]
+
+
+def test_the_family_table_pools_a_familys_problems(quick):
+    other = dataclasses.replace(quick, name="static-spheres-1")
+    planners = [entry(StraightLinePlanner)]
+    results = bench_path_planners([quick, other], planners, 2, False, None, lambda _: None)
+    table = path_reports.family_table(results, flights=False).splitlines()
+    assert table[0].startswith("| family | planner | runs | success | time median [ms] |")
+    assert table[2].startswith("| static-spheres | straight-line | 4 | 4 |")
+    assert table[2].endswith("| – | – | 91.0 | 1.60 |")  # no statistics; 60 m in 91 s
+
+
+def test_memory_tracing_can_be_left_out(quick):
+    answer, seconds, peak = plan_in_process(StraightLinePlanner, 0, quick.problem, memory=False)
+    assert isinstance(answer, Trajectory) and seconds > 0 and math.isnan(peak)
+
+
+class MisplacedPlanner(StraightLinePlanner):
+    name = "misplaced"
+    summary = "Starts its trajectory 1 m off the start (test)"
+
+    def plan(self, problem):
+        trajectory = super().plan(problem)
+        return dataclasses.replace(trajectory, positions=trajectory.positions + [0.0, 1.0, 0.0])
+
+
+def test_a_trajectory_that_does_not_start_at_the_start_is_no_success(quick):
+    answer, seconds, peak = plan_in_process(MisplacedPlanner, 0, quick.problem, memory=False)
+    run = evaluate("misplaced", quick, 0, answer, seconds, peak)
+    assert run.status == "solved" and not run.exact and not run.success
+    assert run.reason == "starts 1 m and 0 s from the start state"

@@ -15,7 +15,7 @@ from dcsim_plugins.localisers.trilateration import TrilaterationLocaliser
 from dcsim_plugins.path_planners.straight_line import StraightLinePlanner
 from dcsim_plugins.task_planners.nearest import NearestTaskPlanner
 
-from dcsim.api import Command, GoalRegion, PluginRegistry, ShapeKind
+from dcsim.api import Command, GoalRegion, NoPath, PluginRegistry, ShapeKind
 from dcsim.testing import CheckResult, ControllerContract, check_plugin, checks_for
 from tests.testing.peeking_plugin import PeekingController
 
@@ -169,6 +169,24 @@ class SlowPathPlanner(StraightLinePlanner):
         return super().plan(problem)
 
 
+class StillnessPathPlanner(StraightLinePlanner):
+    name = "stillness"
+    summary = "Plans among static obstacles only, and says so (test)"
+    handles_moving_obstacles = False
+
+    def plan(self, problem):
+        moving = [o.id for o in problem.obstacles if np.any(o.predict(problem.start.time + 1.0)[1])]
+        if moving:
+            return NoPath(f"obstacles {moving} are moving")
+        return super().plan(problem)
+
+
+class BoastfulPathPlanner(StraightLinePlanner):
+    name = "boastful"
+    summary = "Declares it handles static obstacles only, then plans among moving ones (test)"
+    handles_moving_obstacles = False
+
+
 # SlowPlanner's checks sleep through its budgets for some 15 s: the tests reading them
 # share one pass, in one pytest-xdist worker.
 SHARES_SLOW_CHECKS = pytest.mark.xdist_group("slow-planner-checks")
@@ -196,6 +214,7 @@ def results_of(plugin: type) -> dict[str, CheckResult]:
         (ShortcutPathPlanner, {"collision_free"}),
         (StartBlindPathPlanner, {"answers_no_path"}),
         (SlowPathPlanner, {"honours_time_budget"}),
+        (BoastfulPathPlanner, {"declares_obstacle_motion"}),
         (PeekingController, {"uses_only_the_public_api"}),
     ],
     ids=lambda value: getattr(value, "name", None) or "-".join(sorted(value)),
@@ -230,6 +249,16 @@ def test_path_planner_messages_say_what_the_plugin_did():
     assert "for a start inside obstacle 9" in blind["answers_no_path"].message
     hurried = {r.check: r for r in check_plugin(HurriedPathPlanner)}
     assert "exceeds 0.5 m/s" in hurried["respects_limits"].message
+
+
+def test_a_static_only_planner_is_checked_on_still_obstacles_and_on_its_refusal():
+    results = results_of(StillnessPathPlanner)
+    # this test module itself imports more of dcsim than dcsim.api
+    failed = {name for name, r in results.items() if not r.passed}
+    assert failed == {"uses_only_the_public_api"}, results
+    boastful = results_of(BoastfulPathPlanner)["declares_obstacle_motion"].message
+    assert "answered a trajectory ending at" in boastful
+    assert "whose obstacles move" in boastful
 
 
 def test_a_class_that_is_no_plugin_fails_only_the_metadata_check():
