@@ -85,11 +85,23 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
+from dcsim_plugins.path_planners.closing_manoeuvre import Closing, ClosingManoeuvre
 from dcsim_plugins.path_planners.ompl_support import (
     ObstacleField,
     endpoint_refusal,
     in_worker,
     seed_ompl,
+)
+from dcsim_plugins.path_planners.rigid_body import (
+    DIMENSION,
+    DV,
+    Model,
+    P,
+    Q,
+    T,
+    V,
+    W,
+    state_vector,
 )
 from ompl import base as ob
 from ompl import control as oc
@@ -110,17 +122,11 @@ from dcsim.api import (
     rotation_vector,
 )
 
-DIMENSION = 15
-"""State vector length: p (3), q (4, ``[x, y, z, w]``), v (3), ω (3), t, Δv."""
-P, Q, V, W, T, DV = slice(0, 3), slice(3, 7), slice(7, 10), slice(10, 13), 13, 14
 SOURCE_BOX = (np.array([-16.0, -8.0, -25.0]), np.array([16.0, 8.0, 25.0]))
 """The source's position sampling box, m."""
 SOURCE_SPEED, SOURCE_RATE = 5.0, 2.0
 """The source's velocity (m/s) and angular-velocity (rad/s) sampling half-ranges."""
-_FORCE_SET = (1.0, -1.0, 0.0)  # along the body z axis, per unit force
-_TORQUE_SET = ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1), (0, 0, 0))
 _RESERVE = 0.05  # s of the budget kept for expanding and returning the solution
-_DURATIONS = np.geomspace(1.0, 2000.0, 48)  # closing-manoeuvre durations tried, in steps
 
 
 class OmplControlParams(PluginParams):
@@ -183,160 +189,6 @@ class OmplControlParams(PluginParams):
         return value
 
 
-# ------------------------------------------------------------------ the model
-
-
-def discrete_control(first: float, second: float) -> tuple[int, int]:
-    """Indices into the source's force and torque sets of a control sampled in
-    ``[0, 3) × [0, 7)``: each component floored and kept inside its set."""
-    return min(max(int(first), 0), 2), min(max(int(second), 0), 6)
-
-
-def _clip(x: float, y: float, z: float, limit: float) -> tuple[float, float, float]:
-    """``(x, y, z)`` scaled back onto the ball of radius ``limit`` if longer."""
-    norm = math.sqrt(x * x + y * y + z * z)
-    if norm <= limit:
-        return x, y, z
-    s = limit / norm
-    return x * s, y * s, z * s
-
-
-@dataclass(frozen=True)
-class Model:
-    """Eq. 2 with its control magnitudes: everything a propagation step needs.
-
-    Attributes
-    ----------
-    acceleration : float
-        Thrust acceleration magnitude, m/s².
-    torque : float
-        Torque magnitude, N·m.
-    mass : float
-        kg.
-    inertia : tuple of float
-        Principal moments, kg·m².
-    discrete : bool
-        The source's control sets, else continuous controls.
-    rk4 : bool
-        RK4 steps, else Euler.
-    mean_motion : float
-        Clohessy–Wiltshire mean motion, rad/s (0 for an inertial frame).
-    """
-
-    acceleration: float
-    torque: float
-    mass: float
-    inertia: tuple[float, float, float]
-    discrete: bool
-    rk4: bool
-    mean_motion: float
-
-    @property
-    def control_dimension(self) -> int:
-        """Length of the real control vector OMPL samples."""
-        return 2 if self.discrete else 6
-
-    def control_bounds(self) -> tuple[list[float], list[float]]:
-        """Lower and upper bounds of the sampled control vector."""
-        if self.discrete:
-            return [0.0, 0.0], [3.0, 7.0]
-        a, tau = self.acceleration, self.torque
-        return [-a, -a, -a, -tau, -tau, -tau], [a, a, a, tau, tau, tau]
-
-    def wrench(self, u: tuple[float, ...], q: tuple[float, ...]) -> tuple[float, ...]:
-        """Thrust acceleration (m/s², world) and torque (N·m, world) of control ``u`` at
-        attitude ``q``, as ``(ax, ay, az, τx, τy, τz)``."""
-        if self.discrete:
-            i, j = discrete_control(u[0], u[1])
-            f = _FORCE_SET[i] * self.acceleration
-            x, y, z, w = q
-            tx, ty, tz = _TORQUE_SET[j]
-            tau = self.torque
-            return (
-                2.0 * (x * z + y * w) * f,
-                2.0 * (y * z - x * w) * f,
-                (1.0 - 2.0 * (x * x + y * y)) * f,
-                tx * tau,
-                ty * tau,
-                tz * tau,
-            )
-        return (
-            *_clip(u[0], u[1], u[2], self.acceleration),
-            *_clip(u[3], u[4], u[5], self.torque),
-        )
-
-    def derivative(self, x: list[float], wrench: tuple[float, ...]) -> list[float]:
-        """Eq. 2: the time derivative of the state vector ``x`` under ``wrench``
-        (:meth:`wrench`, recomputed at ``x``'s attitude for a body-fixed thrust)."""
-        qx, qy, qz, qw = x[3], x[4], x[5], x[6]
-        wx, wy, wz = x[10], x[11], x[12]
-        ax, ay, az, tx, ty, tz = wrench
-        # ω̇ = R I⁻¹ Rᵀ τ: torque to body axes, divide, back to the world
-        r00, r01, r02 = (
-            1 - 2 * (qy * qy + qz * qz),
-            2 * (qx * qy - qz * qw),
-            2 * (qx * qz + qy * qw),
-        )
-        r10, r11, r12 = (
-            2 * (qx * qy + qz * qw),
-            1 - 2 * (qx * qx + qz * qz),
-            2 * (qy * qz - qx * qw),
-        )
-        r20, r21, r22 = (
-            2 * (qx * qz - qy * qw),
-            2 * (qy * qz + qx * qw),
-            1 - 2 * (qx * qx + qy * qy),
-        )
-        i0, i1, i2 = self.inertia
-        b0 = (r00 * tx + r10 * ty + r20 * tz) / i0
-        b1 = (r01 * tx + r11 * ty + r21 * tz) / i1
-        b2 = (r02 * tx + r12 * ty + r22 * tz) / i2
-        vx, vy, vz = x[7], x[8], x[9]
-        n = self.mean_motion
-        if n:
-            ax, ay, az = ax + 3 * n * n * x[0] + 2 * n * vy, ay - 2 * n * vx, az - n * n * x[2]
-        thrust = math.sqrt(wrench[0] ** 2 + wrench[1] ** 2 + wrench[2] ** 2)
-        return [
-            vx,
-            vy,
-            vz,
-            0.5 * (qw * wx + wy * qz - wz * qy),
-            0.5 * (qw * wy + wz * qx - wx * qz),
-            0.5 * (qw * wz + wx * qy - wy * qx),
-            -0.5 * (wx * qx + wy * qy + wz * qz),
-            ax,
-            ay,
-            az,
-            r00 * b0 + r01 * b1 + r02 * b2,
-            r10 * b0 + r11 * b1 + r12 * b2,
-            r20 * b0 + r21 * b1 + r22 * b2,
-            1.0,
-            thrust,
-        ]
-
-    def step(self, x: list[float], u: tuple[float, ...], dt: float) -> list[float]:
-        """The state ``dt`` s after ``x`` under control ``u`` (one Euler or RK4 step);
-        the quaternion comes out unit."""
-        k1 = self.derivative(x, self.wrench(u, x[3:7]))
-        if self.rk4:
-            y = [a + 0.5 * dt * b for a, b in zip(x, k1, strict=True)]
-            k2 = self.derivative(y, self.wrench(u, y[3:7]))
-            y = [a + 0.5 * dt * b for a, b in zip(x, k2, strict=True)]
-            k3 = self.derivative(y, self.wrench(u, y[3:7]))
-            y = [a + dt * b for a, b in zip(x, k3, strict=True)]
-            k4 = self.derivative(y, self.wrench(u, y[3:7]))
-            h = dt / 6.0
-            new = [
-                a + h * (b + 2 * c + 2 * d + e)
-                for a, b, c, d, e in zip(x, k1, k2, k3, k4, strict=True)
-            ]
-        else:
-            new = [a + dt * b for a, b in zip(x, k1, strict=True)]
-        norm = math.sqrt(new[3] ** 2 + new[4] ** 2 + new[5] ** 2 + new[6] ** 2)
-        new[3], new[4], new[5], new[6] = new[3] / norm, new[4] / norm, new[5] / norm, new[6] / norm
-        return new
-
-
 def make_model(params: OmplControlParams, problem: PathProblem) -> Model:
     """The model of ``params`` with the thrust and torque the problem's limits allow."""
     acceleration = problem.max_acceleration
@@ -356,21 +208,6 @@ def make_model(params: OmplControlParams, problem: PathProblem) -> Model:
         params.integrator == "rk4",
         n,
     )
-
-
-def state_vector(problem: PathProblem) -> list[float]:
-    """The start's state vector (p, q, v, ω, t, Δv = 0), quaternion normalised."""
-    start = problem.start
-    q = np.asarray(start.attitude, dtype=float)
-    q = q / np.linalg.norm(q)
-    return [
-        *map(float, start.position),
-        *map(float, q),
-        *map(float, start.velocity),
-        *map(float, start.angular_velocity),
-        float(start.time),
-        0.0,
-    ]
 
 
 # ------------------------------------------------------------------ validity
@@ -435,150 +272,6 @@ class StateCheck:
 
 
 # ------------------------------------------------------------------ the closing manoeuvre
-
-
-def _rotation(r: np.ndarray) -> np.ndarray:
-    """Unit quaternions ``[x, y, z, w]`` of rotation vectors ``r`` (..., 3), rad."""
-    angle = np.linalg.norm(r, axis=-1, keepdims=True)
-    half = 0.5 * angle
-    scale = np.where(angle > 1e-12, np.sin(half) / np.where(angle > 1e-12, angle, 1.0), 0.5)
-    return np.concatenate([scale * r, np.cos(half)], axis=-1)
-
-
-def _cubic(
-    start: np.ndarray, rate0: np.ndarray, end: np.ndarray, rate1: np.ndarray, tau: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Cubic Hermite from ``(start, rate0)`` at 0 to ``(end, rate1)`` at ``tau[-1]``:
-    values, rates at ``tau`` (k,) and the second derivatives at both ends (2, 3)."""
-    span = tau[-1]
-    c2 = (3 * (end - start) - (2 * rate0 + rate1) * span) / span**2
-    c3 = (2 * (start - end) + (rate0 + rate1) * span) / span**3
-    s = tau[:, None]
-    values = start + rate0 * s + c2 * s**2 + c3 * s**3
-    rates = rate0 + 2 * c2 * s + 3 * c3 * s**2
-    return values, rates, np.array([2 * c2, 2 * c2 + 6 * c3 * span])
-
-
-@dataclass(frozen=True)
-class Closing:
-    """A closing manoeuvre: state vectors at every step (the first is the node's) and the
-    thrust acceleration (m/s²) and angular acceleration (rad/s²) over each step."""
-
-    states: np.ndarray
-    accelerations: np.ndarray
-    angular_accelerations: np.ndarray
-
-
-class ClosingManoeuvre:
-    """Cubic manoeuvres from a tree node into the goal region (see the module docstring).
-
-    Parameters
-    ----------
-    problem : PathProblem
-        The goal, limits and frame.
-    check : StateCheck
-        Validity of every step of the manoeuvre.
-    model : Model
-        Thrust and torque limits.
-    step : float
-        Spacing of the manoeuvre's samples, s.
-    """
-
-    def __init__(self, problem: PathProblem, check: StateCheck, model: Model, step: float) -> None:
-        self.goal, self.check, self.step = problem.goal, check, step
-        self.acceleration = model.acceleration * (1 - 1e-9)
-        inertia_max = max(model.inertia)
-        self.angular = min(problem.max_angular_acceleration, model.torque / inertia_max)
-        self.speed = problem.max_speed
-        self.inertial = model.mean_motion == 0.0
-        self.attempts = 0
-
-    def aim(self, p0: np.ndarray) -> np.ndarray:
-        """The point aimed at: ``p0`` pulled into the inner half of the goal region, m."""
-        goal = self.goal
-        offset = p0 - goal.position
-        if goal.half_extents is None:
-            norm = float(np.linalg.norm(offset))
-            half = 0.5 * goal.tolerance
-            return goal.position + (offset if norm <= half else offset * (half / norm))
-        return goal.position + np.clip(offset, -0.5 * goal.half_extents, 0.5 * goal.half_extents)
-
-    def __call__(self, x: list[float]) -> Closing | None:
-        """A valid manoeuvre from state vector ``x`` into the goal, or None."""
-        if not self.inertial:
-            return None  # the cubic ignores the Clohessy–Wiltshire terms
-        self.attempts += 1
-        goal, a = self.goal, np.asarray(x)
-        p0, v0 = a[P], a[V]
-        p1 = self.aim(p0)
-        if goal.time is not None:
-            spans = np.array([goal.time - a[T]])
-        else:
-            spans = self.step * _DURATIONS
-        spans = spans[spans >= self.step]
-        for ends in self._end_velocities(p0, v0, p1, spans):
-            feasible = np.flatnonzero(self._feasible(p0, v0, p1, ends, spans))
-            closing = None
-            if len(feasible):
-                closing = self._build(a, p1, ends[feasible[0]], float(spans[feasible[0]]))
-            if closing is not None:
-                return closing
-        return None
-
-    def _end_velocities(
-        self, p0: np.ndarray, v0: np.ndarray, p1: np.ndarray, spans: np.ndarray
-    ) -> list[np.ndarray]:
-        """The end velocities (k, 3) m/s tried for each duration of ``spans`` (k,) s: the
-        goal's, or, when it leaves the velocity free, the node's own and then the one of
-        constant acceleration."""
-        count = len(spans)
-        if math.isfinite(self.goal.velocity_tolerance):
-            return [np.broadcast_to(self.goal.velocity, (count, 3))]
-        return [np.broadcast_to(v0, (count, 3)), 2 * (p1 - p0) / spans[:, None] - v0]
-
-    def _feasible(
-        self, p0: np.ndarray, v0: np.ndarray, p1: np.ndarray, v1: np.ndarray, spans: np.ndarray
-    ) -> np.ndarray:
-        """Which cubics of durations ``spans`` (k,) s, ending at velocities ``v1`` (k, 3)
-        m/s, keep within the acceleration limit at their ends (where it peaks) and the
-        speed limit at nine points."""
-        s = spans[:, None]
-        drift = (p1 - p0) / s**2
-        first = 6 * drift - (4 * v0 + 2 * v1) / s
-        last = -6 * drift + (2 * v0 + 4 * v1) / s
-        peak = np.maximum(np.linalg.norm(first, axis=1), np.linalg.norm(last, axis=1))
-        c2 = 3 * drift - (2 * v0 + v1) / s
-        c3 = (v0 + v1) / s**2 - 2 * drift / s
-        tau = np.linspace(0.0, 1.0, 9)[None, :, None] * s[:, :, None]
-        velocities = v0 + 2 * c2[:, None, :] * tau + 3 * c3[:, None, :] * tau**2
-        speeds = np.linalg.norm(velocities, axis=2)
-        return (peak <= self.acceleration) & (speeds.max(axis=1) <= self.speed)
-
-    def _build(self, a: np.ndarray, p1: np.ndarray, v1: np.ndarray, span: float) -> Closing | None:
-        """The manoeuvre of duration ``span`` s from state vector ``a``, or None if it
-        breaks a limit or meets an obstacle."""
-        count = max(1, math.ceil(span / self.step - 1e-9))
-        tau = np.linspace(0.0, span, count + 1)
-        positions, velocities, _ = _cubic(a[P], a[V], p1, v1, tau)
-        q0, w0 = a[Q], a[W]
-        if self.goal.attitude is None:
-            turn, w1 = w0 * span, w0
-        else:
-            error = quaternion_multiply(self.goal.attitude, quaternion_conjugate(q0))
-            turn, w1 = rotation_vector(error), np.zeros(3)
-        angles, rates, spins = _cubic(np.zeros(3), w0, turn, w1, tau)
-        if np.linalg.norm(spins, axis=1).max() > self.angular * (1 + 1e-9):
-            return None
-        attitudes = quaternion_multiply(_rotation(angles), q0)
-        steps = np.diff(velocities, axis=0)
-        spent = np.concatenate([[0.0], np.cumsum(np.linalg.norm(steps, axis=1))])
-        states = np.column_stack(
-            [positions, attitudes, velocities, rates, a[T] + tau, a[DV] + spent]
-        )
-        if not self.check.all_valid(states[1:]):
-            return None
-        durations = np.diff(tau)[:, None]
-        return Closing(states, steps / durations, np.diff(rates, axis=0) / durations)
 
 
 # ------------------------------------------------------------------ OMPL

@@ -11,13 +11,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from dcsim_plugins.path_planners.ompl_control import (
-    Model,
-    OmplControlParams,
-    OmplControlPlanner,
-    discrete_control,
-)
+from dcsim_plugins.path_planners.ompl_control import OmplControlParams, OmplControlPlanner
 from dcsim_plugins.path_planners.ompl_support import in_worker, seed_ompl
+from dcsim_plugins.path_planners.rigid_body import Model, discrete_control
 
 from dcsim.api import (
     Bounds,
