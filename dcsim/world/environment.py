@@ -126,6 +126,4 @@ class Propellant:
         self.used += used
         self.delta_v += magnitude * dt * float(fractions.sum()) / mass
         self.last_acceleration = force * (fractions.mean() / mass)
-        if fractions.min() == 1.0:  # the usual case: thrust held over the whole period
-            return [tuple(float(f) for f in force)] * steps
-        return [tuple(float(f) for f in force * k) for k in fractions]
+        return [tuple(thrust) for thrust in np.outer(fractions, force).tolist()]
