@@ -18,19 +18,16 @@ from dcsim_plugins.path_planners.rigid_body import Model, discrete_control
 from dcsim.api import (
     Bounds,
     GoalRegion,
-    LinearMotion,
     NoPath,
-    ObjectKind,
-    ObjectTrack,
     PathProblem,
     PluginParameterError,
     RobotState,
-    StaticMotion,
     Trajectory,
     path_clearance,
     rotate,
 )
 from dcsim.bench.path_problems import load_problem
+from dcsim.testing.problems import obstacle_track
 
 ESCAPE = Path(__file__).resolve().parents[2] / "scenarios" / "asteroid_escape.yaml"
 
@@ -102,15 +99,7 @@ def test_discrete_force_pushes_along_the_body_z_axis():
 
 def small_problem(time_budget=5.0, obstacles=None):
     """A 12 m hop past a sphere in a tight box (fast dynamics: a few thousand steps)."""
-    sphere = ObjectTrack(
-        1,
-        ObjectKind.OBSTACLE,
-        0.0,
-        (6, 0, 0),
-        (0, 0, 0),
-        radius=2.0,
-        motion=StaticMotion((6, 0, 0)),
-    )
+    sphere = obstacle_track(1, (6.0, 0.0, 0.0), radius=2.0)
     return PathProblem(
         start=RobotState(time=0.0, position=[0.0, 0.0, 0.0]),
         goal=GoalRegion(position=[12.0, 0.0, 0.0], tolerance=1.5),
@@ -126,15 +115,7 @@ def small_problem(time_budget=5.0, obstacles=None):
 def upward_problem():
     """A 12 m climb along z beside a sphere: the source's thrust along the body z axis
     reaches it without turning."""
-    sphere = ObjectTrack(
-        1,
-        ObjectKind.OBSTACLE,
-        0.0,
-        (3, 0, 6),
-        (0, 0, 0),
-        radius=2.0,
-        motion=StaticMotion((3, 0, 6)),
-    )
+    sphere = obstacle_track(1, (3.0, 0.0, 6.0), radius=2.0)
     return dataclasses.replace(
         small_problem(obstacles=(sphere,)),
         goal=GoalRegion(position=[0.0, 0.0, 12.0], tolerance=1.5),
@@ -206,15 +187,7 @@ def test_the_closing_manoeuvre_arrives_at_rest_turned_on_time():
 
 def test_the_budget_is_honoured_and_an_unreachable_goal_is_no_path():
     wall = tuple(
-        ObjectTrack(
-            10 + i,
-            ObjectKind.OBSTACLE,
-            0.0,
-            c,
-            (0, 0, 0),
-            radius=2.0,
-            motion=StaticMotion(c),
-        )
+        obstacle_track(10 + i, c, radius=2.0)
         for i, c in enumerate(
             [(12 + dx, dy, dz) for dx, dy, dz in np.vstack([np.eye(3), -np.eye(3)]) * 3.2]
         )
@@ -253,15 +226,7 @@ def test_parameters_hold_the_sources_values_by_default():
 
 def test_moving_obstacles_are_checked_where_they_are_at_each_states_time():
     # a sphere crossing the way at 0.5 m/s, at the middle about when a direct flight passes
-    crossing = ObjectTrack(
-        2,
-        ObjectKind.OBSTACLE,
-        0.0,
-        (6.0, -4.0, 0.0),
-        (0.0, 0.5, 0.0),
-        radius=1.0,
-        motion=LinearMotion((6.0, -4.0, 0.0), (0.0, 0.5, 0.0)),
-    )
+    crossing = obstacle_track(2, (6.0, -4.0, 0.0), velocity=(0.0, 0.5, 0.0), radius=1.0)
     problem = small_problem(obstacles=(crossing,))
     for connect_radius in (0.0, 50.0):
         trajectory = plan(problem, connect_radius=connect_radius)

@@ -11,32 +11,20 @@ from dcsim_plugins.path_planners.ompl_geometric import MOVING_REFUSAL, OmplGeome
 from dcsim.api import (
     Bounds,
     GoalRegion,
-    LinearMotion,
     NoPath,
-    ObjectKind,
-    ObjectTrack,
     PathProblem,
     RobotState,
     Shape,
     ShapeKind,
-    StaticMotion,
     Trajectory,
     path_clearance,
 )
+from dcsim.testing.problems import obstacle_track
 
 
-def track(obstacle_id, position, radius=2.0, shape=None, velocity=(0.0, 0.0, 0.0)):
-    motion = LinearMotion(position, velocity) if any(velocity) else StaticMotion(position)
-    return ObjectTrack(
-        obstacle_id,
-        ObjectKind.OBSTACLE,
-        0.0,
-        position,
-        velocity,
-        radius=0.0 if shape else radius,
-        motion=motion,
-        shape=shape,
-    )
+def track(obstacle_id, position, **properties):
+    """An obstacle track, a sphere of radius 2 m unless ``properties`` say otherwise."""
+    return obstacle_track(obstacle_id, position, **{"radius": 2.0, **properties})
 
 
 WALL = Shape(ShapeKind.BOX, half_extents=(0.5, 6.0, 6.0))
@@ -88,7 +76,7 @@ def test_same_seed_same_path(default_plan):
 
 
 @pytest.mark.parametrize("planner", ["rrt", "rrtstar", "informed-rrtstar", "sorrtstar"])
-def test_every_planner_constructs_and_solves(planner, default_plan):
+def test_every_planner_constructs_and_solves(planner):
     p = problem()
     trajectory = plan(p, planner=planner, optimise_for=0.05)
     assert isinstance(trajectory, Trajectory), trajectory
