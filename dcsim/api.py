@@ -36,7 +36,7 @@ Kinematics
 Geometry
     :func:`spherical_to_cartesian`, :func:`quaternion_between`, :func:`rotate`, :func:`unit`,
     :func:`clip_norm`, :func:`quaternion_multiply`, :func:`quaternion_conjugate`,
-    :func:`rotation_vector`, :func:`slerp`.
+    :func:`rotation_vector`, :func:`quaternion_from_rotation_vector`, :func:`slerp`.
 FMUs (FMI 2.0 co-simulation, through fmpy)
     :class:`FmuDescription`, :class:`FmuInstance`, :class:`FmuError`,
     :class:`FmuCallError`.
@@ -69,6 +69,7 @@ from dcsim.geometry import (
     clip_norm,
     quaternion_between,
     quaternion_conjugate,
+    quaternion_from_rotation_vector,
     quaternion_multiply,
     rotate,
     rotation_vector,
@@ -182,6 +183,7 @@ __all__ = [
     "quantity",
     "quaternion_between",
     "quaternion_conjugate",
+    "quaternion_from_rotation_vector",
     "quaternion_multiply",
     "Reference",
     "resolution_step",

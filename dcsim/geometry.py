@@ -128,6 +128,16 @@ def rotation_vector(q: ArrayLike) -> Vector:
     return q[..., :3] * scale
 
 
+def quaternion_from_rotation_vector(r: ArrayLike) -> Vector:
+    """Unit quaternion ``[x, y, z, w]`` of rotation vector(s) ``r`` (..., 3) (axis times
+    angle, rad); the inverse of :func:`rotation_vector` for angles up to π."""
+    r = np.asarray(r, dtype=float)
+    angle = np.linalg.norm(r, axis=-1, keepdims=True)
+    half = 0.5 * angle
+    scale = np.where(angle > _EPS, np.sin(half) / np.maximum(angle, _EPS), 0.5)
+    return np.concatenate([scale * r, np.cos(half)], axis=-1)
+
+
 def slerp(q0: ArrayLike, q1: ArrayLike, fraction: ArrayLike) -> Vector:
     """Spherical linear interpolation between unit quaternions, along the shorter arc.
 

@@ -23,7 +23,9 @@ from dcsim.api import (
     StateEstimate,
     Trajectory,
     quaternion_between,
+    quaternion_from_rotation_vector,
     rotate,
+    rotation_vector,
 )
 
 
@@ -74,6 +76,14 @@ def test_quaternion_between_rotates_a_onto_b(a, b):
     assert np.linalg.norm(q) == pytest.approx(1.0)
     rotated = rotate(q, np.asarray(a, float) / np.linalg.norm(a))
     np.testing.assert_allclose(rotated, np.asarray(b, float) / np.linalg.norm(b), atol=1e-12)
+
+
+def test_rotation_vectors_become_scipys_quaternions_and_back():
+    vectors = np.vstack([np.random.default_rng(4).normal(size=(50, 3)), np.zeros((1, 3))])
+    vectors[:50] *= 3.0 / np.linalg.norm(vectors[:50], axis=1, keepdims=True)  # angles < π
+    quaternions = quaternion_from_rotation_vector(vectors)
+    np.testing.assert_allclose(quaternions, Rotation.from_rotvec(vectors).as_quat(), atol=1e-12)
+    np.testing.assert_allclose(rotation_vector(quaternions), vectors, atol=1e-12)
 
 
 def test_trajectory_samples_linearly_and_holds_at_the_ends():

@@ -11,20 +11,18 @@ from typing import TYPE_CHECKING
 import numpy as np
 from dcsim_plugins.path_planners.rigid_body import DV, Model, P, Q, T, V, W
 
-from dcsim.api import PathProblem, quaternion_conjugate, quaternion_multiply, rotation_vector
+from dcsim.api import (
+    PathProblem,
+    quaternion_conjugate,
+    quaternion_from_rotation_vector,
+    quaternion_multiply,
+    rotation_vector,
+)
 
 if TYPE_CHECKING:
     from dcsim_plugins.path_planners.ompl_control import StateCheck
 
 _DURATIONS = np.geomspace(1.0, 2000.0, 48)  # durations tried, in steps
-
-
-def _rotation(r: np.ndarray) -> np.ndarray:
-    """Unit quaternions ``[x, y, z, w]`` of rotation vectors ``r`` (..., 3), rad."""
-    angle = np.linalg.norm(r, axis=-1, keepdims=True)
-    half = 0.5 * angle
-    scale = np.where(angle > 1e-12, np.sin(half) / np.where(angle > 1e-12, angle, 1.0), 0.5)
-    return np.concatenate([scale * r, np.cos(half)], axis=-1)
 
 
 def _cubic(
@@ -151,7 +149,7 @@ class ClosingManoeuvre:
         angles, rates, spins = _cubic(np.zeros(3), w0, turn, w1, tau)
         if np.linalg.norm(spins, axis=1).max() > self.angular * (1 + 1e-9):
             return None
-        attitudes = quaternion_multiply(_rotation(angles), q0)
+        attitudes = quaternion_multiply(quaternion_from_rotation_vector(angles), q0)
         steps = np.diff(velocities, axis=0)
         spent = np.concatenate([[0.0], np.cumsum(np.linalg.norm(steps, axis=1))])
         states = np.column_stack(
