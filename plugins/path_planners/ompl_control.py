@@ -86,12 +86,11 @@ from typing import Any, Literal
 
 import numpy as np
 from dcsim_plugins.path_planners.closing_manoeuvre import Closing, ClosingManoeuvre
-from dcsim_plugins.path_planners.ompl_support import (
+from dcsim_plugins.path_planners.obstacle_field import (
     ObstacleField,
     endpoint_refusal,
-    in_worker,
-    seed_ompl,
 )
+from dcsim_plugins.path_planners.ompl_support import in_worker, seed_ompl
 from dcsim_plugins.path_planners.rigid_body import (
     DIMENSION,
     DV,

@@ -43,13 +43,12 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from dcsim_plugins.path_planners.ompl_support import (
+from dcsim_plugins.path_planners.obstacle_field import (
     ObstacleField,
     endpoint_refusal,
     free_goal_point,
-    in_worker,
-    seed_ompl,
 )
+from dcsim_plugins.path_planners.ompl_support import in_worker, seed_ompl
 from dcsim_plugins.path_planners.straight_line import Profile
 from ompl import base as ob
 from ompl import geometric as og

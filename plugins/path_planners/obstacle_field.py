@@ -1,0 +1,182 @@
+"""Obstacles of a path problem, for fast "is the robot clear here?" tests, and endpoint checks.
+
+Not a plugin itself; the path planners of this package share it.
+
+:class:`ObstacleField`
+    Is a robot sphere at a point and time clear of every obstacle's true shape? A
+    vectorised bounding-sphere test over all obstacles first, then the exact distance
+    (``dcsim.api.body_surface_distance``, in the shape's frame) for the few boxes and
+    cylinders whose bounding sphere is touched. Obstacles in straight-line or no motion
+    (``StaticMotion``, ``LinearMotion`` or none) are predicted in closed form, others
+    by ``predict``.
+:func:`endpoint_refusal`
+    "No path" with a reason when the start is outside the bounds or inside an obstacle,
+    or when every probe point of the goal region is.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dcsim.api import (
+    LinearMotion,
+    NoPath,
+    PathProblem,
+    ShapeKind,
+    StaticMotion,
+    body_surface_distance,
+    quaternion_conjugate,
+    rotate,
+)
+
+
+class ObstacleField:
+    """The obstacles of a path problem, for fast "is this robot sphere clear?" tests.
+
+    Parameters
+    ----------
+    problem : PathProblem
+        Its obstacles (true shapes and predicted motion) and ``robot_radius``.
+    clearance : float
+        Margin kept beyond the robot radius, m.
+    """
+
+    def __init__(self, problem: PathProblem, clearance: float) -> None:
+        self.tracks = problem.obstacles
+        self.count = len(self.tracks)
+        self.reach = problem.robot_radius + clearance
+        affine = [_is_affine(track.motion) for track in self.tracks]
+        self.affine = np.flatnonzero(affine)
+        self.curved = [i for i, ok in enumerate(affine) if not ok]
+        start = [track.predict(0.0) for track in self.tracks]
+        self.origin = np.array([p for p, _ in start], dtype=float).reshape(-1, 3)
+        self.velocity = np.array([v for _, v in start], dtype=float).reshape(-1, 3)
+        self.moving = bool(self.curved) or bool(np.any(self.velocity != 0.0))
+        self.static_centres = self.origin.copy()
+        self.bounding = np.array([t.radius for t in self.tracks], dtype=float)
+        self.round = np.array([t.shape.kind is ShapeKind.SPHERE for t in self.tracks], dtype=bool)
+        self.to_body = [  # world-to-body rotation matrices (fixed while the obstacles move)
+            rotate(quaternion_conjugate(t.shape.orientation), np.eye(3)).T for t in self.tracks
+        ]
+        self.max_obstacle_speed = self._fastest(problem)
+
+    def _fastest(self, problem: PathProblem) -> float:
+        """Largest obstacle speed over the next hour from the start, m/s (sampled each
+        second for curved motion)."""
+        speeds = [0.0]
+        if len(self.affine):
+            speeds.append(float(np.linalg.norm(self.velocity[self.affine], axis=1).max()))
+        times = problem.start.time + np.arange(0.0, 3600.0, 1.0)
+        for i in self.curved:
+            speeds.append(float(np.linalg.norm(self.tracks[i].predict(times)[1], axis=1).max()))
+        return max(speeds)
+
+    def centres(self, t: float) -> np.ndarray:
+        """Obstacle centres at time ``t`` (s), (n, 3) m."""
+        if not self.moving:
+            return self.static_centres
+        centres = self.velocity * t
+        centres += self.origin
+        for i in self.curved:
+            centres[i] = self.tracks[i].predict(t)[0]
+        return centres
+
+    def clear(self, x: float, y: float, z: float, t: float, margin: float = 0.0) -> bool:
+        """Whether the robot sphere at ``(x, y, z)`` (m) at time ``t`` (s), grown by
+        ``margin`` (m), is clear of every obstacle."""
+        return not self.count or self._first_hit(x, y, z, t, self.reach + margin) is None
+
+    def _first_hit(self, x: float, y: float, z: float, t: float, reach: float) -> int | None:
+        """Index of an obstacle whose surface is nearer than ``reach`` (m) to ``(x, y, z)``
+        (m) at time ``t`` (s), or None."""
+        offsets = self.centres(t) - (x, y, z)
+        squares = offsets * offsets
+        gaps = np.sqrt(np.add.reduce(squares, axis=1))
+        gaps -= self.bounding
+        if np.minimum.reduce(gaps) >= reach:
+            return None
+        for i in np.flatnonzero(gaps < reach):
+            if self.round[i]:
+                return int(i)
+            body = self.to_body[i] @ -offsets[i]
+            if body_surface_distance(self.tracks[i].shape, body[None])[0] < reach:
+                return int(i)
+        return None
+
+    def clear_path(self, points: np.ndarray, times: np.ndarray, margins: np.ndarray) -> bool:
+        """Whether the robot sphere is clear at every one of ``points`` (k, 3) m at
+        ``times`` (k,) s, grown by ``margins`` (k,) m: bounding spheres of all obstacles
+        at all times at once, then exact shapes where a bounding sphere is touched."""
+        if not self.count:
+            return True
+        centres = self.origin[None] + self.velocity[None] * times[:, None, None]
+        for i in self.curved:
+            centres[:, i] = self.tracks[i].predict(times)[0]
+        reach = self.reach + margins
+        gaps = np.linalg.norm(centres - points[:, None], axis=2) - self.bounding
+        near = gaps < reach[:, None]
+        for i in np.flatnonzero(near.any(axis=0)):
+            if self.round[i]:
+                return False
+            rows = near[:, i]
+            body = (points[rows] - centres[rows, i]) @ self.to_body[i].T
+            exact = body_surface_distance(self.tracks[i].shape, body)
+            if np.any(exact < reach[rows]):
+                return False
+        return True
+
+    def blocker(self, point: np.ndarray, t: float) -> int | None:
+        """Id of an obstacle the robot sphere at ``point`` (m) at ``t`` (s) overlaps."""
+        if not self.count:
+            return None
+        hit = self._first_hit(*map(float, point), t, self.reach)
+        return None if hit is None else self.tracks[hit].id
+
+
+def _is_affine(motion: object) -> bool:
+    """Whether a motion model is a straight line at constant velocity (or rest)."""
+    return motion is None or isinstance(motion, (StaticMotion, LinearMotion))
+
+
+def goal_probes(problem: PathProblem) -> np.ndarray:
+    """Points of the goal region: its centre, the ends of its axes and, for a box, its
+    corners and the middles of its edges and faces, (k, 3) m."""
+    goal = problem.goal
+    if goal.half_extents is None:
+        offsets = np.vstack([np.zeros(3), np.eye(3), -np.eye(3)]) * goal.tolerance
+    else:
+        grid = np.array(np.meshgrid([0, -1, 1], [0, -1, 1], [0, -1, 1], indexing="ij"))
+        offsets = grid.reshape(3, -1).T * goal.half_extents
+    return goal.position + offsets
+
+
+def endpoint_refusal(problem: PathProblem, field: ObstacleField) -> NoPath | None:
+    """NoPath if the start is outside the bounds or inside an obstacle, or if every probe
+    point of the goal region (:func:`goal_probes`) is outside the bounds or inside an
+    obstacle (at the goal's time, or the start's); None otherwise."""
+    start, bounds = problem.start, problem.bounds
+    if bounds is not None and not bool(bounds.contains(start.position)):
+        return NoPath("the start is outside the bounds")
+    hit = field.blocker(start.position, start.time)
+    if hit is not None:
+        return NoPath(f"the start is inside obstacle {hit} (robot radius and clearance included)")
+    probes = goal_probes(problem)
+    if bounds is not None:
+        probes = probes[bounds.contains(probes)]
+        if not len(probes):
+            return NoPath("the goal region is outside the bounds")
+    t = problem.goal.time if problem.goal.time is not None else start.time
+    blockers = [field.blocker(p, t) for p in probes]
+    if all(b is not None for b in blockers):
+        return NoPath(f"the goal region is inside obstacle {blockers[0]}")
+    return None
+
+
+def free_goal_point(problem: PathProblem, field: ObstacleField) -> np.ndarray | None:
+    """The first probe point of the goal region that is in bounds and clear, m."""
+    t = problem.goal.time if problem.goal.time is not None else problem.start.time
+    for point in goal_probes(problem):
+        inside = problem.bounds is None or bool(problem.bounds.contains(point))
+        if inside and field.blocker(point, t) is None:
+            return point
+    return None
