@@ -158,6 +158,8 @@ class PathProblem(Message):
         The free dynamics of the planning frame.
     robot_radius : float
         Radius of the robot's bounding sphere, m.
+    robot_mass : float or None
+        The robot's mass, kg, for planners that give feed-forward forces; None if unknown.
     max_speed : float
         Speed limit, m/s.
     max_acceleration : float
@@ -181,6 +183,7 @@ class PathProblem(Message):
     obstacles: tuple[ObjectTrack, ...] = ()
     frame: FrameDynamics = field(default_factory=FrameDynamics)
     robot_radius: float = 0.0
+    robot_mass: float | None = None
     max_speed: float = 1.0
     max_acceleration: float = _INF
     max_delta_v: float = _INF

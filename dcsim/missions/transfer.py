@@ -322,6 +322,7 @@ def transfer_problem(
         obstacles=obstacles,
         frame=scenario.frame_dynamics,
         robot_radius=robot.radius,
+        robot_mass=robot.mass,
         max_speed=robot.max_speed,
         max_acceleration=settings.acceleration_fraction * robot.max_force / robot.mass,
         max_delta_v=max_delta_v,

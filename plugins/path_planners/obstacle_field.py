@@ -125,6 +125,63 @@ class ObstacleField:
                 return False
         return True
 
+    @property
+    def resting_indices(self) -> np.ndarray:
+        """Indices of the obstacles at rest."""
+        resting = np.zeros(self.count, dtype=bool)
+        resting[self.affine] = ~np.any(self.velocity[self.affine] != 0.0, axis=1)
+        return np.flatnonzero(resting)
+
+    @property
+    def moving_indices(self) -> np.ndarray:
+        """Indices of the obstacles that move."""
+        return np.setdiff1d(np.arange(self.count), self.resting_indices)
+
+    def clear_arcs(
+        self, points: np.ndarray, times: np.ndarray, margins: np.ndarray, which: np.ndarray
+    ) -> np.ndarray:
+        """Whether each arc is clear: the robot sphere at every sample of arc ``a``, grown
+        by ``margins[a]``, against the obstacles ``which``.
+
+        Parameters
+        ----------
+        points : ndarray (m, s, 3)
+            ``s`` samples of each of ``m`` arcs, m.
+        times : ndarray (m, s)
+            Their times, s.
+        margins : ndarray (m,)
+            Growth of the robot's sphere on each arc, m.
+        which : ndarray of int
+            Indices of the obstacles to check (:attr:`resting_indices`, :attr:`moving_indices`).
+
+        Returns
+        -------
+        ndarray of bool (m,)
+        """
+        clear = np.ones(len(points), dtype=bool)
+        if not len(which):
+            return clear
+        centres = self.origin[which] + self.velocity[which] * times[..., None, None]
+        for column, i in enumerate(which):
+            if i in self.curved:
+                centres[:, :, column] = (
+                    self.tracks[i].predict(times.ravel())[0].reshape(points.shape)
+                )
+        reach = (self.reach + margins)[:, None]
+        offsets = points[:, :, None, :] - centres
+        gaps = np.linalg.norm(offsets, axis=-1) - self.bounding[which]
+        near = gaps < reach[..., None]
+        for column in np.flatnonzero(near.any(axis=(0, 1))):
+            i = which[column]
+            arcs, samples = np.nonzero(near[:, :, column])
+            if self.round[i]:
+                clear[arcs] = False
+                continue
+            body = offsets[arcs, samples, column] @ self.to_body[i].T
+            exact = body_surface_distance(self.tracks[i].shape, body)
+            clear[arcs[exact < reach[arcs, 0]]] = False
+        return clear
+
     def blocker(self, point: np.ndarray, t: float) -> int | None:
         """Id of an obstacle the robot sphere at ``point`` (m) at ``t`` (s) overlaps."""
         if not self.count:
