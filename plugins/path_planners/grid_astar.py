@@ -84,6 +84,9 @@ PAPER_SPEEDS = (0.09, 0.19, 0.2)
 """The paper's least speed, largest speed and largest single delta-v, ft/s (Table 2)."""
 PAPER_STEPS_PER_CELL = 0.19 * 60.0 / 6.0
 """The paper's largest speed times its time step over its grid spacing (1.9)."""
+BURN_SHARE = 0.45
+"""Share of a derived time step that the burn from rest onto the slowest one-step move
+may take."""
 
 
 class GridAStarParams(PluginParams):
@@ -93,9 +96,9 @@ class GridAStarParams(PluginParams):
     ``v``: least speed ``0.09/0.19 v``, largest burn ``0.2/0.19 v`` (but at most what
     the problem's acceleration gives in half a time step, so that burns flown with
     finite thrust never overlap), grid spacing 6 ft and the time step that makes
-    ``v t = 1.9 d`` (the paper's 60 s at 0.19 ft/s). Where a burn of the least speed
-    would not fit in half of that step, the step grows until it does and the spacing
-    with it (``d = v t / 1.9``). At the paper's 0.19 ft/s this gives exactly its 6 ft,
+    ``v t = 1.9 d`` (the paper's 60 s at 0.19 ft/s). Where the burn from rest onto the slowest one-step
+    move (speed ``v / 1.9``) would take more than :data:`BURN_SHARE` of that step, the
+    step grows until it does not, and the spacing with it (``d = v t / 1.9``). At the paper's 0.19 ft/s this gives exactly its 6 ft,
     60 s, 0.09 ft/s and 0.2 ft/s.
     """
 
@@ -174,8 +177,9 @@ class GridSettings:
         if t is None:
             d = d if d is not None else 6 * FOOT
             t = PAPER_STEPS_PER_CELL * d / v
-            if params.distance_resolution is None and 2 * min_speed / a > t:
-                t = 2 * min_speed / a
+            slowest_step = v / PAPER_STEPS_PER_CELL  # speed of a one-cell, one-step move
+            if params.distance_resolution is None and slowest_step / (BURN_SHARE * a) > t:
+                t = slowest_step / (BURN_SHARE * a)
                 d = v * t / PAPER_STEPS_PER_CELL
         elif d is None:
             d = v * t / PAPER_STEPS_PER_CELL
