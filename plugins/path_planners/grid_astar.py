@@ -96,10 +96,11 @@ class GridAStarParams(PluginParams):
     ``v``: least speed ``0.09/0.19 v``, largest burn ``0.2/0.19 v`` (but at most what
     the problem's acceleration gives in half a time step, so that burns flown with
     finite thrust never overlap), grid spacing 6 ft and the time step that makes
-    ``v t = 1.9 d`` (the paper's 60 s at 0.19 ft/s). Where the burn from rest onto the slowest one-step
-    move (speed ``v / 1.9``) would take more than :data:`BURN_SHARE` of that step, the
-    step grows until it does not, and the spacing with it (``d = v t / 1.9``). At the paper's 0.19 ft/s this gives exactly its 6 ft,
-    60 s, 0.09 ft/s and 0.2 ft/s.
+    ``v t = 1.9 d`` (the paper's 60 s at 0.19 ft/s). Where the burn from rest onto the
+    slowest one-step move (speed ``v / 1.9``) would take more than :data:`BURN_SHARE` of
+    that step, the step grows until it does not, and the spacing with it
+    (``d = v t / 1.9``). At the paper's 0.19 ft/s this gives exactly its 6 ft, 60 s,
+    0.09 ft/s and 0.2 ft/s.
     """
 
     distance_resolution: float | None = quantity(
