@@ -585,6 +585,48 @@ def bench_fmu_command(scenario: Path | None, duration: float, repeats: int) -> N
     click.echo(markdown_table(result))
 
 
+@bench_group.command("grid-search")
+@click.option(
+    "--scenario",
+    type=click.Path(exists=True, dir_okay=False, path_type=Path),
+    default=Path("scenarios/station_inspection.yaml"),
+    show_default=True,
+    help="The station scenario the paper's three goals are posed in.",
+)
+@click.option(
+    "--budget",
+    type=click.FloatRange(min=0, min_open=True),
+    default=60.0,
+    show_default=True,
+    help="Planning budget of every cell, s.",
+)
+@click.option(
+    "--grid",
+    "grid_params",
+    default=None,
+    help="grid-astar's parameters as key=value:key=value (default: its defaults).",
+)
+@click.option("--fly", is_flag=True, help="Also fly every plan through the transfer mission.")
+def bench_grid_search_command(
+    scenario: Path, budget: float, grid_params: str | None, fly: bool
+) -> None:
+    """The Boeing paper's Tables 3 and 4 regenerated: grid-astar on three goals under five
+    weightings of delta-v and distance, beside the paper's figures, and multi-burn's
+    delta-v per goal. Prints Markdown tables for docs/benchmarks.md.
+    """
+    from dcsim.bench.grid_search import bench_grid_search, tables
+    from dcsim.bench.path_planners import planner_spec
+
+    registry = _registry()
+    params = None
+    if grid_params:
+        params = dict(planner_spec(registry, f"grid-astar:{grid_params}").params)
+    cells = bench_grid_search(
+        registry, scenario, budget, fly, lambda line: click.echo(line, err=True), params
+    )
+    click.echo(tables(cells))
+
+
 @bench_group.command("path-planners")
 @click.option(
     "--planners",

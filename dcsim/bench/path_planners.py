@@ -428,13 +428,13 @@ def select_planners(registry: PluginRegistry, names: Sequence[str] | None) -> li
             for entry in sorted(registry.plugins("path_planner"), key=lambda entry: entry.name)
         ]
     else:
-        chosen = [_choice(registry, name) for name in names]
+        chosen = [planner_spec(registry, name) for name in names]
     if not chosen:
         raise DcsimError("no path planner is installed")
     return chosen
 
 
-def _choice(registry: PluginRegistry, spec: str) -> PlannerChoice:
+def planner_spec(registry: PluginRegistry, spec: str) -> PlannerChoice:
     """The planner and parameters of ``NAME[:key=value...]``."""
     name, *assignments = spec.split(":")
     params = {}

@@ -189,13 +189,20 @@ class TransferMission(Mission):
         return self.reference
 
     def _feed_forward(self, trajectory: Trajectory, time: float) -> tuple[np.ndarray, np.ndarray]:
-        """Linear and angular acceleration of the segment flown at ``time`` (zero after it)."""
+        """Linear and angular acceleration that deliver, over the control period from
+        ``time``, the impulse the trajectory's forces and torques give in that period
+        (zero outside the trajectory): a burn that does not fill whole periods is neither
+        lengthened nor cut short."""
         zero = np.zeros(3)
         if not trajectory.times[0] <= time < trajectory.times[-1]:
             return zero, zero
-        segment = int(np.searchsorted(trajectory.times, time, side="right")) - 1
+        period = self.scenario.world.control_period
         spec = self.world.robot_spec()
-        acceleration = zero if trajectory.forces is None else trajectory.forces[segment] / spec.mass
+        acceleration = (
+            zero
+            if trajectory.forces is None
+            else _mean_over(trajectory, trajectory.forces, time, period) / spec.mass
+        )
         if trajectory.torques is None:
             return acceleration, zero
         attitude = (
@@ -205,7 +212,8 @@ class TransferMission(Mission):
         )
         rotation = np.column_stack([rotate(attitude, axis) for axis in np.eye(3)])
         inertia = rotation @ spec.inertia @ rotation.T
-        return acceleration, np.linalg.solve(inertia, trajectory.torques[segment])
+        torque = _mean_over(trajectory, trajectory.torques, time, period)
+        return acceleration, np.linalg.solve(inertia, torque)
 
     def _held_attitude(self) -> np.ndarray:
         """The attitude held when the trajectory leaves it free: the goal's, or the start's."""
@@ -356,6 +364,15 @@ def trajectory_csv(trajectory: Trajectory) -> str:
     for row in table:
         out.write(",".join("" if np.isnan(v) else repr(float(v)) for v in row) + "\n")
     return out.getvalue()
+
+
+def _mean_over(
+    trajectory: Trajectory, values: np.ndarray, start: float, period: float
+) -> np.ndarray:
+    """Mean over ``[start, start + period]`` (s) of per-segment ``values`` (held over each
+    segment of the trajectory, zero after its end)."""
+    overlap = np.diff(np.clip(trajectory.times, start, start + period))
+    return overlap @ values / period
 
 
 def _or_empty(values: np.ndarray | None, rows: int, width: int) -> np.ndarray:
