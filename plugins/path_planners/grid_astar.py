@@ -640,7 +640,7 @@ class GridAStarPlanner(PathPlanner):
             return answer
         statistics = search.statistics.as_dict(burns=len(answer.times))
         try:
-            return answer.trajectory(
+            flown = answer.trajectory(
                 problem.max_acceleration, problem.robot_mass, self.params.sample_step, statistics
             )
         except ValueError:
@@ -648,6 +648,13 @@ class GridAStarPlanner(PathPlanner):
                 f"the plan's burns take longer than its legs at "
                 f"{problem.max_acceleration:g} m/s²: lower max_burn or raise time_resolution"
             )
+        swept = self.params.collision == "swept"
+        if swept and not search.obstacles.clear_trajectory(flown, self.params.check_spacing):
+            return NoPath(
+                "the plan flown with finite burns cuts a corner into an obstacle: "
+                "raise clearance or lower max_burn"
+            )
+        return flown
 
 
 @hookimpl

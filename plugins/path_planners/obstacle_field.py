@@ -24,6 +24,7 @@ from dcsim.api import (
     PathProblem,
     ShapeKind,
     StaticMotion,
+    Trajectory,
     body_surface_distance,
     quaternion_conjugate,
     rotate,
@@ -181,6 +182,21 @@ class ObstacleField:
             exact = body_surface_distance(self.tracks[i].shape, body)
             clear[arcs[exact < reach[arcs, 0]]] = False
         return clear
+
+    def clear_trajectory(self, trajectory: Trajectory, spacing: float) -> bool:
+        """Whether the robot sphere is clear along a whole trajectory (positions linear
+        between its samples), checked at times over which robot and obstacles close by
+        at most ``spacing`` (m), each check's sphere grown by half of that."""
+        segments = np.linalg.norm(np.diff(trajectory.positions, axis=0), axis=1)
+        speed = float((segments / np.diff(trajectory.times)).max(initial=0.0))
+        closing = speed + self.max_obstacle_speed
+        span = float(trajectory.times[-1] - trajectory.times[0])
+        count = max(int(np.ceil(closing * span / spacing)), 1) + 1
+        times = np.union1d(
+            np.linspace(trajectory.times[0], trajectory.times[-1], count), trajectory.times
+        )
+        points, _ = trajectory.sample(times)
+        return self.clear_path(points, times, np.full(len(times), 0.5 * spacing))
 
     def blocker(self, point: np.ndarray, t: float) -> int | None:
         """Id of an obstacle the robot sphere at ``point`` (m) at ``t`` (s) overlaps."""

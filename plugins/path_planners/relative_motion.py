@@ -31,11 +31,14 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import optimize
 
 from dcsim.api import FrameDynamics, FrameKind, Trajectory
 
 _BURN_SAMPLES = 5
 """Trajectory samples across each finite burn (its position is quadratic in time)."""
+_NO_ARC = 1e3
+"""Residual of the burn fit where the burns would leave a leg no time."""
 _SHORTEST_BURN = 1e-3
 """Duration given to a burn when the acceleration is unlimited, s."""
 
@@ -243,8 +246,10 @@ class BurnPlan:
         joins the planned arcs exactly (about an orbit, up to the free motion's pull over
         the burn). The first burn starts at the start time and the last ends at the
         arrival time, so the first arc starts where the first burn ends and the last arc
-        ends where the last burn starts; both are solved again (a fixed point of five
-        iterations, burn duration and arc depending on each other).
+        ends where the last burn starts. Both arcs are solved again together with the two
+        burns' durations and end points (scipy's Levenberg–Marquardt ``root``): each burn
+        lasts what its velocity change needs at the limit, and its end lies where
+        constant thrust takes the robot.
 
         Returns
         -------
@@ -252,22 +257,39 @@ class BurnPlan:
             One per leg.
         """
         k = len(self.times) - 1
-        starts = [(float(self.times[i]), self.positions[i]) for i in range(k)]
-        ends = [(float(self.times[i + 1]), self.positions[i + 1]) for i in range(k)]
-        for _ in range(5):
+        inner = [(float(self.times[i]), self.positions[i]) for i in range(k + 1)]
+
+        def arcs(unknowns: np.ndarray) -> tuple[list, list]:
+            """Arc end points for the burn spans ``unknowns[:2]`` (s) and the first arc's
+            start and last arc's end ``unknowns[2:5]``, ``unknowns[5:]`` (m)."""
+            starts, ends = list(inner[:-1]), list(inner[1:])
+            starts[0] = (inner[0][0] + unknowns[0], unknowns[2:5])
+            ends[-1] = (inner[-1][0] - unknowns[1], unknowns[5:8])
+            return starts, ends
+
+        def mismatch(unknowns: np.ndarray) -> np.ndarray:
+            starts, ends = arcs(unknowns)
+            if any(b <= a for (a, _), (b, _) in zip(starts, ends, strict=True)):
+                return np.full(8, _NO_ARC)  # burns longer than a leg: far from a solution
             departure, arrival = self._solve(starts, ends)
-            first = departure[0] - self.start_velocity
-            span = _span(first, max_acceleration)
-            starts[0] = (
-                float(self.times[0]) + span,
-                self.positions[0] + 0.5 * span * (self.start_velocity + departure[0]),
+            first, last = departure[0], arrival[-1]
+            spans = [
+                _span(first - self.start_velocity, max_acceleration),
+                _span(self.goal_velocity - last, max_acceleration),
+            ]
+            start = inner[0][1] + 0.5 * unknowns[0] * (self.start_velocity + first)
+            end = inner[-1][1] - 0.5 * unknowns[1] * (last + self.goal_velocity)
+            return np.concatenate([spans - unknowns[:2], start - unknowns[2:5], end - unknowns[5:]])
+
+        departure, arrival = self._solve(inner[:-1], inner[1:])
+        guess = np.concatenate([[0.0, 0.0], inner[0][1], inner[-1][1]])
+        guess -= mismatch(guess)  # the impulsive burns' spans and the points they give
+        solution = optimize.root(mismatch, guess, method="lm", options={"xtol": 1e-14}).x
+        if np.abs(mismatch(solution)).max() > 1e-9:
+            raise ValueError(
+                "a leg is shorter than the burns at its ends (no fit for the first and last)"
             )
-            last = self.goal_velocity - arrival[-1]
-            span = _span(last, max_acceleration)
-            ends[-1] = (
-                float(self.times[-1]) - span,
-                self.positions[-1] - 0.5 * span * (arrival[-1] + self.goal_velocity),
-            )
+        starts, ends = arcs(solution)
         return [(a, p, b, q) for (a, p), (b, q) in zip(starts, ends, strict=True)]
 
     def _solve(
@@ -329,6 +351,8 @@ class BurnPlan:
             position, before = self.motion.propagate(
                 origins[i - 1], departure[i - 1], start - begins[i - 1]
             )
+            # the ramp starts from the arc's velocity half a burn early, not its arrival
+            span = _span(departure[i] - before, max_acceleration)
             ramps.append(_ramp(position, before, departure[i], start, start + span))
         last = legs[-1][3]
         ramps.append(_ramp(last, arrival[-1], self.goal_velocity, ends[-1], self.times[-1]))
@@ -346,6 +370,8 @@ class BurnPlan:
             )
             pieces.append(ramps[i + 1])
         times = np.concatenate([p[0] for p in pieces])
+        if np.any(np.diff(times) <= 0):
+            raise ValueError("burns overlap: a leg is shorter than the burns at its ends")
         positions = np.vstack([p[1] for p in pieces])
         accelerations = np.vstack([p[3] for p in pieces])[:-1]
         sizes = [float(np.linalg.norm(r[2][-1] - r[2][0])) for r in ramps]
