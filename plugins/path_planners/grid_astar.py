@@ -64,7 +64,12 @@ from typing import Literal
 
 import numpy as np
 from dcsim_plugins.path_planners.obstacle_field import ObstacleField, endpoint_refusal
-from dcsim_plugins.path_planners.relative_motion import BurnPlan, FreeMotion
+from dcsim_plugins.path_planners.relative_motion import (
+    BurnPlan,
+    FreeMotion,
+    SpeedLimits,
+    swept_arcs,
+)
 
 from dcsim.api import (
     NoPath,
@@ -79,9 +84,6 @@ from dcsim.api import (
 FOOT = 0.3048
 """One foot, m: the paper's unit."""
 
-
-PAPER_SPEEDS = (0.09, 0.19, 0.2)
-"""The paper's least speed, largest speed and largest single delta-v, ft/s (Table 2)."""
 PAPER_STEPS_PER_CELL = 0.19 * 60.0 / 6.0
 """The paper's largest speed times its time step over its grid spacing (1.9)."""
 BURN_SHARE = 0.45
@@ -171,9 +173,8 @@ class GridSettings:
     @classmethod
     def derive(cls, params: GridAStarParams, problem: PathProblem) -> GridSettings:
         """Fill the unset parameters from the problem (see :class:`GridAStarParams`)."""
-        least, most, burn = PAPER_SPEEDS
         v, a = problem.max_speed, problem.max_acceleration
-        min_speed = params.min_speed if params.min_speed is not None else least / most * v
+        limits = SpeedLimits.derive(params.min_speed, params.max_burn, v)
         d, t = params.distance_resolution, params.time_resolution
         if t is None:
             d = d if d is not None else 6 * FOOT
@@ -184,10 +185,10 @@ class GridSettings:
                 d = v * t / PAPER_STEPS_PER_CELL
         elif d is None:
             d = v * t / PAPER_STEPS_PER_CELL
-        max_burn = params.max_burn if params.max_burn is not None else burn / most * v
+        max_burn = limits.max_burn
         if params.max_burn is None:
             max_burn = min(max_burn, 0.5 * a * t)
-        return cls(d, t, min_speed, v, max_burn)
+        return cls(d, t, limits.min_speed, v, max_burn)
 
 
 @dataclass(frozen=True)
@@ -386,16 +387,17 @@ class GridSearch:
     def _arc_samples(
         self, position: np.ndarray, departures: np.ndarray, durations: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Samples of each arc from ``position``: fractions of its duration (s,), points
-        (m, s, 3) m, and each arc's margin (m,) m."""
-        closing = self.problem.max_speed + self.obstacles.max_obstacle_speed
-        count = int(np.ceil(closing * durations.max() / self.params.check_spacing)) + 1
-        fractions = np.linspace(0.0, 1.0, max(count, 2))
-        elapsed = durations[:, None] * fractions
-        points, _ = self.motion.propagate(position, departures[:, None, :], elapsed)
-        hops = np.linalg.norm(np.diff(points, axis=1), axis=2).max(axis=1)
-        obstacle_hop = self.obstacles.max_obstacle_speed * durations / (len(fractions) - 1)
-        return elapsed, points, 0.5 * (hops + obstacle_hop)
+        """Samples of each arc from ``position`` (:func:`swept_arcs`): times since its
+        start (m, s) s, points (m, s, 3) m, and each arc's margin (m,) m."""
+        return swept_arcs(
+            self.motion,
+            position,
+            departures,
+            durations,
+            self.problem.max_speed,
+            self.obstacles.max_obstacle_speed,
+            self.params.check_spacing,
+        )
 
     def _clear(
         self,

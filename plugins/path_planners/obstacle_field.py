@@ -9,6 +9,8 @@ Not a plugin itself; the path planners of this package share it.
     cylinders whose bounding sphere is touched. Obstacles in straight-line or no motion
     (``StaticMotion``, ``LinearMotion`` or none) are predicted in closed form, others
     by ``predict``.
+    For swept checks, :meth:`ObstacleField.clear_arcs` says which sampled arcs are
+    clear and :meth:`ObstacleField.arc_overlaps` how deep each goes into an obstacle.
 :func:`endpoint_refusal`
     "No path" with a reason when the start is outside the bounds or inside an obstacle,
     or when every probe point of the goal region is.
@@ -162,12 +164,7 @@ class ObstacleField:
         clear = np.ones(len(points), dtype=bool)
         if not len(which):
             return clear
-        centres = self.origin[which] + self.velocity[which] * times[..., None, None]
-        for column, i in enumerate(which):
-            if i in self.curved:
-                centres[:, :, column] = (
-                    self.tracks[i].predict(times.ravel())[0].reshape(points.shape)
-                )
+        centres = self._arc_centres(times, which, points.shape)
         reach = (self.reach + margins)[:, None]
         offsets = points[:, :, None, :] - centres
         gaps = np.linalg.norm(offsets, axis=-1) - self.bounding[which]
@@ -197,6 +194,60 @@ class ObstacleField:
         )
         points, _ = trajectory.sample(times)
         return self.clear_path(points, times, np.full(len(times), 0.5 * spacing))
+
+    def arc_overlaps(
+        self, points: np.ndarray, times: np.ndarray, margins: np.ndarray, which: np.ndarray
+    ) -> np.ndarray:
+        """How deep each arc goes into an obstacle: the largest overlap of the robot
+        sphere, grown by ``margins[a]``, with the true shape of any of the obstacles
+        ``which``, over the samples of arc ``a``; 0 where it is clear (exactly where
+        :meth:`clear_arcs` says so).
+
+        Parameters
+        ----------
+        points : ndarray (m, s, 3)
+            ``s`` samples of each of ``m`` arcs, m.
+        times : ndarray (m, s)
+            Their times, s.
+        margins : ndarray (m,)
+            Growth of the robot's sphere on each arc, m.
+        which : ndarray of int
+            Indices of the obstacles to check.
+
+        Returns
+        -------
+        ndarray (m,)
+            Largest overlap, m (robot reach plus margin minus the gap to the surface).
+        """
+        depth = np.zeros(len(points))
+        if not len(which):
+            return depth
+        centres = self._arc_centres(times, which, points.shape)
+        reach = (self.reach + margins)[:, None]
+        offsets = points[:, :, None, :] - centres
+        gaps = np.linalg.norm(offsets, axis=-1) - self.bounding[which]
+        near = gaps < reach[..., None]
+        for column in np.flatnonzero(near.any(axis=(0, 1))):
+            i = which[column]
+            arcs, samples = np.nonzero(near[:, :, column])
+            if self.round[i]:
+                exact = gaps[arcs, samples, column]
+            else:
+                body = offsets[arcs, samples, column] @ self.to_body[i].T
+                exact = body_surface_distance(self.tracks[i].shape, body)
+            np.maximum.at(depth, arcs, reach[arcs, 0] - exact)
+        return depth
+
+    def _arc_centres(
+        self, times: np.ndarray, which: np.ndarray, shape: tuple[int, ...]
+    ) -> np.ndarray:
+        """Centres of the obstacles ``which`` at ``times`` (m, s), (m, s, len(which), 3) m;
+        ``shape`` is that of the samples, (m, s, 3)."""
+        centres = self.origin[which] + self.velocity[which] * times[..., None, None]
+        for column, i in enumerate(which):
+            if i in self.curved:
+                centres[:, :, column] = self.tracks[i].predict(times.ravel())[0].reshape(shape)
+        return centres
 
     def blocker(self, point: np.ndarray, t: float) -> int | None:
         """Id of an obstacle the robot sphere at ``point`` (m) at ``t`` (s) overlaps."""

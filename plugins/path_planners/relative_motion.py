@@ -23,6 +23,13 @@ Two burns (:meth:`FreeMotion.two_burn_delta_v`)
     Waypoints joined by single-burn arcs: the burns, swept samples for collision checks,
     and the :class:`dcsim.api.Trajectory` that realises each impulsive burn with finite
     thrust (:meth:`BurnPlan.trajectory`).
+:class:`SpeedLimits`
+    The limits a burn planner keeps: the least and largest mean speed of a leg and the
+    largest single burn, unset ones scaled from the problem's speed limit with the
+    paper's Table 2 ratios.
+Swept samples (:func:`swept_arcs`)
+    Samples along free arcs close enough that a collision check at them, with the
+    robot's sphere grown by the margin returned, covers the whole arc.
 """
 
 from __future__ import annotations
@@ -35,6 +42,8 @@ from scipy import optimize
 
 from dcsim.api import FrameDynamics, FrameKind, Trajectory
 
+PAPER_SPEEDS = (0.09, 0.19, 0.2)
+"""The paper's least speed, largest speed and largest single delta-v, ft/s (Table 2)."""
 _BURN_SAMPLES = 5
 """Trajectory samples across each finite burn (its position is quadratic in time)."""
 _NO_ARC = 1e3
@@ -173,6 +182,102 @@ class FreeMotion:
         departure, arrival = self.single_burn(position, goal_position, durations)
         first = np.linalg.norm(departure - velocity, axis=-1)
         return first + np.linalg.norm(np.asarray(goal_velocity) - arrival, axis=-1)
+
+
+@dataclass(frozen=True)
+class SpeedLimits:
+    """The limits of a burn plan's legs and burns.
+
+    Attributes
+    ----------
+    min_speed, max_speed : float
+        Least and largest mean speed of a leg (chord over duration), m/s.
+    max_burn : float
+        Largest single delta-v, m/s.
+    """
+
+    min_speed: float
+    max_speed: float
+    max_burn: float
+
+    @classmethod
+    def derive(
+        cls, min_speed: float | None, max_burn: float | None, max_speed: float
+    ) -> SpeedLimits:
+        """The limits with unset values scaled from the speed limit by the paper's Table 2.
+
+        Parameters
+        ----------
+        min_speed : float or None
+            Least mean speed, m/s (None: ``0.09/0.19 max_speed``).
+        max_burn : float or None
+            Largest single delta-v, m/s (None: ``0.2/0.19 max_speed``).
+        max_speed : float
+            The problem's speed limit, m/s.
+        """
+        least, most, burn = PAPER_SPEEDS
+        return cls(
+            min_speed if min_speed is not None else least / most * max_speed,
+            max_speed,
+            max_burn if max_burn is not None else burn / most * max_speed,
+        )
+
+
+def swept_arcs(
+    motion: FreeMotion,
+    origins: np.ndarray,
+    departures: np.ndarray,
+    durations: np.ndarray,
+    robot_speed: float,
+    obstacle_speed: float,
+    spacing: float,
+    most_samples: int | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Samples along free arcs for a swept collision check.
+
+    Every arc gets the same number of samples, enough that robot and obstacle close by
+    at most ``spacing`` between two samples of the longest arc (``most_samples`` at
+    most). Checking the robot's sphere grown by the returned margin at the samples
+    covers the arc between them: the margin is half the largest step of the robot
+    between two samples plus half the obstacles' largest step.
+
+    Parameters
+    ----------
+    motion : FreeMotion
+        The frame's free motion.
+    origins, departures : ndarray (..., 3)
+        Where each arc starts (m) and its velocity after the burn there (m/s),
+        broadcast together.
+    durations : ndarray (...)
+        Flight time of each arc, s.
+    robot_speed, obstacle_speed : float
+        Largest speeds of the robot and of any obstacle, m/s.
+    spacing : float
+        Largest closing of robot and obstacle between two samples, m.
+    most_samples : int, optional
+        Cap on the samples per arc (the margins grow to match).
+
+    Returns
+    -------
+    elapsed : ndarray (..., s)
+        Time of each sample since the arc's start, s.
+    points : ndarray (..., s, 3)
+        Positions, m.
+    margins : ndarray (...)
+        Growth of the robot's sphere on each arc, m.
+    """
+    durations = np.asarray(durations, dtype=float)
+    count = int(np.ceil((robot_speed + obstacle_speed) * durations.max() / spacing)) + 1
+    if most_samples is not None:
+        count = min(count, most_samples)
+    fractions = np.linspace(0.0, 1.0, max(count, 2))
+    elapsed = durations[..., None] * fractions
+    points, _ = motion.propagate(
+        np.asarray(origins, dtype=float)[..., None, :], departures[..., None, :], elapsed
+    )
+    hops = np.linalg.norm(np.diff(points, axis=-2), axis=-1).max(axis=-1)
+    obstacle_hop = obstacle_speed * durations / (len(fractions) - 1)
+    return elapsed, points, 0.5 * (hops + obstacle_hop)
 
 
 def _apply(matrices: np.ndarray, vectors: np.ndarray) -> np.ndarray:
