@@ -34,7 +34,8 @@ Two burns
 Collisions
     Swept: every arc sampled at most ``check_spacing`` of closing distance apart, the
     robot's sphere (``robot_radius`` + ``clearance``, grown by half the largest step
-    between samples, and by how far flying the burns at the problem's acceleration takes
+    between samples but at least half of ``check_spacing``, as the flown trajectory's
+    check grows it, and by how far flying the burns at the problem's acceleration takes
     the robot off the arcs) tested against every obstacle's true shape where the
     obstacle is at each sample's time (``ObstacleField.arc_overlaps``, which also gives
     how deep an arc goes in). Samples also stay in the problem's bounds.
@@ -117,8 +118,9 @@ SHORTEST_LEG = 1e-3
 """Shortest leg the two-burn scan tries, s."""
 MOST_SAMPLES = 4000
 """Most swept samples of one arc (the sphere's margin grows to match)."""
-BATCH_SAMPLES = 40_000
-"""Swept samples of one batch of candidates (bounds the memory of a check)."""
+BATCH_PAIRS = 400_000
+"""Swept samples times obstacles of one batch of candidates (bounds the memory and the
+time of one check)."""
 SWEPT_PER_REFINEMENT = 256
 """Candidates swept for collisions per candidate to refine, at most, at each number of
 burns."""
@@ -417,7 +419,7 @@ class BurnSearch:
         depth = self.obstacles.arc_overlaps(
             points.reshape(count * legs, samples, 3),
             (starts[..., None] + elapsed).reshape(count * legs, samples),
-            (margins + drift).ravel() + slack,
+            (np.maximum(margins, 0.5 * self.params.check_spacing) + drift).ravel() + slack,
             self.everyone,
         ).reshape(count, legs)
         bounds = self.problem.bounds
@@ -433,7 +435,8 @@ class BurnSearch:
             int(np.ceil(closing * float(durations.max()) / self.params.check_spacing)) + 1,
             MOST_SAMPLES,
         )
-        return max(1, BATCH_SAMPLES // (legs * max(samples, 2)))
+        pairs = legs * max(samples, 2) * max(self.obstacles.count, 1)
+        return max(1, BATCH_PAIRS // pairs)
 
     def _candidate(self, positions: np.ndarray, durations: np.ndarray, step: float) -> Candidate:
         """A plan, assessed and swept."""
@@ -718,18 +721,12 @@ class BurnSearch:
 
     def flown_clear(self, trajectory: Trajectory) -> bool:
         """Whether the flown trajectory, as its samples give it (linear between them),
-        stays clear of the obstacles and in the bounds."""
-        closing = self.problem.max_speed + self.obstacles.max_obstacle_speed
-        start, end = float(trajectory.times[0]), float(trajectory.times[-1])
-        count = int(np.ceil(closing * (end - start) / self.params.check_spacing)) + 1
-        times = np.union1d(np.linspace(start, end, max(count, 2)), trajectory.times)
-        points, _ = trajectory.sample(times)
-        hop = float(np.linalg.norm(np.diff(points, axis=0), axis=1).max(initial=0.0))
-        obstacle_hop = self.obstacles.max_obstacle_speed * float(np.diff(times).max())
-        margin = np.array([0.5 * (hop + obstacle_hop)])
-        depth = self.obstacles.arc_overlaps(points[None], times[None], margin, self.everyone)
-        inside = self.problem.bounds is None or bool(self.problem.bounds.contains(points).all())
-        return inside and not depth[0] > 0
+        stays clear of the obstacles (``ObstacleField.clear_trajectory``) and in the
+        bounds."""
+        bounds = self.problem.bounds
+        if bounds is not None and not bool(bounds.contains(trajectory.positions).all()):
+            return False
+        return self.obstacles.clear_trajectory(trajectory, self.params.check_spacing)
 
 
 def _apart(new: np.ndarray, spacing: np.ndarray, chosen: list[int], row: int) -> bool:
