@@ -144,7 +144,8 @@ class MultiBurnParams(PluginParams):
         unit="m/s",
         gt=0,
         description="Least mean speed of a leg (unset: 0.09/0.19 of the speed limit); the "
-        "largest is the problem's speed limit.",
+        "largest is the problem's speed limit. Positive: in a force-free frame a slower "
+        "transfer is always cheaper.",
     )
     max_burn: float | None = quantity(
         None,
