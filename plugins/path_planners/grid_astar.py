@@ -21,9 +21,10 @@ Moves (the paper's two neighbour sets)
     ``max_burn`` is not allowed.
 Goal
     From every state the goal's centre is tried as one more neighbour (set 1 or set 2
-    distance, the speed limit but not the least speed), then a last burn matches the
-    goal's velocity; both burns are within ``max_burn``. The goal has no time: arrival
-    after whole time steps; the goal has a time: arrival then.
+    distance), then a last burn matches the goal's velocity; both burns are within
+    ``max_burn``. The goal has no time: arrival after whole time steps, within both
+    speed limits; the goal has a time: arrival then, within the speed limit (the least
+    speed would make some goal times unreachable).
 Cost
     Of a move, ``w_dv |Δv| + w_L |δ| d + w_T Δt`` with the problem's weights (straight-
     line distance, as in the paper); the last burn is added to the arrival.
@@ -40,8 +41,10 @@ Heuristic (``heuristic``)
 Collisions (``collision``)
     ``swept``: every arc sampled at most ``check_spacing`` of closing distance apart,
     the robot's sphere (``robot_radius`` + ``clearance``, grown by half the largest
-    closing between samples) clear of every obstacle's true shape where the obstacle is
-    at each sample's time. ``grid-points``: the paper's test, at the grid points alone,
+    closing between samples and by ``max_burn² / 2a``, the most the path flown with
+    finite burns strays from the impulsive arcs) clear of every obstacle's true shape
+    where the obstacle is at each sample's time; the trajectory flown is checked again
+    at the end. ``grid-points``: the paper's test, at the grid points alone,
     so an arc between two clear points may cross an obstacle. Tests against obstacles at
     rest are done once per grid point and move.
 
@@ -363,6 +366,8 @@ class GridSearch:
             self.motion, offsets, steps, grid.distance_resolution, grid.time_resolution
         )
         self.obstacles = ObstacleField(problem, p.clearance)
+        # how far the flown path may stray from the impulsive arcs near a burn
+        self.corner_cut = 0.5 * grid.max_burn**2 / problem.max_acceleration
         self.resting = self.obstacles.resting_indices
         self.moving = self.obstacles.moving_indices
         self.timed_key = len(self.moving) > 0 or problem.goal.time is not None
@@ -414,6 +419,7 @@ class GridSearch:
             margins = np.zeros(len(durations))
         else:
             elapsed, points, margins = self._arc_samples(position, departures, durations)
+            margins = np.maximum(margins, 0.5 * self.params.check_spacing) + self.corner_cut
         inside = np.ones(len(durations), dtype=bool)
         if self.problem.bounds is not None:
             inside = self.problem.bounds.contains(points).all(axis=1)
@@ -562,6 +568,8 @@ class GridSearch:
             & (durations <= self.motion.longest_duration)
             & (distance <= self.problem.max_speed * durations * (1 + 1e-9))
         ]
+        if goal.time is None:  # the least speed holds too, unless the arrival time is set
+            durations = durations[distance >= self.grid.min_speed * durations * (1 - 1e-9)]
         if not len(durations):
             return []
         departures, arrivals = self.motion.single_burn(
