@@ -12,9 +12,11 @@ plus the least, over the nodes of layer i, of the cheapest way there plus the ed
 Each layer is one numpy minimum over the predecessors (broadcast over every pair), so
 the cost is O(m P²) for m layers of P nodes.
 
-The graph is passed as arrays, so this module needs no plugin: the planner exports its
-graph (``dcsim_plugins.path_planners.ant_colony.build_graph`` gives ``lengths`` and
-``node_cost``) and the colony is scored against the optimum of exactly that graph.
+The graph is passed as arrays, so this module needs no plugin: the ``ant-colony``
+planner, taken from the registry, gives its graph (``planner.candidate_graph(problem)``,
+with ``lengths`` and ``node_cost``) and runs its colony on it (``planner.colony(graph)``,
+whose ``cost`` and per-cycle ``history`` are scored against the optimum of exactly that
+graph with :func:`optimality_gap`).
 """
 
 from __future__ import annotations

@@ -104,8 +104,11 @@ Trajectory
 Statistics: ``cycles`` (cycles run), ``ants``, ``best_cost`` (F of the answer),
 ``converged`` (1 if the colony converged before ``max_cycles`` and the budget),
 ``nodes`` (usable candidate points), ``waypoints`` (vertices flown). The best cost of
-every cycle is in :class:`ColonyResult` (:func:`solve_colony`), which the benchmark
-compares with the exact optimum of the same graph.
+every cycle is in :class:`ColonyResult`. A benchmark reaches both halves through the
+registered class, without importing this module: ``planner.candidate_graph(problem)``
+is the graph :meth:`~AntColonyPlanner.plan` searches (its ``lengths`` and
+``node_cost`` are what ``dcsim.bench.layered_optimum`` minimises exactly) and
+``planner.colony(graph)`` runs the colony on it with the planner's generator.
 """
 
 from __future__ import annotations
@@ -1013,6 +1016,24 @@ class AntColonyPlanner(PathPlanner):
     params: AntColonyParams
     handles_moving_obstacles = True
 
+    def candidate_graph(self, problem: PathProblem) -> LayeredGraph:
+        """The graph :meth:`plan` searches for ``problem`` (:func:`build_graph` with this
+        planner's parameters), for scoring the colony against the exact optimum of the
+        same graph (``dcsim.bench.layered_optimum``) without importing this module.
+
+        Raises
+        ------
+        ValueError
+            When the problem has no graph (the start or the goal inside an obstacle or
+            outside the bounds, or the start at the goal).
+        """
+        return build_graph(problem, self.params)
+
+    def colony(self, graph: LayeredGraph, deadline: float = math.inf) -> ColonyResult:
+        """Run this planner's colony on ``graph`` with its generator (:func:`solve_colony`):
+        the best path, its objective and the best objective of every cycle."""
+        return solve_colony(graph, self.params, self.rng, deadline)
+
     def plan(self, problem: PathProblem) -> Trajectory | NoPath:
         """Build the graph, run the colony, simplify and time the best path."""
         started = time.monotonic()
@@ -1033,7 +1054,7 @@ class AntColonyPlanner(PathPlanner):
                 "obstacle or leaves the bounds (widen half_width or add points)"
             )
         deadline = started + (1.0 - _RESERVE) * problem.time_budget
-        colony = solve_colony(graph, self.params, self.rng, deadline)
+        colony = self.colony(graph, deadline)
         vertices, _ = simplify(problem, graph, colony.path, self.params)
         statistics = {
             "cycles": float(colony.cycles),

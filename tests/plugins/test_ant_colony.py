@@ -27,6 +27,7 @@ from dcsim.api import (
     GoalRegion,
     NoPath,
     PathProblem,
+    PluginRegistry,
     RobotState,
     Shape,
     ShapeKind,
@@ -316,6 +317,21 @@ def test_the_trajectory_keeps_the_limits():
     )
     assert rates.max() <= layout.max_acceleration * (1 + 1e-6)
     assert set(trajectory.statistics) >= {"cycles", "ants", "best_cost", "converged"}
+
+
+def test_the_bench_scores_the_planner_through_its_own_graph_and_colony():
+    planner_class = PluginRegistry.discover().get("path_planner", "ant-colony").cls
+    layout = blocked_problem()
+    planner = planner_class(SMALL, np.random.default_rng(7))
+    graph = planner.candidate_graph(layout)
+    expected = build_graph(layout, AntColonyParams(**SMALL))
+    np.testing.assert_array_equal(graph.lengths, expected.lengths)
+    np.testing.assert_array_equal(graph.node_cost, expected.node_cost)
+    result = planner.colony(graph)
+    again = solve_colony(graph, AntColonyParams(**SMALL), np.random.default_rng(7))
+    np.testing.assert_array_equal(result.history, again.history)
+    assert result.cost >= layered_optimum(graph.lengths, graph.node_cost).cost - 1e-9
+    assert np.all(np.diff(result.history) <= 0)
 
 
 def test_it_is_a_registered_path_planner_with_checks():
