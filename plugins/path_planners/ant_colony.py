@@ -878,8 +878,7 @@ def _chords_clear(
 ) -> np.ndarray:
     """Whether the chord from vertex ``i`` to each of ``ends`` keeps ``reach`` from every
     obstacle (moving from its place at ``times[i]`` to that at each end's time)."""
-    clear = np.ones(len(ends), dtype=bool)
-    clear[0] = True  # a segment of the graph itself
+    clear = np.ones(len(ends), dtype=bool)  # the first chord is a segment of the graph
     for track in problem.obstacles:
         here = track.predict(times[i])[0]
         there = track.predict(times[ends])[0]
@@ -951,9 +950,7 @@ def blended(vertices: np.ndarray, speed: float, acceleration: float) -> Samples:
             change = turn / duration if duration > 0 else np.zeros(3)
         else:
             duration, change = ramp, -acceleration * direction
-        entry = vertices[j + 1] - direction * (
-            0.5 * speed * duration if j < last else 0.5 * speed * ramp
-        )
+        entry = vertices[j + 1] - direction * (0.5 * speed * duration)  # half-blend or ramp
         cruise = float(np.dot(entry - position, direction)) / speed
         if cruise > 0:
             parts.append(
