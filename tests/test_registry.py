@@ -71,7 +71,8 @@ def test_unknown_name_suggests_the_closest():
     registry = PluginRegistry.discover()
     with pytest.raises(
         PluginNotFoundError,
-        match=r"available: grid-astar, multi-burn, ompl-control, ompl-geometric, straight-line\); "
+        match=r"available: ant-colony, grid-astar, multi-burn, ompl-control, ompl-geometric, "
+        r"straight-line\); "
         r"did you mean 'straight-line'\?",
     ):
         registry.get("path_planner", "straight_line")
