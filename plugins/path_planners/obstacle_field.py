@@ -13,7 +13,8 @@ Not a plugin itself; the path planners of this package share it.
     clear and :meth:`ObstacleField.arc_overlaps` how deep each goes into an obstacle.
 :func:`endpoint_refusal`
     "No path" with a reason when the start is outside the bounds or inside an obstacle,
-    or when every probe point of the goal region is.
+    or when every probe point of the goal region is; :func:`goal_or_refusal` adds the
+    first clear probe point of the goal region, for the planners that aim at one.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import numpy as np
 from dcsim.api import (
     LinearMotion,
     NoPath,
+    ObjectTrack,
     PathProblem,
     ShapeKind,
     StaticMotion,
@@ -58,9 +60,8 @@ class ObstacleField:
         self.static_centres = self.origin.copy()
         self.bounding = np.array([t.radius for t in self.tracks], dtype=float)
         self.round = np.array([t.shape.kind is ShapeKind.SPHERE for t in self.tracks], dtype=bool)
-        self.to_body = [  # world-to-body rotation matrices (fixed while the obstacles move)
-            rotate(quaternion_conjugate(t.shape.orientation), np.eye(3)).T for t in self.tracks
-        ]
+        # world-to-body rotation matrices (fixed while the obstacles move)
+        self.to_body = [to_body(t) for t in self.tracks]
         self.max_obstacle_speed = self._fastest(problem)
 
     def _fastest(self, problem: PathProblem) -> float:
@@ -257,6 +258,11 @@ class ObstacleField:
         return None if hit is None else self.tracks[hit].id
 
 
+def to_body(track: ObjectTrack) -> np.ndarray:
+    """World-to-body rotation matrix of an obstacle's shape."""
+    return rotate(quaternion_conjugate(track.shape.orientation), np.eye(3)).T
+
+
 def _is_affine(motion: object) -> bool:
     """Whether a motion model is a straight line at constant velocity (or rest)."""
     return motion is None or isinstance(motion, (StaticMotion, LinearMotion))
@@ -304,3 +310,15 @@ def free_goal_point(problem: PathProblem, field: ObstacleField) -> np.ndarray | 
         if inside and field.blocker(point, t) is None:
             return point
     return None
+
+
+def goal_or_refusal(problem: PathProblem, field: ObstacleField) -> NoPath | np.ndarray:
+    """:func:`endpoint_refusal`, or "no path" when no probe point of the goal region is in
+    bounds and clear, or else the first that is (:func:`free_goal_point`), m."""
+    refusal = endpoint_refusal(problem, field)
+    if refusal is not None:
+        return refusal
+    goal = free_goal_point(problem, field)
+    if goal is None:
+        return NoPath("no point of the goal region is clear of the obstacles")
+    return goal

@@ -8,20 +8,17 @@ import math
 
 import numpy as np
 import pytest
-from dcsim_plugins.path_planners.ant_colony import (
-    AntColonyParams,
-    AntColonyPlanner,
-    LayeredGraph,
-    build_graph,
+from dcsim_plugins.path_planners.ant_colony import AntColonyParams, AntColonyPlanner
+from dcsim_plugins.path_planners.colony import (
     descend,
     lay_pheromone,
-    segment_gaps,
     solve_colony,
     transition_probabilities,
     transition_weights,
     visibility,
     walk,
 )
+from dcsim_plugins.path_planners.layered_graph import LayeredGraph, build_graph, segment_gaps
 
 from dcsim.api import (
     GoalRegion,
