@@ -19,8 +19,8 @@ problem tried (its log: "Zero-length path found. May have a common start/goal"),
 is not offered. The path is simplified
 (OMPL's ``simplifyMax``: shortcuts and vertex reduction, collision-checked).
 
-Timing: rest to rest on every segment, with the trapezoidal profile of the
-``straight-line`` planner (accelerate at ``max_acceleration``, cruise at
+Timing: rest to rest on every segment (``polyline_flight``), with the trapezoidal
+profile of the ``straight-line`` planner (accelerate at ``max_acceleration``, cruise at
 ``speed_fraction`` of ``max_speed``, brake to rest at the vertex). A start that moves
 first brakes to rest along its velocity (that stretch is checked too). A goal that sets
 an arrival time is met by waiting at the goal; a goal that asks for a velocity the
@@ -43,13 +43,16 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from dcsim_plugins.path_planners.obstacle_field import (
-    ObstacleField,
-    endpoint_refusal,
-    free_goal_point,
-)
+from dcsim_plugins.path_planners.obstacle_field import ObstacleField, goal_or_refusal
 from dcsim_plugins.path_planners.ompl_support import in_worker, seed_ompl
-from dcsim_plugins.path_planners.straight_line import Profile
+from dcsim_plugins.path_planners.polyline_flight import (
+    SHORTEST,
+    Samples,
+    arrival_refusal,
+    chain,
+    rest_to_rest_segment,
+    trajectory_of,
+)
 from ompl import base as ob
 from ompl import geometric as og
 
@@ -61,11 +64,8 @@ from dcsim.api import (
     Trajectory,
     hookimpl,
     quantity,
-    rest_to_rest_time,
 )
 
-Samples = tuple[np.ndarray, np.ndarray, np.ndarray]
-"""Times (s), positions (m) and velocities (m/s) of a piece of trajectory."""
 MOVING_REFUSAL = "no path: moving obstacles need ompl-control or a time-aware planner"
 """The answer to a problem with moving obstacles."""
 _PLANNERS = {
@@ -77,7 +77,6 @@ _PLANNERS = {
 }
 _OPTIMISING = {"rrtstar", "informed-rrtstar", "sorrtstar"}
 _RESERVE = 0.05  # s of the budget kept for simplifying and returning the path
-_SHORTEST = 1e-6  # m: shorter segments of a simplified path are dropped
 _MIN_SPAN = 10.0  # m: least growth of the box planned in when the problem has no bounds
 
 
@@ -202,66 +201,21 @@ def solve(
     return Waypoints(points, statistics)
 
 
-class Timing:
-    """Rest-to-rest timing of straight segments (see the module docstring).
-
-    Parameters
-    ----------
-    speed : float
-        Cruise speed limit, m/s.
-    acceleration : float
-        m/s² (``inf``: impulsive).
-    """
-
-    def __init__(self, speed: float, acceleration: float) -> None:
-        self.speed, self.acceleration = speed, acceleration
-
-    def segment(self, a: np.ndarray, b: np.ndarray) -> Samples:
-        """Times since the segment's start (s), positions (m) and velocities (m/s) of the
-        rest-to-rest flight from ``a`` to ``b``."""
-        length = float(np.linalg.norm(b - a))
-        accel = self.acceleration
-        duration = float(rest_to_rest_time(length, self.speed, accel))
-        cruise = self.speed if math.isinf(accel) else min(self.speed, math.sqrt(accel * length))
-        profile = Profile(length, duration, cruise, accel)
-        tau = profile.sample_times()
-        distance, speed = profile(tau)
-        direction = (b - a) / length
-        return tau, a + np.outer(distance, direction), np.outer(speed, direction)
-
-    def braking(self, position: np.ndarray, velocity: np.ndarray) -> Samples:
-        """Times (s), positions (m) and velocities (m/s) of braking to rest along
-        ``velocity`` at the acceleration limit, from ``position``."""
-        speed = float(np.linalg.norm(velocity))
-        duration = speed / self.acceleration if math.isfinite(self.acceleration) else 0.0
-        if duration == 0.0:
-            return np.zeros(1), position[None], np.zeros((1, 3))
-        tau = np.linspace(0.0, duration, 13)
-        fraction = (1.0 - tau / duration)[:, None]
-        positions = (
-            position
-            + velocity * tau[:, None]
-            - 0.5 * velocity * (tau / duration)[:, None] * tau[:, None]
-        )
-        return tau, positions, velocity * fraction
-
-
-def _chain(pieces: list[Samples], t0: float) -> Samples:
-    """Times, positions and velocities of consecutive pieces, joined end to start."""
-    times, positions, velocities = [np.array([t0])], [pieces[0][1][:1]], [pieces[0][2][:1]]
-    clock = t0
-    for tau, p, v in pieces:
-        times.append(clock + tau[1:])
-        positions.append(p[1:])
-        velocities.append(v[1:])
-        clock += float(tau[-1])
-    times_, positions_, velocities_ = (
-        np.concatenate(times),
-        np.vstack(positions),
-        np.vstack(velocities),
+def _braking(position: np.ndarray, velocity: np.ndarray, acceleration: float) -> Samples:
+    """Times (s), positions (m) and velocities (m/s) of braking to rest along
+    ``velocity`` at ``acceleration`` (m/s², ``inf``: impulsive), from ``position``."""
+    speed = float(np.linalg.norm(velocity))
+    duration = speed / acceleration if math.isfinite(acceleration) else 0.0
+    if duration == 0.0:
+        return np.zeros(1), position[None], np.zeros((1, 3))
+    tau = np.linspace(0.0, duration, 13)
+    fraction = (1.0 - tau / duration)[:, None]
+    positions = (
+        position
+        + velocity * tau[:, None]
+        - 0.5 * velocity * (tau / duration)[:, None] * tau[:, None]
     )
-    keep = np.append(True, np.diff(times_) > _SHORTEST)  # ramps that meet at a vertex
-    return times_[keep], positions_[keep], velocities_[keep]
+    return tau, positions, velocity * fraction
 
 
 class OmplGeometricPlanner(PathPlanner):
@@ -282,20 +236,18 @@ class OmplGeometricPlanner(PathPlanner):
         field = ObstacleField(problem, self.params.clearance)
         if field.moving:
             return NoPath(MOVING_REFUSAL)
-        refusal = endpoint_refusal(problem, field)
-        if refusal is not None:
-            return refusal
-        goal = free_goal_point(problem, field)
-        if goal is None:
-            return NoPath("no point of the goal region is clear of the obstacles")
-        timing = Timing(self.params.speed_fraction * problem.max_speed, problem.max_acceleration)
+        goal = goal_or_refusal(problem, field)
+        if isinstance(goal, NoPath):
+            return goal
         start = problem.start
-        braking = timing.braking(np.asarray(start.position), np.asarray(start.velocity))
-        stop = braking[1][-1]
-        if len(braking[0]) > 1 and not field.clear_path(
-            braking[1],
-            start.time + braking[0],
-            np.full(len(braking[0]), 0.5 * self.params.resolution),
+        stopping = _braking(
+            np.asarray(start.position), np.asarray(start.velocity), problem.max_acceleration
+        )
+        stop = stopping[1][-1]
+        if len(stopping[0]) > 1 and not field.clear_path(
+            stopping[1],
+            start.time + stopping[0],
+            np.full(len(stopping[0]), 0.5 * self.params.resolution),
         ):
             return NoPath("braking from the start's velocity runs into an obstacle")
         seed = int(self.rng.integers(1, 2**31 - 1))
@@ -303,27 +255,27 @@ class OmplGeometricPlanner(PathPlanner):
         found = in_worker(solve, args, deadline)
         if found is None or found.points is None:
             return NoPath(f"no path within the {problem.time_budget:g} s budget")
-        return self._timed(problem, timing, braking, found)
+        return self._timed(problem, stopping, found)
 
     def _timed(
-        self, problem: PathProblem, timing: Timing, braking: Samples, found: Waypoints
+        self, problem: PathProblem, stopping: Samples, found: Waypoints
     ) -> Trajectory | NoPath:
         """The waypoints flown rest to rest after braking, waiting for the goal's time."""
-        pieces = [braking] if len(braking[0]) > 1 else []
+        pieces = [stopping] if len(stopping[0]) > 1 else []
         points = found.points
+        speed = self.params.speed_fraction * problem.max_speed
         pieces += [
-            timing.segment(a, b)
+            rest_to_rest_segment(a, b, speed, problem.max_acceleration)
             for a, b in zip(points[:-1], points[1:], strict=True)
-            if np.linalg.norm(b - a) > _SHORTEST
+            if np.linalg.norm(b - a) > SHORTEST
         ]
         if not pieces:
             pieces = [(np.array([0.0]), points[:1], np.zeros((1, 3)))]
-        times, positions, velocities = _chain(pieces, problem.start.time)
+        times, positions, velocities = chain(pieces, problem.start.time)
+        refusal = arrival_refusal(problem)
+        if refusal is not None:
+            return refusal
         goal = problem.goal
-        if np.linalg.norm(goal.velocity) > goal.velocity_tolerance:
-            return NoPath(
-                f"the goal asks to arrive at {goal.velocity} m/s; this planner arrives at rest"
-            )
         if goal.time is not None:
             late = times[-1] - goal.time
             if late > goal.time_tolerance:
@@ -338,23 +290,7 @@ class OmplGeometricPlanner(PathPlanner):
             times = np.append(times, times[-1] + 1e-3)
             positions = np.vstack([positions, positions[-1]])
             velocities = np.vstack([velocities, velocities[-1]])
-        changes = np.linalg.norm(
-            np.diff(np.vstack([problem.start.velocity, velocities]), axis=0), axis=1
-        )
-        delta_v = float(changes.sum())
-        if delta_v > problem.max_delta_v:
-            return NoPath(
-                f"the path needs {delta_v:.3g} m/s of delta-v, above {problem.max_delta_v:g}"
-            )
-        return Trajectory(
-            times=times,
-            positions=positions,
-            velocities=velocities,
-            delta_v=delta_v,
-            length=float(np.linalg.norm(np.diff(positions, axis=0), axis=1).sum()),
-            duration=float(times[-1] - times[0]),
-            statistics=found.statistics,
-        )
+        return trajectory_of(problem, (times, positions, velocities), found.statistics)
 
 
 @hookimpl
