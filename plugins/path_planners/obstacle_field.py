@@ -162,24 +162,7 @@ class ObstacleField:
         -------
         ndarray of bool (m,)
         """
-        clear = np.ones(len(points), dtype=bool)
-        if not len(which):
-            return clear
-        centres = self._arc_centres(times, which, points.shape)
-        reach = (self.reach + margins)[:, None]
-        offsets = points[:, :, None, :] - centres
-        gaps = np.linalg.norm(offsets, axis=-1) - self.bounding[which]
-        near = gaps < reach[..., None]
-        for column in np.flatnonzero(near.any(axis=(0, 1))):
-            i = which[column]
-            arcs, samples = np.nonzero(near[:, :, column])
-            if self.round[i]:
-                clear[arcs] = False
-                continue
-            body = offsets[arcs, samples, column] @ self.to_body[i].T
-            exact = body_surface_distance(self.tracks[i].shape, body)
-            clear[arcs[exact < reach[arcs, 0]]] = False
-        return clear
+        return self.arc_overlaps(points, times, margins, which) <= 0.0
 
     def clear_trajectory(self, trajectory: Trajectory, spacing: float) -> bool:
         """Whether the robot sphere is clear along a whole trajectory (positions linear
