@@ -33,6 +33,13 @@ Plan cost
     :func:`leg_delta_v`.
 Kinematics
     :func:`rest_to_rest_time`, :func:`shortest_leg`, :func:`cruise_speed`.
+Space manipulator model (DH kinematics and dynamics of the source thesis 004)
+    :class:`ManipulatorModel` (forward kinematics, generalised and free-floating
+    Jacobians, inverse kinematics, det(J Jᵀ), M(q), C(q, q̇)), built by
+    :func:`manipulator_model` from a :class:`DHRobot` (a :class:`ManipulatorBase` and
+    :class:`DHLink` rows); :func:`thesis_manipulator` (the thesis's robot),
+    :func:`manipulator_urdf`; results :class:`ForwardKinematics`,
+    :class:`InverseKinematicsResult`.
 Geometry
     :func:`spherical_to_cartesian`, :func:`quaternion_between`, :func:`rotate`, :func:`unit`,
     :func:`clip_norm`, :func:`quaternion_multiply`, :func:`quaternion_conjugate`,
@@ -123,6 +130,14 @@ from dcsim.motion import (
 from dcsim.params import PluginParams, quantity
 from dcsim.plancost import leg_delta_v, legs_delta_v, plan_cost, plan_delta_v, plan_duration
 from dcsim.registry import PluginRegistry
+from dcsim.robots.dh import DHLink, DHRobot, ManipulatorBase, thesis_manipulator
+from dcsim.robots.manipulator import (
+    ForwardKinematics,
+    InverseKinematicsResult,
+    ManipulatorModel,
+    manipulator_model,
+)
+from dcsim.robots.urdf import urdf_text as manipulator_urdf
 
 __all__ = [
     "array_field",
@@ -137,6 +152,8 @@ __all__ = [
     "CostWeights",
     "cruise_speed",
     "DcsimError",
+    "DHLink",
+    "DHRobot",
     "DropPoint",
     "DropVisit",
     "DuplicatePluginError",
@@ -144,14 +161,20 @@ __all__ = [
     "FmuDescription",
     "FmuError",
     "FmuInstance",
+    "ForwardKinematics",
     "FrameDynamics",
     "FrameKind",
     "GoalRegion",
     "hookimpl",
+    "InverseKinematicsResult",
     "leg_delta_v",
     "legs_delta_v",
     "LinearMotion",
     "Localiser",
+    "manipulator_model",
+    "manipulator_urdf",
+    "ManipulatorBase",
+    "ManipulatorModel",
     "mean_motion",
     "Message",
     "message",
@@ -205,6 +228,7 @@ __all__ = [
     "Surroundings",
     "TaskPlanner",
     "TaskRequest",
+    "thesis_manipulator",
     "Trajectory",
     "unit",
 ]

@@ -1,0 +1,1 @@
+"""Robot models: the space manipulator's DH description, URDF and dynamics."""
