@@ -28,6 +28,16 @@ from numpy.typing import ArrayLike, NDArray
 Vector = NDArray[np.float64]
 
 
+def _check_moments(moments: Vector, owner: str) -> None:
+    """Principal moments of a rigid body: positive, and each at most the sum of the other
+    two (PyBullet drops an inertia that breaks this)."""
+    if np.any(moments <= 0.0) or np.any(2.0 * moments > moments.sum() * (1.0 + 1e-12)):
+        raise ValueError(
+            f"{owner} principal moments of inertia must be positive and each at most the sum "
+            f"of the other two, got {moments.tolist()}"
+        )
+
+
 def _vector(values: ArrayLike, size: int, name: str) -> Vector:
     array = np.array(values, dtype=float).reshape(-1)
     if array.shape != (size,) or not np.all(np.isfinite(array)):
@@ -74,8 +84,7 @@ class DHLink:
         object.__setattr__(self, "inertia", _vector(self.inertia, 3, "inertia"))
         if not self.mass > 0.0:
             raise ValueError(f"link mass must be positive, got {self.mass}")
-        if np.any(self.inertia <= 0.0):
-            raise ValueError(f"principal moments of inertia must be positive: {self.inertia}")
+        _check_moments(self.inertia, "link")
         lower, upper = self.joint_limits
         if not lower <= upper:
             raise ValueError(f"joint limits must be (lower, upper), got {self.joint_limits}")
@@ -110,8 +119,9 @@ class ManipulatorBase:
         object.__setattr__(self, "inertia", _vector(self.inertia, 3, "base inertia"))
         object.__setattr__(self, "size", _vector(self.size, 3, "base size"))
         object.__setattr__(self, "mount", _vector(self.mount, 3, "base mount"))
-        if not self.mass > 0.0 or np.any(self.inertia <= 0.0) or np.any(self.size <= 0.0):
-            raise ValueError("base mass, inertia and size must be positive")
+        if not self.mass > 0.0 or np.any(self.size <= 0.0):
+            raise ValueError("base mass and size must be positive")
+        _check_moments(self.inertia, "base")
 
 
 @dataclass(frozen=True)

@@ -12,7 +12,7 @@ import pybullet
 import pytest
 
 from dcsim.geometry import quaternion_from_rotation_vector, quaternion_multiply
-from dcsim.robots.dh import thesis_manipulator
+from dcsim.robots.dh import DHLink, DHRobot, ManipulatorBase, thesis_manipulator
 from dcsim.robots.kinematics import rotation_matrix
 from dcsim.robots.manipulator import ManipulatorModel
 
@@ -186,3 +186,80 @@ def test_end_effector_jacobian_agrees_with_pinocchio(model, pinocchio_model, see
     np.testing.assert_allclose(
         data.oMf[frame].rotation, model.forward_kinematics(q).end_effector_rotation, atol=1e-12
     )
+
+
+def skewed_robot() -> DHRobot:
+    """Offsets, link offsets d and twists the thesis's robot does not have."""
+    rows = [
+        (0.3, -0.4, 0.2, 0.3),
+        (0.5, 1.1, -0.15, -0.7),
+        (0.25, -2.0, 0.1, 1.2),
+        (0.0, 0.6, 0.35, 0.0),
+    ]
+    links = tuple(
+        DHLink(
+            a=a,
+            alpha=alpha,
+            d=d,
+            theta_offset=offset,
+            mass=5.0 + i,
+            inertia=(0.1 + 0.01 * i, 0.2, 0.25),
+        )
+        for i, (a, alpha, d, offset) in enumerate(rows)
+    )
+    base = ManipulatorBase(
+        mass=200.0, inertia=(20.0, 30.0, 25.0), size=(1.0, 0.8, 0.6), mount=(0.4, 0.1, -0.2)
+    )
+    return DHRobot(base=base, links=links, name="skewed")
+
+
+def test_a_robot_with_offsets_and_twists_agrees_with_pinocchio_and_pybullet(tmp_path):
+    model = ManipulatorModel(skewed_robot())
+    n = model.n_joints
+    built = pin.buildModelFromXML(model.urdf(), pin.JointModelFreeFlyer())
+    built.gravity.setZero()
+    data = built.createData()
+    path = tmp_path / "skewed.urdf"
+    path.write_text(model.urdf())
+    client = pybullet.connect(pybullet.DIRECT)
+    try:
+        body = pybullet.loadURDF(
+            str(path), flags=pybullet.URDF_USE_INERTIA_FROM_FILE, physicsClientId=client
+        )
+        rng = np.random.default_rng(11)
+        for _ in range(3):
+            quaternion = rng.normal(size=4)
+            q = np.concatenate(
+                [rng.normal(size=3), quaternion / np.linalg.norm(quaternion), rng.uniform(-3, 3, n)]
+            )
+            qd = rng.normal(size=6 + n)
+            rotation_t = rotation_matrix(q[3:7]).T
+            t_pin = np.zeros((6 + n, 6 + n))
+            t_pin[:3, :3], t_pin[3:6, 3:6], t_pin[6:, 6:] = rotation_t, rotation_t, np.eye(n)
+            t_bullet = np.zeros((6 + n, 6 + n))
+            t_bullet[:3, 3:6], t_bullet[3:6, :3], t_bullet[6:, 6:] = (
+                rotation_t,
+                rotation_t,
+                np.eye(n),
+            )
+            m_pin = pin.crba(built, data, q)
+            m_pin = np.triu(m_pin) + np.triu(m_pin, 1).T
+            assert relative_error(model.mass_matrix(q), t_pin.T @ m_pin @ t_pin) <= RELATIVE
+            m_bullet = np.array(
+                pybullet.calculateMassMatrix(body, list(q[7:]), physicsClientId=client)
+            )
+            assert (
+                relative_error(model.mass_matrix(q), t_bullet.T @ m_bullet @ t_bullet) <= RELATIVE
+            )
+            v = t_pin @ qd
+            acceleration = np.zeros(6 + n)
+            acceleration[:3] = -np.cross(v[3:6], v[:3])
+            bias_pin = t_pin.T @ pin.rnea(built, data, q, v, acceleration)
+            assert relative_error(model.bias(q, qd), bias_pin) <= RELATIVE
+            pin.computeJointJacobians(built, data, q)
+            pin.updateFramePlacements(built, data)
+            frame = built.getFrameId("end_effector")
+            jac = pin.getFrameJacobian(built, data, frame, pin.LOCAL_WORLD_ALIGNED) @ t_pin
+            assert relative_error(model.jacobian(q), jac) <= RELATIVE
+    finally:
+        pybullet.disconnect(client)

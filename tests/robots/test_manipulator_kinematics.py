@@ -9,7 +9,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from dcsim.geometry import quaternion_from_rotation_vector, quaternion_multiply, rotation_vector
-from dcsim.robots.dh import thesis_manipulator
+from dcsim.robots.dh import DHLink, thesis_manipulator
 from dcsim.robots.kinematics import rotation_matrix
 from dcsim.robots.manipulator import ManipulatorModel
 
@@ -161,3 +161,8 @@ def test_det_jjt_is_positive_away_from_singularities(model):
     q = state([0.3, 0.5, -0.7, 0.4, 0.9, -0.2])
     assert model.det_jjt(q) > 1e-6
     assert model.det_jjt(q, position_only=True) > 1e-6
+
+
+def test_a_link_inertia_no_body_can_have_is_refused():
+    with pytest.raises(ValueError, match="at most the sum of the other two"):
+        DHLink(a=0.5, alpha=0.0, d=0.0, mass=1.0, inertia=(0.05, 0.2, 0.3))
