@@ -93,9 +93,9 @@ def bullet(model, tmp_path_factory):
 
 def bullet_map(q: np.ndarray) -> np.ndarray:
     """``T`` with PyBullet's velocity = ``T`` · ours."""
-    rotation_t = rotation_matrix(q[3:7]).T
-    t = np.zeros((6 + N, 6 + N))
-    t[:3, 3:6], t[3:6, :3], t[6:, 6:] = rotation_t, rotation_t, np.eye(N)
+    rotation_t, n = rotation_matrix(q[3:7]).T, q.size - 7
+    t = np.zeros((6 + n, 6 + n))
+    t[:3, 3:6], t[3:6, :3], t[6:, 6:] = rotation_t, rotation_t, np.eye(n)
     return t
 
 
@@ -141,9 +141,9 @@ def pinocchio_model(model):
 
 def pinocchio_map(q: np.ndarray) -> np.ndarray:
     """``T`` with Pinocchio's velocity = ``T`` · ours."""
-    rotation_t = rotation_matrix(q[3:7]).T
-    t = np.zeros((6 + N, 6 + N))
-    t[:3, :3], t[3:6, 3:6], t[6:, 6:] = rotation_t, rotation_t, np.eye(N)
+    rotation_t, n = rotation_matrix(q[3:7]).T, q.size - 7
+    t = np.zeros((6 + n, 6 + n))
+    t[:3, :3], t[3:6, 3:6], t[6:, 6:] = rotation_t, rotation_t, np.eye(n)
     return t
 
 
@@ -233,15 +233,7 @@ def test_a_robot_with_offsets_and_twists_agrees_with_pinocchio_and_pybullet(tmp_
                 [rng.normal(size=3), quaternion / np.linalg.norm(quaternion), rng.uniform(-3, 3, n)]
             )
             qd = rng.normal(size=6 + n)
-            rotation_t = rotation_matrix(q[3:7]).T
-            t_pin = np.zeros((6 + n, 6 + n))
-            t_pin[:3, :3], t_pin[3:6, 3:6], t_pin[6:, 6:] = rotation_t, rotation_t, np.eye(n)
-            t_bullet = np.zeros((6 + n, 6 + n))
-            t_bullet[:3, 3:6], t_bullet[3:6, :3], t_bullet[6:, 6:] = (
-                rotation_t,
-                rotation_t,
-                np.eye(n),
-            )
+            t_pin, t_bullet = pinocchio_map(q), bullet_map(q)
             m_pin = pin.crba(built, data, q)
             m_pin = np.triu(m_pin) + np.triu(m_pin, 1).T
             assert relative_error(model.mass_matrix(q), t_pin.T @ m_pin @ t_pin) <= RELATIVE
