@@ -15,6 +15,7 @@ from dcsim.robots.kinematics import (
     Array,
     DHArrays,
     Kinematics,
+    cross,
     point_jacobians,
     rotation_jacobians,
     skew,
@@ -56,7 +57,7 @@ def _body_twists(kin: Kinematics, jt: Array, qd: Array) -> tuple[Array, Array]:
     """Angular velocities (n, 3) and centre-of-mass velocities (n, 3) of the links."""
     v_b, w_b, rates = qd[:3], qd[3:6], qd[6:]
     omegas = w_b + np.cumsum(kin.axes * rates[:, None], axis=0)
-    velocities = v_b + np.cross(w_b, kin.coms - kin.base_position) + jt @ rates
+    velocities = v_b + cross(w_b, kin.coms - kin.base_position) + jt @ rates
     return omegas, velocities
 
 
@@ -80,11 +81,11 @@ def complement_rate(dh: DHArrays, kin: Kinematics, jt: Array, qd: Array) -> tupl
     (n + 1, 3), base first."""
     n = dh.a.size
     omegas, velocities = _body_twists(kin, jt, qd)
-    axis_rates = np.cross(omegas, kin.axes)  # k̂_j is fixed in link j (and j − 1)
-    joint_velocities = velocities + np.cross(omegas, kin.joint_points - kin.coms)
+    axis_rates = cross(omegas, kin.axes)  # k̂_j is fixed in link j (and j − 1)
+    joint_velocities = velocities + cross(omegas, kin.joint_points - kin.coms)
     arms = kin.coms[:, None, :] - kin.joint_points[None, :, :]
     arm_rates = velocities[:, None, :] - joint_velocities[None, :, :]
-    columns = np.cross(axis_rates[None], arms) + np.cross(kin.axes[None], arm_rates)
+    columns = cross(axis_rates[None], arms) + cross(kin.axes[None], arm_rates)
     rate = np.zeros((n + 1, 6, 6 + n))
     rate[1:, 0:3, 6:] = (axis_rates[None] * dh.lower[:, :, None]).transpose(0, 2, 1)
     rate[1:, 3:6, 3:6] = -skew(velocities - qd[:3])

@@ -22,10 +22,20 @@ Array = NDArray[np.float64]
 def skew(v: ArrayLike) -> Array:
     """Cross-product matrices ``[v×]`` (eq. 3.9) of vectors ``v`` (..., 3) → (..., 3, 3)."""
     v = np.asarray(v, dtype=float)
-    x, y, z = v[..., 0], v[..., 1], v[..., 2]
-    zero = np.zeros_like(x)
-    rows = [np.stack([zero, -z, y], -1), np.stack([z, zero, -x], -1), np.stack([-y, x, zero], -1)]
-    return np.stack(rows, -2)
+    out = np.zeros(v.shape + (3,))
+    out[..., 0, 1], out[..., 0, 2] = -v[..., 2], v[..., 1]
+    out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
+    out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
+    return out
+
+
+def cross(a: Array, b: Array) -> Array:
+    """``a × b`` over the last axis, broadcasting (numpy's ``cross`` without its overhead)."""
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
 
 
 def rotation_matrix(quaternion: ArrayLike) -> Array:
@@ -119,15 +129,13 @@ def dh_transforms(dh: DHArrays, theta: Array) -> tuple[Array, Array]:
     """Rotations ``R_i^{i−1}`` (n, 3, 3) and translations ``p_i^{i−1}`` (n, 3) of eq. 3.2."""
     angle = theta + dh.theta_offset
     ct, st, ca, sa = np.cos(angle), np.sin(angle), np.cos(dh.alpha), np.sin(dh.alpha)
-    rot = np.stack(
-        [
-            np.stack([ct, -st * ca, st * sa], -1),
-            np.stack([st, ct * ca, -ct * sa], -1),
-            np.stack([np.zeros_like(ct), sa, ca], -1),
-        ],
-        -2,
-    )
-    return rot, np.stack([dh.a * ct, dh.a * st, dh.d], -1)
+    rot = np.empty((angle.size, 3, 3))
+    rot[:, 0, 0], rot[:, 0, 1], rot[:, 0, 2] = ct, -st * ca, st * sa
+    rot[:, 1, 0], rot[:, 1, 1], rot[:, 1, 2] = st, ct * ca, -ct * sa
+    rot[:, 2, 0], rot[:, 2, 1], rot[:, 2, 2] = 0.0, sa, ca
+    translation = np.empty((angle.size, 3))
+    translation[:, 0], translation[:, 1], translation[:, 2] = dh.a * ct, dh.a * st, dh.d
+    return rot, translation
 
 
 def split_state(q: ArrayLike, n: int) -> tuple[Array, Array, Array]:
@@ -171,7 +179,7 @@ def point_jacobians(kin: Kinematics, points: Array, lower: Array) -> Array:
     move them.
     """
     arms = points[:, None, :] - kin.joint_points[None, :, :]
-    columns = np.cross(kin.axes[None, :, :], arms) * lower[:, :, None]
+    columns = cross(kin.axes[None, :, :], arms) * lower[:, :, None]
     return columns.transpose(0, 2, 1)
 
 

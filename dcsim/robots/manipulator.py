@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike
 from dcsim.geometry import quaternion_from_rotation_vector, quaternion_multiply
 from dcsim.robots import dynamics
 from dcsim.robots.dh import DHRobot
-from dcsim.robots.kinematics import Array, DHArrays, Kinematics, kinematics, skew
+from dcsim.robots.kinematics import Array, DHArrays, Kinematics, cross, kinematics, skew
 from dcsim.robots.urdf import urdf_text
 
 IKStatus = Literal["converged", "unreachable", "singular", "not-converged"]
@@ -165,7 +165,7 @@ class ManipulatorModel:
         jac = np.zeros((6, 6 + n))
         jac[:3, :3] = np.eye(3)
         jac[:3, 3:6] = -skew(reach)
-        jac[:3, 6:] = np.cross(kin.axes, kin.end_effector - kin.joint_points).T
+        jac[:3, 6:] = cross(kin.axes, kin.end_effector - kin.joint_points).T
         jac[3:, 3:6] = np.eye(3)
         jac[3:, 6:] = kin.axes.T
         return jac
