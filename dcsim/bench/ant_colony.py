@@ -746,7 +746,7 @@ def convergence_figure(
     figure, axes = plt.subplots(
         len(rows),
         len(cross_sections),
-        figsize=(6.5 * len(cross_sections), 4.5 * len(rows)),
+        figsize=(max(9.0, 6.5 * len(cross_sections)), 4.5 * len(rows)),
         squeeze=False,
     )
     for row, (kind, runs) in enumerate(rows):
@@ -817,7 +817,7 @@ def convergence_figure(
             if mine:
                 axis.legend(fontsize=8)
     figure.suptitle(
-        "Ant colony convergence: (F − F_optimum) / F_optimum per cycle "
+        "Ant colony convergence: (F − F_optimum) / F_optimum per cycle\n"
         f"(dotted: {TARGET_MEDIAN_GAP:g} %, dash-dot: {TARGET_P95_GAP:g} %)"
     )
     save(figure, path)
@@ -838,11 +838,11 @@ def distribution_plot(runs: Sequence[Run], path: Path) -> None:
     groups = _groups([r for r in runs if r.scored])
     labels = [s.label.replace(" ", "\n", 1) for s in groups]
     figure, axes = plt.subplots(2, 1, figsize=(max(8, 1.3 * len(groups)), 8))
-    for axis, (title, value, limit) in zip(
+    for axis, (title, value, limit, gaps) in zip(
         axes,
         [
-            ("gap to the exact optimum [%]", lambda r: r.gap, TARGET_P95_GAP),
-            ("whole plan [ms]", lambda r: 1e3 * r.plan_seconds, 1e3 * TARGET_PLAN_SECONDS),
+            ("gap to the exact optimum [%]", lambda r: r.gap, TARGET_P95_GAP, True),
+            ("whole plan [ms]", lambda r: 1e3 * r.plan_seconds, 1e3 * TARGET_PLAN_SECONDS, False),
         ],
         strict=True,
     ):
@@ -850,8 +850,12 @@ def distribution_plot(runs: Sequence[Run], path: Path) -> None:
         axis.set_xticks(np.arange(1, len(labels) + 1), labels, fontsize=8)
         axis.axhline(limit, color="0.5", lw=0.7, ls="--")
         axis.set_ylabel(title)
-        axis.set_yscale("symlog", linthresh=1.0)
-        axis.grid(alpha=0.3, axis="y")
+        if gaps:  # gaps of 0 are common: linear up to 0.1 %
+            axis.set_yscale("symlog", linthresh=0.1)
+            axis.set_ylim(bottom=0.0)
+        else:
+            axis.set_yscale("log")
+        axis.grid(alpha=0.3, axis="y", which="both")
     axes[0].set_title(
         f"ant-colony over {len(_problems(runs))} layouts "
         f"(dashed: p95 gap target {TARGET_P95_GAP:g} %, line plan target "

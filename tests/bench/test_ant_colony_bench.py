@@ -29,8 +29,9 @@ def layouts():
 
 @pytest.fixture(scope="module")
 def runs(registry, layouts):
-    lines = []
-    return bench.bench_ant_colony(registry, layouts, SETTINGS, progress=lines.append), lines
+    lines = []  # a generous budget: a busy machine must not cut the whole plan's colony
+    runs = bench.bench_ant_colony(registry, layouts, SETTINGS, budget=30.0, progress=lines.append)
+    return runs, lines
 
 
 def test_every_run_is_a_real_colony_scored_on_a_graph_rebuilt_here(registry, layouts, runs):
@@ -165,3 +166,13 @@ def test_bad_options_are_errors_without_a_traceback(options, message):
 def test_the_convergence_figure_sits_beside_the_paths_figure(tmp_path):
     assert bench.convergence_path(tmp_path / "a.png") == tmp_path / "a_convergence.png"
     assert bench.convergence_path(tmp_path / "b") == tmp_path / "b_convergence.png"
+
+
+def test_a_whole_plan_cut_short_by_its_budget_is_counted(registry, layouts):
+    setting = SETTINGS[0]
+    cls = bench.planner_class(registry)
+    run = bench.run_setting(cls, layouts[0], setting, 0, budget=0.005)
+    assert run.scored and run.cycles > 1  # the measured colony has no deadline
+    assert run.plan_cycles < run.cycles and run.cut_by_budget
+    row = next(line for line in bench.time_table([run]).splitlines() if "| line |" in line)
+    assert row.endswith("| 1 |")
