@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import re
 import sys
+import time
 import warnings
 from collections.abc import Sequence
 from datetime import datetime
@@ -625,6 +626,195 @@ def bench_grid_search_command(
         registry, scenario, budget, fly, lambda line: click.echo(line, err=True), params
     )
     click.echo(tables(cells))
+
+
+@bench_group.command("ant-colony")
+@click.option(
+    "--layouts",
+    type=int,
+    default=None,
+    help="Seeded obstacle layouts static-spheres:0 to N - 1 (default 100).",
+)
+@click.option(
+    "--problems",
+    default=None,
+    help="Comma-separated problems instead of the layouts: a family (static-spheres, "
+    "cw-spheres, shapes) with :SEED or :FIRST..LAST seeds, or a transfer scenario file.",
+)
+@click.option("--deltas", default="2,6", show_default=True, help="Comma-separated δ values, m².")
+@click.option(
+    "--cross-sections",
+    default="line,grid",
+    show_default=True,
+    help="Comma-separated cross-sections: line (the paper's), grid.",
+)
+@click.option(
+    "--variants",
+    default="defaults,paper",
+    show_default=True,
+    help="Comma-separated variants: defaults (the planner's), paper (the paper's literal "
+    "colony: visibility=length, local_search=false, deposit_by=all, pheromone_floor=0, "
+    "stall_cycles=242).",
+)
+@click.option(
+    "--params",
+    "extra",
+    default=None,
+    help="Further ant-colony parameters for every variant as key=value:key=value (e.g. ants=60).",
+)
+@click.option(
+    "--budget",
+    type=float,
+    default=None,
+    help="Planning budget of every whole plan, s (default: the problem's; 1 s for the families).",
+)
+@click.option(
+    "--figure",
+    "figure_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Write the paper's Fig. 2 regenerated on --figure-scenario (paths for every δ) "
+    "here, and the convergence curves beside it as NAME_convergence.png.",
+)
+@click.option(
+    "--figure-scenario",
+    default="scenarios/ffsr_obstacles.yaml",
+    show_default=True,
+    help="The problem drawn by --figure.",
+)
+@click.option(
+    "--plot",
+    "plot_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Save box plots of the gap and the plan time over the layouts per setting.",
+)
+def bench_ant_colony_command(
+    layouts: int | None,
+    problems: str | None,
+    deltas: str,
+    cross_sections: str,
+    variants: str,
+    extra: str | None,
+    budget: float | None,
+    figure_path: Path | None,
+    figure_scenario: str,
+    plot_path: Path | None,
+) -> None:
+    """The ant-colony planner against the exact optimum of its own candidate graph.
+
+    On every layout, for every cross-section, δ and variant: the colony's gap to the
+    optimum that dynamic programming finds on the same graph, its cycles, and the wall
+    times of the graph, the colony, the whole plan and the DP, beside issue 17's targets
+    (median gap ≤ 1 %, p95 ≤ 3 %, ≤ 0.5 s per plan with the line cross-section). Prints
+    Markdown tables for docs/benchmarks.md; progress goes to stderr.
+    """
+    from dcsim.bench import ant_colony as bench
+    from dcsim.bench.path_planners import planner_spec
+    from dcsim.bench.path_problems import expand_specs, load_problem
+
+    if layouts is not None and problems is not None:
+        raise DcsimError("give --layouts or --problems, not both")
+    if layouts is not None and layouts < 1:
+        raise DcsimError(f"--layouts must be at least 1, got {layouts}")
+    if budget is not None and not budget > 0:
+        raise DcsimError(f"--budget must be a positive number of seconds, got {budget:g}")
+    chosen = bench.settings(
+        _words(cross_sections, "--cross-sections"),
+        _numbers(deltas, "--deltas"),
+        _words(variants, "--variants"),
+    )
+    registry = _registry()
+    params = dict(planner_spec(registry, f"{bench.PLANNER}:{extra}").params) if extra else None
+    resolved = bench.check_params(registry, chosen, params)
+    specs = (
+        expand_specs(_words(problems, "--problems"))
+        if problems is not None
+        else [f"static-spheres:{seed}" for seed in range(100 if layouts is None else layouts)]
+    )
+    figure_problem = load_problem(figure_scenario) if figure_path is not None else None
+
+    def say(line: str) -> None:
+        click.echo(line, err=True)
+
+    say(f"loading problems: {len(specs)}")
+    loaded = [load_problem(spec) for spec in specs]
+    began = time.monotonic()
+    runs = bench.bench_ant_colony(registry, loaded, chosen, params, budget, say)
+    wall = time.monotonic() - began
+    click.echo(
+        f"ant-colony on {len(loaded)} problems ({_span(specs)}), {len(chosen)} settings, "
+        f"planner seed = problem index, whole-plan budget "
+        f"{'the problem' + chr(39) + 's' if budget is None else f'{budget:g} s'}; "
+        f"{wall:.0f} s of wall time"
+    )
+    click.echo("")
+    for variant in dict.fromkeys(s.variant for s in chosen):
+        label = next(s.label for s in chosen if s.variant == variant)
+        shown = {k: v for k, v in resolved[label].items() if k not in ("cross_section", "delta")}
+        click.echo(f"- {variant}: " + ", ".join(f"{k}={v}" for k, v in shown.items()))
+    click.echo("")
+    click.echo("Gap to the exact optimum of the same graph")
+    click.echo("")
+    click.echo(bench.quality_table(runs))
+    click.echo("")
+    click.echo("Wall time, ms")
+    click.echo("")
+    click.echo(bench.time_table(runs))
+    click.echo("")
+    click.echo("Issue 17's targets")
+    click.echo("")
+    click.echo(bench.target_table(runs))
+    notes = bench.unscored_lines(runs)
+    if notes:
+        click.echo("")
+        click.echo("Runs unscored, without a trajectory, or below the optimum")
+        click.echo("")
+        click.echo("\n".join(notes))
+    if figure_problem is not None and figure_path is not None:
+        say(f"figure: {figure_problem.name}")
+        scenario_runs = bench.bench_ant_colony(
+            registry, [figure_problem], chosen, params, budget, say
+        )
+        click.echo("")
+        click.echo(f"{figure_problem.name} (the paper's Fig. 2), planner seed 0")
+        click.echo("")
+        click.echo(bench.scenario_table(scenario_runs, figure_problem.problem))
+        figure_path.parent.mkdir(parents=True, exist_ok=True)
+        bench.paths_figure(scenario_runs, figure_problem, figure_path)
+        convergence = bench.convergence_path(figure_path)
+        bench.convergence_figure(scenario_runs, runs, figure_problem.name, convergence)
+        click.echo(f"\nfigures: {figure_path}, {convergence}")
+    if plot_path is not None:
+        plot_path.parent.mkdir(parents=True, exist_ok=True)
+        bench.distribution_plot(runs, plot_path)
+        click.echo(f"plot: {plot_path}")
+
+
+def _words(text: str, option: str) -> list[str]:
+    """The comma-separated words of an option (an error when there are none)."""
+    words = [word.strip() for word in text.split(",") if word.strip()]
+    if not words:
+        raise DcsimError(f"{option}: name at least one")
+    return words
+
+
+def _numbers(text: str, option: str) -> list[float]:
+    """The comma-separated numbers of an option."""
+    try:
+        return [float(word) for word in _words(text, option)]
+    except ValueError:
+        raise DcsimError(f"{option}: expected numbers like 2,6, got {text!r}") from None
+
+
+def _span(specs: Sequence[str]) -> str:
+    """``static-spheres:0..99`` for consecutive seeds of one family, else the specs."""
+    match = [re.fullmatch(r"([a-z-]+):(\d+)", spec) for spec in specs]
+    if all(match) and len({m[1] for m in match}) == 1:
+        seeds = [int(m[2]) for m in match]
+        if seeds == list(range(seeds[0], seeds[0] + len(seeds))) and len(seeds) > 1:
+            return f"{match[0][1]}:{seeds[0]}..{seeds[-1]}"
+    return ", ".join(specs)
 
 
 @bench_group.command("path-planners")
