@@ -61,6 +61,7 @@ from typing import Literal
 import numpy as np
 from dcsim_plugins.path_planners.colony import ColonyResult, solve_colony
 from dcsim_plugins.path_planners.layered_graph import (
+    GraphUnfinished,
     LayeredGraph,
     build_graph,
     endpoints,
@@ -235,13 +236,19 @@ class AntColonyPlanner(PathPlanner):
             return ends
         if np.linalg.norm(ends.goal - ends.start) < SHORTEST:
             return self._flown(problem, ends.departure, ends.start[None], {"cycles": 0.0})
-        graph = graph_between(problem, self.params, ends)
+        deadline = started + (1.0 - _RESERVE) * problem.time_budget
+        try:
+            graph = graph_between(problem, self.params, ends, deadline)
+        except GraphUnfinished as unfinished:
+            return NoPath(
+                f"no path within the time budget: the candidate graph was not finished "
+                f"({unfinished}; a coarser check_spacing tests boxes and cylinders faster)"
+            )
         if not graph.has_path:
             return NoPath(
                 f"every path across the {self.params.parts - 1} cross-sections meets an "
                 "obstacle or leaves the bounds (widen half_width or add points)"
             )
-        deadline = started + (1.0 - _RESERVE) * problem.time_budget
         colony = self.colony(graph, deadline)
         vertices, _ = simplify(problem, graph, colony.path, self.params)
         statistics = {

@@ -58,6 +58,7 @@ Fewer vertices (:func:`simplify`)
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -258,8 +259,20 @@ def nominal_times(
     return start_time + np.interp(distances, covered, tau)
 
 
-def graph_between(problem: PathProblem, params: AntColonyParams, ends: Ends) -> LayeredGraph:
-    """The candidate graph from ``ends.start`` to ``ends.goal`` (see :func:`build_graph`)."""
+class GraphUnfinished(RuntimeError):
+    """The candidate graph was not finished by its deadline."""
+
+
+def graph_between(
+    problem: PathProblem, params: AntColonyParams, ends: Ends, deadline: float = math.inf
+) -> LayeredGraph:
+    """The candidate graph from ``ends.start`` to ``ends.goal`` (see :func:`build_graph`).
+
+    Raises
+    ------
+    GraphUnfinished
+        If ``time.monotonic()`` passes ``deadline`` before every obstacle is tested.
+    """
     m = params.parts
     n = params.points if params.points is not None else _DEFAULT_POINTS[params.cross_section]
     start, goal = ends.start, ends.goal
@@ -283,7 +296,9 @@ def graph_between(problem: PathProblem, params: AntColonyParams, ends: Ends) -> 
     reach = problem.robot_radius + params.clearance
     gaps = np.full((m + 1, count), np.inf)
     blocked = np.zeros((m, count, count), dtype=bool)
-    for track in problem.obstacles:
+    for done, track in enumerate(problem.obstacles):
+        if time.monotonic() > deadline:
+            raise GraphUnfinished(f"{done} of {len(problem.obstacles)} obstacles tested")
         centres = track.predict(times)[0]
         gaps = np.minimum(gaps, _point_gaps(track, points - centres[:, None, :]))
         _block_segments(track, points, centres, along, forward, start, reach, params, blocked)
