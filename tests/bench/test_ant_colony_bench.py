@@ -171,7 +171,7 @@ def test_the_convergence_figure_sits_beside_the_paths_figure(tmp_path):
 def test_a_whole_plan_cut_short_by_its_budget_is_counted(registry, layouts):
     setting = SETTINGS[0]
     cls = bench.planner_class(registry)
-    run = bench.run_setting(cls, layouts[0], setting, 0, budget=0.005)
+    run = bench.run_setting(cls, layouts[0], setting, 0, budget=0.06)
     assert run.scored and run.cycles > 1  # the measured colony has no deadline
     assert run.plan_cycles < run.cycles and run.cut_by_budget
     row = next(line for line in bench.time_table([run]).splitlines() if "| line |" in line)
