@@ -264,6 +264,23 @@ def _propellant_rule(get: _Values) -> list[tuple[KeyPath, str]]:
     return [(("robot", "propellant_mass"), message)]
 
 
+def _joint_count_rule(get: _Values) -> list[tuple[KeyPath, str]]:
+    """A manipulator's initial joint angles and rates: one per link."""
+    if get("robot", "type") != "manipulator":
+        return []
+    robot = get.data.get("robot")
+    links = robot.get("links") if isinstance(robot, dict) else None
+    if not isinstance(links, list):  # the schema reports it
+        return []
+    found: list[tuple[KeyPath, str]] = []
+    for key in ("joint_angles_deg", "joint_rates_deg_s"):
+        values = get("robot", "initial", key)
+        if values is not None and len(values) != len(links):
+            message = f"{len(values)} values for {len(links)} links: give one per link"
+            found.append((("robot", "initial", key), message))
+    return found
+
+
 def _reach_rule(get: _Values) -> list[tuple[KeyPath, str]]:
     reach, grab = get("mission", "reach"), get("robot", "grab_distance")
     if reach <= grab:
@@ -333,6 +350,7 @@ _RULES: list[Rule] = [
     _duration_rule,
     _orbit_rule,
     _propellant_rule,
+    _joint_count_rule,
     _reach_rule,
     _attitude_rule,
     _object_rules,
@@ -417,6 +435,11 @@ def _schema_problems(
     messages: dict[KeyPath, list[str]] = {}
     for err in exc.errors():
         path, owner, field = _locate(doc.data, err["loc"], model)
+        if err["type"] == "robot_type" and isinstance(err["input"], dict):
+            tag = err["input"].get("type")  # the robot section's tag names no robot type
+            message = f"unknown robot type {short_repr(tag)}; known: free-flyer, manipulator"
+            messages.setdefault((*path, "type"), []).append(message)
+            continue
         exact = bool(err["loc"]) and path[-1:] == (err["loc"][-1],)
         if exact:
             message = describe_error(owner, field, err)
@@ -478,4 +501,9 @@ def _pick_model(annotation: Any, data: Any) -> type[BaseModel] | None:
             tag = cls.model_fields.get("type")
             if tag is not None and data["type"] in get_args(tag.annotation):
                 return cls
+    if isinstance(data, dict):  # no type: the one class whose type has a default
+        tagged = [cls for cls in classes if "type" in cls.model_fields]
+        defaults = [cls for cls in tagged if not cls.model_fields["type"].is_required()]
+        if len(defaults) == 1 and len(tagged) == len(classes):
+            return defaults[0]
     return None

@@ -9,6 +9,7 @@ generated from these models.
 from __future__ import annotations
 
 import functools
+import math
 from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
@@ -16,8 +17,10 @@ from pydantic import (
     AfterValidator,
     BaseModel,
     ConfigDict,
+    Discriminator,
     Field,
     ModelWrapValidatorHandler,
+    Tag,
     create_model,
     model_validator,
 )
@@ -35,8 +38,14 @@ from dcsim.motion import (
     mean_motion,
 )
 from dcsim.params import quantity
+from dcsim.robots.dh import DHLink, DHRobot, ManipulatorBase
 
 Vec3 = tuple[float, float, float]
+
+PositiveVec3 = tuple[
+    Annotated[float, Field(gt=0)], Annotated[float, Field(gt=0)], Annotated[float, Field(gt=0)]
+]
+"""Three positive numbers (lengths, moments), each > 0."""
 
 MAX_STEPS_PER_CONTROL_PERIOD = 100_000
 """Most physics steps in one control period."""
@@ -253,6 +262,186 @@ class RobotSection(Section):
     )
 
 
+def _rigid(moments: tuple[float, float, float]) -> tuple[float, float, float]:
+    if any(2.0 * m > sum(moments) * (1.0 + 1e-12) for m in moments):
+        raise ValueError("each principal moment must be at most the sum of the other two")
+    return moments
+
+
+Moments = Annotated[PositiveVec3, AfterValidator(_rigid)]
+"""Principal moments of inertia of a rigid body: positive, each at most the sum of the others."""
+
+
+def _ordered(limits: tuple[float, float]) -> tuple[float, float]:
+    if not limits[0] <= limits[1]:
+        raise ValueError("give [lower, upper], lower at most upper")
+    return limits
+
+
+Limits = Annotated[tuple[float, float], AfterValidator(_ordered)]
+"""A lower and an upper limit."""
+
+
+class ManipulatorInitialSpec(InitialStateSpec):
+    """The manipulator's state at t = 0: its base's (as a free flyer's) and its joints'."""
+
+    joint_angles_deg: list[float] | None = quantity(
+        None,
+        unit="deg",
+        description="Joint angles, one per link of `links`; null: all zero.",
+    )
+    joint_rates_deg_s: list[float] | None = quantity(
+        None,
+        unit="deg/s",
+        description="Joint rates, one per link of `links`; null: all zero.",
+    )
+
+
+class DHLinkSpec(Section):
+    """One row of the arm's Denavit–Hartenberg table: a revolute joint and the link it moves.
+
+    The link's centre of mass is the midpoint of its DH segment and its principal axes
+    are those of DH frame i (x along the link); see docs/architecture.md.
+    """
+
+    a: float = quantity(unit="m", description="Link length along x_i.")
+    alpha_deg: float = quantity(unit="deg", description="Link twist about x_i.")
+    d: float = quantity(0.0, unit="m", description="Link offset along z_(i-1).")
+    theta_offset_deg: float = quantity(
+        0.0, unit="deg", description="DH angle θ_i when the joint angle is zero."
+    )
+    mass: float = quantity(unit="kg", gt=0, description="Link mass.")
+    inertia: Moments = quantity(
+        unit="kg*m^2",
+        description="Principal moments of inertia about the link's centre of mass, along "
+        "the axes of DH frame i; each at most the sum of the other two.",
+    )
+    position_limits_deg: Limits | None = quantity(
+        None, unit="deg", description="Lower and upper joint angle; null: unlimited."
+    )
+    torque_limit: float | None = quantity(
+        None, unit="N*m", gt=0, description="Largest joint torque magnitude; null: unlimited."
+    )
+
+    def build(self) -> DHLink:
+        """The link in SI units (radians)."""
+        lower, upper = self.position_limits_deg or (-math.inf, math.inf)
+        return DHLink(
+            a=self.a,
+            alpha=math.radians(self.alpha_deg),
+            d=self.d,
+            mass=self.mass,
+            inertia=self.inertia,
+            theta_offset=math.radians(self.theta_offset_deg),
+            joint_limits=(math.radians(lower), math.radians(upper)),
+            torque_limit=math.inf if self.torque_limit is None else self.torque_limit,
+        )
+
+
+class ManipulatorSection(Section):
+    """The robot: a space manipulator, a satellite base carrying an arm of revolute joints.
+
+    The base flies as a free flyer does (thrust from propellant, torque from reaction
+    wheels); the arm is described by its DH table (docs/architecture.md, Robots).
+    """
+
+    type: Literal["manipulator"] = Field(
+        description="The robot type: `manipulator`, a base with a DH arm."
+    )
+    mass: float = quantity(unit="kg", gt=0, description="Base mass, propellant included.")
+    propellant_mass: float = quantity(
+        0.0, unit="kg", ge=0, description="Usable propellant (part of the base's mass)."
+    )
+    inertia: Moments = quantity(
+        unit="kg*m^2",
+        description="Principal moments of inertia of the base about its centre of mass, "
+        "along its axes; each at most the sum of the other two.",
+    )
+    size: PositiveVec3 = quantity(
+        (1.0, 1.0, 1.0), unit="m", description="Edge lengths of the base's box (centred)."
+    )
+    mount: Vec3 = quantity(
+        (0.0, 0.0, 0.0),
+        unit="m",
+        description="r_q: the first joint's frame (DH frame 0) from the base's centre of "
+        "mass, base frame; frame 0 has the base's axes.",
+    )
+    links: list[DHLinkSpec] = Field(
+        min_length=1, description="The DH table, one row per joint, from the base outwards."
+    )
+    max_force: float = quantity(10.0, unit="N", gt=0, description="Largest thrust magnitude.")
+    max_torque: float = quantity(
+        1.0, unit="N*m", gt=0, description="Largest base torque magnitude."
+    )
+    max_speed: float = quantity(
+        1.0, unit="m/s", gt=0, description="Speed guidance must not exceed."
+    )
+    specific_impulse: float = quantity(
+        220.0, unit="s", gt=0, description="Thruster specific impulse."
+    )
+    sensor_range: float = quantity(
+        200.0, unit="m", gt=0, description="Objects farther away are not tracked."
+    )
+    initial: ManipulatorInitialSpec = Field(
+        default_factory=ManipulatorInitialSpec, description="State at t = 0."
+    )
+
+    grab_distance: ClassVar[float] = 0.0
+    """A manipulator grabs nothing through the world's grab service."""
+    capacity: ClassVar[int] = 0
+
+    @property
+    def radius(self) -> float:
+        """Radius of a sphere about the base's centre of mass holding base and arm, m."""
+        reach = float(np.hypot([k.a for k in self.links], [k.d for k in self.links]).sum())
+        half_diagonal = 0.5 * float(np.linalg.norm(self.size))
+        return max(half_diagonal, float(np.linalg.norm(self.mount)) + reach)
+
+    def dh_robot(self) -> DHRobot:
+        """The robot's DH description in SI units (radians)."""
+        base = ManipulatorBase(
+            mass=self.mass, inertia=self.inertia, size=self.size, mount=self.mount
+        )
+        return DHRobot(base=base, links=tuple(link.build() for link in self.links))
+
+    def initial_joints(self) -> tuple[Vector, Vector]:
+        """Initial joint angles (rad) and rates (rad/s) (zero where not given).
+
+        Raises
+        ------
+        ValueError
+            If a list does not have one value per link (the loader reports it first).
+        """
+        n = len(self.links)
+        for values in (self.initial.joint_angles_deg, self.initial.joint_rates_deg_s):
+            if values is not None and len(values) != n:
+                raise ValueError(f"{len(values)} initial joint values for {n} links")
+        angles, rates = self.initial.joint_angles_deg, self.initial.joint_rates_deg_s
+        return (
+            np.radians(np.zeros(n) if angles is None else np.asarray(angles, dtype=float)),
+            np.radians(np.zeros(n) if rates is None else np.asarray(rates, dtype=float)),
+        )
+
+
+def _robot_type(data: Any) -> str | None:
+    """The tag of a robot section: its ``type`` (``free-flyer`` when absent)."""
+    if isinstance(data, dict):
+        value = data.get("type", "free-flyer")
+        return value if isinstance(value, str) else None
+    return getattr(data, "type", "free-flyer")  # not a section: the default's error says so
+
+
+AnyRobotSection = Annotated[
+    Annotated[RobotSection, Tag("free-flyer")] | Annotated[ManipulatorSection, Tag("manipulator")],
+    Discriminator(
+        _robot_type,
+        custom_error_type="robot_type",
+        custom_error_message="robot.type must be `free-flyer` or `manipulator`",
+    ),
+]
+"""The robot section, chosen by its ``type`` key (``free-flyer`` when absent)."""
+
+
 def _nonzero(quaternion: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
     if sum(q * q for q in quaternion) < 1e-12:
         raise ValueError("the quaternion must not be zero")
@@ -261,11 +450,6 @@ def _nonzero(quaternion: tuple[float, float, float, float]) -> tuple[float, floa
 
 Quaternion = Annotated[tuple[float, float, float, float], AfterValidator(_nonzero)]
 """A rotation ``[x, y, z, w]``, any non-zero length (normalised where used)."""
-
-PositiveVec3 = tuple[
-    Annotated[float, Field(gt=0)], Annotated[float, Field(gt=0)], Annotated[float, Field(gt=0)]
-]
-"""Three lengths, each > 0."""
 
 
 def _unit(quaternion: Quaternion) -> Vector:
@@ -619,7 +803,10 @@ class Scenario(Section):
     name: str = Field("unnamed", description="Short name of the scenario.")
     description: str = Field("", description="What the scenario shows.")
     world: WorldSpec = Field(default_factory=WorldSpec, description="Frame, steps and seed.")
-    robot: RobotSection = Field(default_factory=RobotSection, description="The collector.")
+    robot: AnyRobotSection = Field(
+        default_factory=RobotSection,
+        description="The robot; `type` selects it (default `free-flyer`).",
+    )
     targets: list[SpaceObjectSpec] = Field(default_factory=list, description="Objects to collect.")
     obstacles: list[SpaceObjectSpec] = Field(default_factory=list, description="Objects to avoid.")
     beacons: BeaconsSection = Field(
