@@ -335,6 +335,7 @@ class Runner:
             torque=self._command.torque,
             disturbance_force=disturbance_force,
             disturbance_torque=disturbance_torque,
+            joint_torques=self._command.joint_torques,
         )
         collisions = self.world.step(inputs)
         self.laps.lap("world")

@@ -24,16 +24,32 @@ composes its pieces:
 
 from __future__ import annotations
 
+import dataclasses
 import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from dcsim.geometry import clip_norm, length
-from dcsim.messages import BeaconRange, DropPoint, MotionInput, ObjectTrack, Observations, RobotSpec
-from dcsim.scenario.model import Scenario
+from dcsim.messages import (
+    BeaconRange,
+    DropPoint,
+    MotionInput,
+    ObjectTrack,
+    Observations,
+    RobotSpec,
+    RobotState,
+)
+from dcsim.robots.manipulator import ManipulatorModel
+from dcsim.scenario.model import ManipulatorSection, Scenario
+from dcsim.world.arm import ArmBody
 from dcsim.world.bodies import ObjectBodies, create_collector, surface_gap
-from dcsim.world.environment import Propellant, apply_cw_force, cw_acceleration
+from dcsim.world.environment import (
+    Propellant,
+    apply_cw_force,
+    apply_cw_force_on_link,
+    cw_acceleration,
+)
 from dcsim.world.objects import ObjectField, ObjectStatus, build_objects
 from dcsim.world.pybullet_client import connect_direct, pb
 from dcsim.world.sensors import Sensors
@@ -56,12 +72,16 @@ class WorldInputs:
         External force on the collector, N (not clipped, uses no propellant).
     disturbance_torque : ndarray (3,)
         External torque on the collector, N·m.
+    joint_torques : ndarray (n,)
+        Commanded joint torques of a manipulator, N·m (clipped to the limits); empty
+        for none (and for a free flyer, which has no joints).
     """
 
     force: np.ndarray = field(default_factory=lambda: np.zeros(3))
     torque: np.ndarray = field(default_factory=lambda: np.zeros(3))
     disturbance_force: np.ndarray = field(default_factory=lambda: np.zeros(3))
     disturbance_torque: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    joint_torques: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 @dataclass(frozen=True)
@@ -140,7 +160,14 @@ class World:
         self._disconnect = weakref.finalize(self, pb.disconnect, physicsClientId=self._client)
         self._state_cache: tuple[int, tuple[np.ndarray, ...]] | None = None
         pb.setTimeStep(self.physics_step, physicsClientId=self._client)
-        self.collector = create_collector(self._client, robot)
+        self._arm: ArmBody | None = None
+        if isinstance(robot, ManipulatorSection):
+            self._arm = ArmBody(self._client, robot)
+            self._arm_links = self._arm.link_masses()
+            self.collector = self._arm.body
+        else:
+            self.collector = create_collector(self._client, robot)
+        self._joint_torques = np.zeros(0)
         self._bodies = ObjectBodies(self._client, self.field)
         self._cargo = Cargo(self._client, self.collector, self.field, self._bodies, robot)
         self._contacts: set[tuple[int, int]] = set()
@@ -209,8 +236,37 @@ class World:
         return self.dry_mass + self.propellant
 
     def assembly_mass(self) -> float:
-        """Mass of the collector and every target it carries, kg."""
-        return self.collector_mass() + self._cargo.mass
+        """Mass of the collector and every target it carries, kg (a manipulator's arm
+        included)."""
+        mass = self.collector_mass() + self._cargo.mass
+        if self._arm is not None:
+            return mass + sum(m for _, m in self._arm_links)
+        return mass
+
+    @property
+    def arm(self) -> ArmBody | None:
+        """The manipulator's multibody and joints; None for a free flyer."""
+        return self._arm
+
+    def joint_state(self) -> tuple[np.ndarray, np.ndarray]:
+        """True joint angles (rad) and rates (rad/s), (n,) each; empty for a free flyer."""
+        if self._arm is None:
+            return np.zeros(0), np.zeros(0)
+        return self._arm.joint_state()
+
+    def robot_state(self) -> RobotState:
+        """The true state: base (centre of mass, world frame) and joints."""
+        position, velocity, attitude, angular = self.collector_state()
+        angles, rates = self.joint_state()
+        return RobotState(
+            time=self.time,
+            position=position,
+            velocity=velocity,
+            attitude=attitude,
+            angular_velocity=angular,
+            joint_positions=angles,
+            joint_velocities=rates,
+        )
 
     def robot_spec(self) -> RobotSpec:
         """The collector's current mass, inertia, limits and bounding radius (cargo included).
@@ -220,6 +276,8 @@ class World:
         """
         r = self.robot
         inertia = pb.getDynamicsInfo(self.collector, -1, physicsClientId=self._client)[2]
+        if self._arm is not None:
+            return self._arm_spec(np.diag(inertia))
         return RobotSpec(
             mass=self.assembly_mass(),
             inertia=np.diag(inertia),
@@ -227,6 +285,29 @@ class World:
             max_force=r.max_force,
             max_torque=r.max_torque,
             max_speed=r.max_speed,
+        )
+
+    def _arm_spec(self, inertia: np.ndarray) -> RobotSpec:
+        """A manipulator's spec: total mass, base inertia, limits, joint limits, model.
+
+        The model (:class:`~dcsim.robots.manipulator.ManipulatorModel`) has the base's
+        current mass (propellant used so far).
+        """
+        arm, r = self._arm, self.robot
+        model = arm.model
+        if model.robot.base.mass != self.collector_mass():
+            base = dataclasses.replace(model.robot.base, mass=self.collector_mass())
+            model = ManipulatorModel(dataclasses.replace(model.robot, base=base))
+        return RobotSpec(
+            mass=self.assembly_mass(),
+            inertia=inertia,
+            radius=r.radius,
+            max_force=r.max_force,
+            max_torque=r.max_torque,
+            max_speed=r.max_speed,
+            joint_position_limits=arm.position_limits,
+            joint_torque_limits=arm.torque_limits,
+            model=model,
         )
 
     def carried_ids(self) -> list[int]:
@@ -358,6 +439,8 @@ class World:
         force = clip_norm(self.inputs.force, self.robot.max_force)
         torque = clip_norm(self.inputs.torque, self.robot.max_torque)
         self._period_mass = self.assembly_mass()
+        if self._arm is not None:
+            self._joint_torques = self._arm.clip_torques(self.inputs.joint_torques)
         self._update_broad_phase(force)
         disturbance = tuple(float(f) for f in self.inputs.disturbance_force)
         total_torque = tuple(
@@ -373,6 +456,11 @@ class World:
         return started
 
     def _set_body_mass(self, mass: float) -> None:
+        if self._arm is not None:
+            if mass != self._body_mass:
+                self._arm.set_base_mass(mass)
+                self._body_mass = mass
+            return
         pb.changeDynamics(self.collector, -1, mass=mass, physicsClientId=self._client)
         self._body_mass = mass
 
@@ -396,6 +484,11 @@ class World:
             )
             for index, (cargo, _) in self._cargo.held.items():
                 apply_cw_force(client, cargo, self.field.objects[index].mass, self._mean_motion)
+            if self._arm is not None:
+                for link, mass in self._arm_links:
+                    apply_cw_force_on_link(client, body, link, mass, self._mean_motion)
+        if self._arm is not None:
+            self._arm.apply_joint_torques(self._joint_torques)
         pb.applyExternalForce(
             body, -1, (fx, fy, fz), position, pb.WORLD_FRAME, physicsClientId=client
         )
@@ -464,7 +557,11 @@ class World:
         The star tracker and the gyros are noise-free.
         """
         position, _, attitude, angular_velocity = self.collector_state()
-        return self._sensors.observations(self.time, position, attitude, angular_velocity)
+        observed = self._sensors.observations(self.time, position, attitude, angular_velocity)
+        if self._arm is None:
+            return observed
+        angles, rates = self._arm.joint_state()  # noise-free encoders
+        return dataclasses.replace(observed, joint_positions=angles, joint_velocities=rates)
 
     def motion_input(self) -> MotionInput:
         """Mean thrust acceleration applied over the last control period."""

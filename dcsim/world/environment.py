@@ -61,6 +61,19 @@ def apply_cw_force(client: int, body: int, mass: float, mean_motion: float) -> N
     )
 
 
+def apply_cw_force_on_link(
+    client: int, body: int, link: int, mass: float, mean_motion: float
+) -> None:
+    """Apply the Clohessy–Wiltshire force on link ``link`` of multibody ``body`` (mass in kg)
+    for the next physics step, at the link's centre of mass (world frame)."""
+    state = pb.getLinkState(body, link, computeLinkVelocity=1, physicsClientId=client)
+    p, v = state[0], state[6]
+    cx, cy, cz = cw_acceleration(mean_motion, p, v)
+    pb.applyExternalForce(
+        body, link, (mass * cx, mass * cy, mass * cz), p, pb.WORLD_FRAME, physicsClientId=client
+    )
+
+
 class Propellant:
     """The thrusters' propellant: what is left and used, and the delta-v flown.
 
