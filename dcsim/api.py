@@ -38,7 +38,8 @@ Space manipulator model (DH kinematics and dynamics of the source thesis 004)
     Jacobians, inverse kinematics, det(J Jᵀ), M(q), C(q, q̇)), built by
     :func:`manipulator_model` from a :class:`DHRobot` (a :class:`ManipulatorBase` and
     :class:`DHLink` rows); :func:`thesis_manipulator` (the thesis's robot),
-    :func:`manipulator_urdf`; results :class:`ForwardKinematics`,
+    :func:`manipulator_urdf`, :func:`load_robot_model` (the model of a scenario file's
+    manipulator); results :class:`ForwardKinematics`,
     :class:`InverseKinematicsResult`.
 Geometry
     :func:`spherical_to_cartesian`, :func:`quaternion_between`, :func:`rotate`, :func:`unit`,
@@ -69,6 +70,7 @@ from dcsim.errors import (
     PluginLoadWarning,
     PluginNotFoundError,
     PluginParameterError,
+    RobotTypeError,
     ScenarioError,
 )
 from dcsim.fmu.instance import FmuCallError, FmuDescription, FmuError, FmuInstance
@@ -131,6 +133,7 @@ from dcsim.params import PluginParams, quantity
 from dcsim.plancost import leg_delta_v, legs_delta_v, plan_cost, plan_delta_v, plan_duration
 from dcsim.registry import PluginRegistry
 from dcsim.robots.dh import DHLink, DHRobot, ManipulatorBase, thesis_manipulator
+from dcsim.robots.loading import load_robot_model
 from dcsim.robots.manipulator import (
     ForwardKinematics,
     InverseKinematicsResult,
@@ -171,6 +174,7 @@ __all__ = [
     "legs_delta_v",
     "LinearMotion",
     "Localiser",
+    "load_robot_model",
     "manipulator_model",
     "manipulator_urdf",
     "ManipulatorBase",
@@ -196,6 +200,7 @@ __all__ = [
     "Plugin",
     "PLUGIN_KINDS",
     "PluginError",
+    "RobotTypeError",
     "PluginInterfaceError",
     "PluginLoadWarning",
     "PluginNotFoundError",

@@ -955,6 +955,41 @@ def _names(text: str | None, option: str) -> list[str] | None:
     return names
 
 
+@cli.group("robot")
+def robot_group() -> None:
+    """The robot of a scenario file: its model for other tools."""
+
+
+@robot_group.command("urdf")
+@click.argument("scenario", type=click.Path(dir_okay=False, path_type=Path))
+@click.option(
+    "-o",
+    "--out",
+    required=True,
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="URDF file to write (.urdf).",
+)
+@click.option(
+    "--set",
+    "overrides",
+    multiple=True,
+    metavar="KEY.PATH=VALUE",
+    help="Override one scenario value first (as for dcsim run). Repeatable.",
+)
+def robot_urdf_command(scenario: Path, out: Path, overrides: tuple[str, ...]) -> None:
+    """Write the URDF of SCENARIO's manipulator (robot.type: manipulator) to OUT.
+
+    It is the file the world loads: base link at the base's centre of mass, one
+    revolute joint and link per DH row, a fixed end_effector link, inertias to be used as
+    given (PyBullet: URDF_USE_INERTIA_FROM_FILE; Pinocchio: a free-flyer root joint).
+    """
+    from dcsim.robots.loading import load_robot_model
+
+    model = load_robot_model(scenario, overrides)
+    out.write_text(model.urdf(), encoding="utf-8")
+    click.echo(f"URDF of {model.n_joints}-joint manipulator written to {out}")
+
+
 @cli.group("fmu")
 def fmu_group() -> None:
     """FMI 2.0 co-simulation: export scenarios as FMUs, couple FMUs (docs/fmu.md)."""

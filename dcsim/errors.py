@@ -72,6 +72,10 @@ class ScenarioError(DcsimError):
         super().__init__("\n".join([head, *("  " + line for line in lines)]))
 
 
+class RobotTypeError(DcsimError):
+    """A scenario's robot is not of the type a command or a call needs."""
+
+
 class PluginError(DcsimError):
     """Base class of errors about plugins and the plugin registry."""
 

@@ -61,6 +61,9 @@ class Mission(ABC):
         FMU outputs its index).
     columns : tuple of str
         The mission's own telemetry columns, recorded after ``mode`` and ``converged``.
+    robots : tuple of str
+        The robot types (``robot.type``) it can fly; a scenario pairing it with another
+        is refused before the run.
     """
 
     type: ClassVar[str]
@@ -69,6 +72,7 @@ class Mission(ABC):
     roles: ClassVar[tuple[str, ...]]
     modes: ClassVar[tuple[str, ...]]
     columns: ClassVar[tuple[str, ...]] = ()
+    robots: ClassVar[tuple[str, ...]] = ("free-flyer",)
 
     def __init__(
         self, scenario: Scenario, world: World, plugins: Mapping[str, Plugin], emit: Emit

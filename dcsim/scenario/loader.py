@@ -121,11 +121,18 @@ def resolve_plugins(
     ScenarioError
         For unknown or ambiguous plugin names and invalid parameters.
     """
-    from dcsim.missions import scenario_roles  # missions load the world engine
+    from dcsim.missions import mission_class, scenario_roles  # missions load the world engine
 
     problems: list[Problem] = []
     resolved: dict[str, Any] = {}
     robot = scenario.robot.type
+    mission = mission_class(scenario.mission.type)
+    if robot not in mission.robots:
+        message = (
+            f"mission type '{mission.type}' does not support robot type '{robot}' "
+            f"(it supports: {', '.join(mission.robots)})"
+        )
+        problems.append(doc.problem(("mission", "type"), message))
     for role in scenario_roles(scenario):
         choice = getattr(scenario, role)
         try:
