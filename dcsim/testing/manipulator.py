@@ -135,7 +135,7 @@ def simulate(
         else:
             y = solve_ivp(
                 _plant,
-                (t, t + period),
+                (0.0, period),  # the plant is autonomous: local time
                 np.concatenate([q, qd]),
                 method="RK45",
                 rtol=rtol,
