@@ -89,7 +89,7 @@ def check_plugin(
     metadata = _run_check(METADATA_CHECK, plugin_class)
     if not metadata.passed:  # without a kind, name and parameters nothing else can run
         return [metadata]
-    rest = [c for c in checks_for(plugin_class.kind) if c is not METADATA_CHECK]
+    rest = [c for c in checks_for(plugin_class.kind, plugin_class) if c is not METADATA_CHECK]
     return [metadata] + [_run_check(check, plugin_class) for check in rest]
 
 

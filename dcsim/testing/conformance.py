@@ -15,7 +15,7 @@ def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
     cases, ids = [], []
     for spec in metafunc.config.getoption(OPTION.lstrip("-").replace("-", "_")):
         plugin_class = resolve_plugin(spec)
-        for check in checks_for(plugin_class.kind):
+        for check in checks_for(plugin_class.kind, plugin_class):
             cases.append((plugin_class, check))
             ids.append(f"{spec}::{check.name}")
     metafunc.parametrize(("dcsim_plugin_class", "dcsim_check"), cases, ids=ids)

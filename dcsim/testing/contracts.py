@@ -61,15 +61,26 @@ class Check:
         The contract in words.
     function : callable
         ``function(plugin_class)``; raises :class:`ContractViolation`.
+    robots : tuple of str
+        Robot types whose problems the check poses; empty: any.
     """
 
     name: str
     kinds: tuple[str, ...]
     contract: str
     function: Callable[[type[Plugin]], None]
+    robots: tuple[str, ...] = ()
+
+    def applies(self, plugin_class: type[Plugin]) -> bool:
+        """Whether the check poses a problem of a robot the plugin supports (a check that
+        names no robot applies to every plugin of its kinds)."""
+        return not self.robots or bool(set(self.robots) & set(_robots(plugin_class)))
 
     def run(self, plugin_class: type[Plugin]) -> None:
-        """Run the check, prefixing any violation with the plugin and the contract."""
+        """Run the check, prefixing any violation with the plugin and the contract; a
+        check for robots the plugin does not support has nothing to check."""
+        if not self.applies(plugin_class):
+            return
         try:
             self.function(plugin_class)
         except ContractViolation as violation:
@@ -82,19 +93,41 @@ class Check:
 _CHECKS: list[Check] = []
 
 
-def contract(name: str, text: str, kinds: tuple[str, ...] = tuple(PLUGIN_KINDS)) -> Callable:
-    """Register the decorated function as the check ``name`` for ``kinds``."""
+def contract(
+    name: str,
+    text: str,
+    kinds: tuple[str, ...] = tuple(PLUGIN_KINDS),
+    robots: tuple[str, ...] = (),
+) -> Callable:
+    """Register the decorated function as the check ``name`` for ``kinds`` (and, if
+    given, only for plugins supporting one of ``robots``)."""
 
     def register(function: Callable[[type[Plugin]], None]) -> Callable[[type[Plugin]], None]:
-        _CHECKS.append(Check(name, kinds, text, function))
+        _CHECKS.append(Check(name, kinds, text, function, robots))
         return function
 
     return register
 
 
-def checks_for(kind: str) -> list[Check]:
-    """Every check that applies to plugins of ``kind``."""
-    return [c for c in _CHECKS if kind in c.kinds]
+def checks_for(kind: str, plugin_class: type[Plugin] | None = None) -> list[Check]:
+    """Every check that applies to plugins of ``kind`` (and to ``plugin_class``'s robots,
+    if given)."""
+    return [
+        c for c in _CHECKS if kind in c.kinds and (plugin_class is None or c.applies(plugin_class))
+    ]
+
+
+def _robots(plugin_class: type[Plugin]) -> tuple[str, ...]:
+    return tuple(getattr(plugin_class, "robots", ("free-flyer",)))
+
+
+def controller_robot(plugin_class: type[Plugin] | None) -> str:
+    """The robot type the standard controller problems are posed for: the free flyer,
+    unless the controller supports manipulators only."""
+    if plugin_class is not None and "free-flyer" not in _robots(plugin_class):
+        if "manipulator" in _robots(plugin_class):
+            return "manipulator"
+    return "free-flyer"
 
 
 def _label(plugin_class: type) -> str:
@@ -133,7 +166,9 @@ def _feed_localiser(plugin: Localiser, inputs: list) -> list:
     return outputs
 
 
-def _controller_inputs(empty: bool) -> list:
+def _controller_inputs(empty: bool, plugin_class: type[Plugin] | None) -> list:
+    if controller_robot(plugin_class) == "manipulator":
+        return problems.manipulator_ticks(empty)
     rng = np.random.default_rng(3)
     obstacles = () if empty else problems.path_problem().obstacles
     ticks = []
@@ -166,7 +201,7 @@ _INPUTS: dict[str, Callable[[bool, Any], list]] = {
     "localiser": lambda empty, _: _localiser_inputs(empty),
     "task_planner": lambda empty, _: [problems.task_request(targets=0 if empty else 6)],
     "path_planner": _path_inputs,
-    "controller": lambda empty, _: _controller_inputs(empty),
+    "controller": _controller_inputs,
 }
 _FEEDS: dict[str, Callable[[Any, list], list]] = {
     "localiser": _feed_localiser,
@@ -190,7 +225,8 @@ def feed(plugin: Plugin, inputs: list) -> list:
 
 
 def _same(a: Any, b: Any) -> bool:
-    """Deep equality of messages, arrays, tuples, lists and floats (NaN equal to NaN)."""
+    """Deep equality of messages, arrays, tuples, lists, dicts, floats (NaN equal to NaN)
+    and plain objects (by their attributes)."""
     if isinstance(a, (list, tuple)):
         return (
             type(a) is type(b)
@@ -207,6 +243,11 @@ def _same(a: Any, b: Any) -> bool:
         return True
     if dataclasses.is_dataclass(a) and type(a) is type(b):
         return all(_same(getattr(a, f.name), getattr(b, f.name)) for f in dataclasses.fields(a))
+    if isinstance(a, dict):
+        return isinstance(b, dict) and a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
+    if type(a) is type(b) and type(a).__eq__ is object.__eq__ and hasattr(a, "__dict__"):
+        # an object without its own equality (a robot's model): equal state, not identity
+        return _same(vars(a), vars(b))
     return bool(a == b)
 
 

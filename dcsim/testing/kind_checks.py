@@ -8,7 +8,12 @@ from collections.abc import Callable
 import numpy as np
 
 from dcsim.clearance import RESOLUTION, path_clearance
-from dcsim.geometry import quaternion_conjugate, quaternion_multiply, rotation_vector
+from dcsim.geometry import (
+    quaternion_conjugate,
+    quaternion_from_rotation_vector,
+    quaternion_multiply,
+    rotation_vector,
+)
 from dcsim.interfaces import Plugin
 from dcsim.messages import (
     NoPath,
@@ -24,11 +29,13 @@ from dcsim.testing.contracts import (
     LOCALISER_ERROR_BOUND,
     TIME_SLACK,
     contract,
+    controller_robot,
     fail,
     make,
     run_plugin,
     standard_inputs,
 )
+from dcsim.testing.manipulator import simulate
 
 START_TOLERANCES = (1e-6, 1e-9, 1e-6)
 """How far a trajectory may start from the start state: position (m), time (s), attitude (rad)."""
@@ -416,19 +423,25 @@ def check_obstacle_motion(plugin_class: type[Plugin]) -> None:
 
 @contract(
     "commands_within_limits",
-    "force and torque magnitudes never exceed max_force and max_torque",
+    "force and torque magnitudes never exceed max_force and max_torque (and, for a "
+    "manipulator, each joint torque its joint_torque_limits)",
     kinds=("controller",),
 )
 def check_command_limits(plugin_class: type[Plugin]) -> None:
-    robot = problems.ROBOT
-    for index, command in enumerate(
-        run_plugin(plugin_class, standard_inputs("controller"), "the standard ticks")
-    ):
+    inputs = standard_inputs("controller", plugin_class=plugin_class)
+    robot = inputs[0]
+    for index, command in enumerate(run_plugin(plugin_class, inputs, "the standard ticks")):
         force, torque = np.linalg.norm(command.force), np.linalg.norm(command.torque)
         if force > robot.max_force * (1 + 1e-9) or torque > robot.max_torque * (1 + 1e-9):
             fail(
                 f"command {index} asks {force:.3f} N and {torque:.3f} N*m; the limits are "
                 f"{robot.max_force} N and {robot.max_torque} N*m"
+            )
+        excess = np.abs(command.joint_torques) > robot.joint_torque_limits * (1 + 1e-9)
+        if command.joint_torques.shape != robot.joint_torque_limits.shape or excess.any():
+            fail(
+                f"command {index} asks joint torques {command.joint_torques.tolist()} N*m; "
+                f"the limits are {robot.joint_torque_limits.tolist()} N*m"
             )
 
 
@@ -438,14 +451,35 @@ def check_command_limits(plugin_class: type[Plugin]) -> None:
     kinds=("controller",),
 )
 def check_rest(plugin_class: type[Plugin]) -> None:
-    robot = problems.ROBOT
-    estimate = StateEstimate(time=0.0, position=[3.0, -4.0, 5.0], converged=True)
-    reference = Reference(time=0.0, position=[3.0, -4.0, 5.0])
+    if controller_robot(plugin_class) == "manipulator":
+        robot = problems.manipulator_robot()
+        joints = problems.MANIPULATOR_JOINTS
+        estimate = StateEstimate(
+            time=0.0,
+            position=[3.0, -4.0, 5.0],
+            attitude=[0.0, 0.6, 0.0, 0.8],
+            joint_positions=joints,
+            joint_velocities=np.zeros_like(joints),
+            converged=True,
+        )
+        reference = Reference(
+            time=0.0,
+            position=[3.0, -4.0, 5.0],
+            attitude=[0.0, 0.6, 0.0, 0.8],
+            joint_positions=joints,
+        )
+        what = "a manipulator at rest on its reference"
+    else:
+        robot = problems.ROBOT
+        estimate = StateEstimate(time=0.0, position=[3.0, -4.0, 5.0], converged=True)
+        reference = Reference(time=0.0, position=[3.0, -4.0, 5.0])
+        what = "a collector at rest on its reference"
     inputs = [robot, [(0.0, estimate, reference, Surroundings())]]
-    command = run_plugin(plugin_class, inputs, "a collector at rest on its reference")[0]
+    command = run_plugin(plugin_class, inputs, what)[0]
     if (
         np.linalg.norm(command.force) > 1e-6 * robot.max_force
         or np.linalg.norm(command.torque) > 1e-6 * robot.max_torque
+        or np.any(np.abs(command.joint_torques) > 1e-6 * robot.joint_torque_limits)
     ):
         fail(f"commands {command!r} while at rest on the reference")
 
@@ -453,8 +487,9 @@ def check_rest(plugin_class: type[Plugin]) -> None:
 @contract(
     "stabilises_a_double_integrator",
     "from 11.6 m off, a 100 kg double integrator reaches the reference within 0.1 m and "
-    "0.01 m/s in 1000 s",
+    "0.01 m/s in 1000 s (free-flyer controllers)",
     kinds=("controller",),
+    robots=("free-flyer",),
 )
 def check_double_integrator(plugin_class: type[Plugin]) -> None:
     robot, dt = problems.ROBOT, 0.1
@@ -470,3 +505,52 @@ def check_double_integrator(plugin_class: type[Plugin]) -> None:
     error, speed = float(np.linalg.norm(position)), float(np.linalg.norm(velocity))
     if error > 0.1 or speed > 0.01:
         fail(f"after 1000 s it is {error:.3f} m from the reference moving at {speed:.4f} m/s")
+
+
+CONVERGENCE_TIME = 15.0
+"""Time the manipulator convergence check gives a controller, s."""
+
+
+@contract(
+    "converges_on_a_manipulator",
+    "the thesis's manipulator at rest, its joints 0.05 rad and its base attitude 0.03 rad "
+    f"off a constant reference, comes within a third of both errors in {CONVERGENCE_TIME:g} s "
+    "(100 Hz control, the model's own dynamics) and never strays beyond 1.5 times them "
+    "(manipulator controllers; the base position is not required to follow)",
+    kinds=("controller",),
+    robots=("manipulator",),
+)
+def check_manipulator_convergence(plugin_class: type[Plugin]) -> None:
+    robot = problems.manipulator_robot()
+    plugin = make(plugin_class)
+    plugin.reset(robot)
+    joints = problems.MANIPULATOR_JOINTS
+    reference = Reference(
+        time=0.0, position=[0.0, 0.0, 0.0], attitude=[0.0, 0.0, 0.0, 1.0], joint_positions=joints
+    )
+    offset = np.array([0.05, -0.05, 0.05, -0.05, 0.05, -0.05])
+    tilt = quaternion_from_rotation_vector([0.03, 0.0, 0.0])
+    q0 = np.concatenate([[0.02, 0.0, 0.0], tilt, joints + offset])
+    try:
+        loop = simulate(
+            plugin,
+            robot,
+            lambda t: reference,
+            q0,
+            np.zeros(q0.size - 1),
+            CONVERGENCE_TIME,
+            0.01,
+            integrator="euler",
+        )
+    except Exception as error:  # a plugin's own failure: name it, with the problem posed
+        fail(f"raised {type(error).__name__}: {error} on a manipulator near its reference")
+    joint_error = np.abs(loop.q[:, 7:] - joints).max(axis=1) / np.abs(offset).max()
+    attitude_error = np.linalg.norm(rotation_vector(loop.q[:, 3:7]), axis=1) / 0.03
+    worst = float(np.nanmax(np.maximum(joint_error, attitude_error)))
+    final = float(max(joint_error[-1], attitude_error[-1]))
+    if not np.isfinite(final) or final > 1 / 3 or worst > 1.5:
+        fail(
+            f"after {CONVERGENCE_TIME:g} s its joint and attitude errors are {joint_error[-1]:.3g} "
+            f"and {attitude_error[-1]:.3g} of their initial sizes (at most 1/3 expected), at "
+            f"worst {worst:.3g} of them (at most 1.5)"
+        )

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from dcsim.geometry import quaternion_from_rotation_vector
 from dcsim.interfaces import Plugin
 from dcsim.messages import (
     BeaconRange,
@@ -22,14 +23,17 @@ from dcsim.messages import (
     ObjectTrack,
     PathProblem,
     Prior,
+    Reference,
     RobotSpec,
     RobotState,
     Shape,
     ShapeKind,
     StateEstimate,
+    Surroundings,
     TaskRequest,
 )
 from dcsim.motion import LinearMotion, StaticMotion
+from dcsim.testing.manipulator import thesis_robot
 
 BEACONS = np.array(
     [
@@ -306,3 +310,49 @@ def posed(plugin_class: type[Plugin], problem: PathProblem) -> PathProblem:
     if getattr(plugin_class, "handles_moving_obstacles", True):
         return problem
     return held_still(problem)
+
+
+MANIPULATOR_JOINTS = np.array([0.76, 0.6, -2.33, 3.08, -2.36, -0.6])
+"""A configuration of the thesis's arm away from singularities, rad."""
+
+
+def manipulator_robot() -> RobotSpec:
+    """The thesis's manipulator with limits low enough for the standard ticks to reach
+    them: 20 N of thrust, 5 N·m of base torque, 2 N·m per joint."""
+    return thesis_robot(max_force=20.0, max_torque=5.0, joint_torque=2.0)
+
+
+def manipulator_ticks(empty: bool = False) -> list:
+    """The standard controller ticks for a manipulator controller: ``[robot, ticks]`` with
+    20 ticks at 10 Hz of estimates and references scattered about
+    :data:`MANIPULATOR_JOINTS` (base within decimetres and a few degrees of the origin),
+    among the standard path problem's obstacles unless ``empty``."""
+    rng = np.random.default_rng(5)
+    obstacles = () if empty else path_problem().obstacles
+    n = MANIPULATOR_JOINTS.size
+
+    def state(time: float) -> dict:
+        turn = quaternion_from_rotation_vector(rng.normal(0.0, 0.05, 3))
+        return dict(
+            time=time,
+            position=rng.normal(0.0, 0.1, 3),
+            attitude=turn,
+            velocity=rng.normal(0.0, 0.02, 3),
+            angular_velocity=rng.normal(0.0, 0.02, 3),
+            joint_positions=MANIPULATOR_JOINTS + rng.normal(0.0, 0.2, n),
+            joint_velocities=rng.normal(0.0, 0.05, n),
+        )
+
+    ticks = []
+    for k in range(20):
+        t = 0.1 * k
+        estimate = StateEstimate(**state(t), converged=True)
+        wanted = state(t)
+        reference = Reference(
+            **wanted,
+            acceleration=rng.normal(0.0, 0.01, 3),
+            angular_acceleration=rng.normal(0.0, 0.01, 3),
+            joint_accelerations=rng.normal(0.0, 0.05, n),
+        )
+        ticks.append((t, estimate, reference, Surroundings(obstacles)))
+    return [manipulator_robot(), ticks]

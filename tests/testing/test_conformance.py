@@ -282,7 +282,7 @@ def test_pytest_option_runs_the_suite_against_an_installed_plugin(tmp_path):
         [*command, "controller:pd"], cwd=tmp_path, capture_output=True, text=True
     )
     assert passing.returncode == 0, passing.stdout
-    assert f"{len(checks_for('controller'))} passed" in passing.stdout
+    assert f"{len(checks_for('controller', PDController))} passed" in passing.stdout
     unknown = subprocess.run(
         [*command, "controller:nope"], cwd=tmp_path, capture_output=True, text=True
     )
