@@ -58,7 +58,13 @@ def test_plugins_json_and_kind_filter(dcsim_cli):
     result = dcsim_cli("plugins", "--json", "--kind", "controller")
     assert result.returncode == 0
     entries = json.loads(result.stdout)
-    assert [e["name"] for e in entries] == ["elastic", "fmu", "pd"]
+    assert [e["name"] for e in entries] == [
+        "computed-torque",
+        "elastic",
+        "fmu",
+        "pd",
+        "underactuated",
+    ]
     assert entries[0]["kind"] == "controller"
     assert entries[0]["distribution"] == "dcsim"
     assert entries[0]["summary"]
@@ -138,7 +144,8 @@ def test_run_writes_resolved_scenario_with_seed_and_overrides(dcsim_cli, tmp_pat
     [
         (
             "controller.plugin=pdd",
-            "no controller plugin named 'pdd' (available: elastic, fmu, pd); did you mean 'pd'?",
+            "no controller plugin named 'pdd' (available: computed-torque, elastic, fmu, pd, "
+            "underactuated); did you mean 'pd'?",
         ),
         (
             "controller.params.bandwidth=-1",
