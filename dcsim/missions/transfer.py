@@ -197,11 +197,10 @@ class TransferMission(Mission):
         if not trajectory.times[0] <= time < trajectory.times[-1]:
             return zero, zero
         period = self.scenario.world.control_period
+        overlap = np.diff(np.clip(trajectory.times, time, time + period))  # s per segment
         spec = self.world.robot_spec()
         acceleration = (
-            zero
-            if trajectory.forces is None
-            else _mean_over(trajectory, trajectory.forces, time, period) / spec.mass
+            zero if trajectory.forces is None else overlap @ trajectory.forces / period / spec.mass
         )
         if trajectory.torques is None:
             return acceleration, zero
@@ -212,7 +211,7 @@ class TransferMission(Mission):
         )
         rotation = np.column_stack([rotate(attitude, axis) for axis in np.eye(3)])
         inertia = rotation @ spec.inertia @ rotation.T
-        torque = _mean_over(trajectory, trajectory.torques, time, period)
+        torque = overlap @ trajectory.torques / period
         return acceleration, np.linalg.solve(inertia, torque)
 
     def _held_attitude(self) -> np.ndarray:
@@ -364,15 +363,6 @@ def trajectory_csv(trajectory: Trajectory) -> str:
     for row in table:
         out.write(",".join("" if np.isnan(v) else repr(float(v)) for v in row) + "\n")
     return out.getvalue()
-
-
-def _mean_over(
-    trajectory: Trajectory, values: np.ndarray, start: float, period: float
-) -> np.ndarray:
-    """Mean over ``[start, start + period]`` (s) of per-segment ``values`` (held over each
-    segment of the trajectory, zero after its end)."""
-    overlap = np.diff(np.clip(trajectory.times, start, start + period))
-    return overlap @ values / period
 
 
 def _or_empty(values: np.ndarray | None, rows: int, width: int) -> np.ndarray:
