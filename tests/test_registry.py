@@ -71,7 +71,8 @@ def test_unknown_name_suggests_the_closest():
     registry = PluginRegistry.discover()
     with pytest.raises(
         PluginNotFoundError,
-        match=r"available: ant-colony, grid-astar, multi-burn, ompl-control, ompl-geometric, "
+        match=r"available: ant-colony, end-effector-line, grid-astar, multi-burn, ompl-control, "
+        r"ompl-geometric, "
         r"straight-line\); "
         r"did you mean 'straight-line'\?",
     ):

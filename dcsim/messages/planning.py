@@ -10,6 +10,7 @@ import dataclasses
 import enum
 from collections.abc import Mapping
 from dataclasses import field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -146,6 +147,11 @@ class FrameDynamics(Message):
 class PathProblem(Message):
     """What a path planner is asked to solve.
 
+    For a free flyer the path is the robot's own. For a manipulator (``model`` set) it is
+    its end effector's: ``start`` is the robot's full state (base and joints), while the
+    goal region, the speed and acceleration limits and the returned trajectory's
+    positions and velocities are the end effector's (world frame).
+
     Attributes
     ----------
     start : RobotState
@@ -176,6 +182,9 @@ class PathProblem(Message):
         Cost weights.
     time_budget : float
         Wall time the planner may spend, s.
+    model : object or None
+        The robot's model (``RobotSpec.model``): for a manipulator, its
+        :class:`~dcsim.robots.manipulator.ManipulatorModel`; None for a free flyer.
     """
 
     start: RobotState
@@ -192,6 +201,7 @@ class PathProblem(Message):
     bounds: Bounds | None = None
     weights: CostWeights = field(default_factory=CostWeights)
     time_budget: float = 1.0
+    model: Any = None
 
 
 @message

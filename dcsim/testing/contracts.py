@@ -121,9 +121,9 @@ def _robots(plugin_class: type[Plugin]) -> tuple[str, ...]:
     return tuple(getattr(plugin_class, "robots", ("free-flyer",)))
 
 
-def controller_robot(plugin_class: type[Plugin] | None) -> str:
-    """The robot type the standard controller problems are posed for: the free flyer,
-    unless the controller supports manipulators only."""
+def problem_robot(plugin_class: type[Plugin] | None) -> str:
+    """The robot type the standard controller ticks and path problems are posed for: the
+    free flyer, unless the plugin supports manipulators only."""
     if plugin_class is not None and "free-flyer" not in _robots(plugin_class):
         if "manipulator" in _robots(plugin_class):
             return "manipulator"
@@ -167,7 +167,7 @@ def _feed_localiser(plugin: Localiser, inputs: list) -> list:
 
 
 def _controller_inputs(empty: bool, plugin_class: type[Plugin] | None) -> list:
-    if controller_robot(plugin_class) == "manipulator":
+    if problem_robot(plugin_class) == "manipulator":
         return problems.manipulator_ticks(empty)
     rng = np.random.default_rng(3)
     obstacles = () if empty else problems.path_problem().obstacles
@@ -189,6 +189,8 @@ def _feed_controller(plugin: Controller, inputs: list) -> list:
 
 
 def _path_inputs(empty: bool, plugin_class: type[Plugin] | None) -> list:
+    if problem_robot(plugin_class) == "manipulator":
+        return [problems.reach_problem()]
     problem = problems.path_problem()
     if plugin_class is not None:
         problem = problems.posed(plugin_class, problem)

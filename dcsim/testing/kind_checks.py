@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Callable
 
@@ -29,9 +30,9 @@ from dcsim.testing.contracts import (
     LOCALISER_ERROR_BOUND,
     TIME_SLACK,
     contract,
-    controller_robot,
     fail,
     make,
+    problem_robot,
     run_plugin,
     standard_inputs,
 )
@@ -186,7 +187,8 @@ _BUDGET_PROBLEMS: dict[str, Callable[[float], object]] = {
 @contract(
     "honours_time_budget",
     "a request for 15 targets (task planners), or a path problem whose goal is walled in by "
-    "60 obstacles (path planners), with a 0.3 s budget is answered within the budget "
+    "60 obstacles (path planners; the reach problem for a manipulator's), with a 0.3 s budget "
+    "is answered within the budget "
     f"(plus 20 % and {TIME_SLACK} s)",
     kinds=("task_planner", "path_planner"),
 )
@@ -194,6 +196,8 @@ def check_budget(plugin_class: type[Plugin]) -> None:
     request = _BUDGET_PROBLEMS[plugin_class.kind](0.3)
     if plugin_class.kind == "path_planner":
         request = problems.posed(plugin_class, request)
+        if problem_robot(plugin_class) == "manipulator":
+            request = problems.reach_problem(0.3)
     plugin = make(plugin_class)
     start = time.perf_counter()
     plugin.plan(request)
@@ -260,6 +264,7 @@ def _check_start(trajectory: Trajectory, start: RobotState, what: str) -> None:
     "to arrive at rest, turned, at a set time (a trajectory that leaves the attitude free "
     "arrives at the goal's attitude, which the transfer mission holds)",
     kinds=("path_planner",),
+    robots=("free-flyer",),
 )
 def check_endpoints(plugin_class: type[Plugin]) -> None:
     for problem, what in (
@@ -280,6 +285,7 @@ def check_endpoints(plugin_class: type[Plugin]) -> None:
     "stays_in_bounds",
     "the trajectory, sampled finely, stays inside the problem's bounds",
     kinds=("path_planner",),
+    robots=("free-flyer",),
 )
 def check_bounds(plugin_class: type[Plugin]) -> None:
     trajectory, problem = _standard_path(plugin_class)
@@ -303,6 +309,7 @@ def _implied_delta_v(trajectory: Trajectory, start: RobotState) -> float:
     "samples imply (the start's velocity change plus every change between samples, in the "
     "standard problem's inertial frame) exceeds max_delta_v",
     kinds=("path_planner",),
+    robots=("free-flyer",),
 )
 def check_limits(plugin_class: type[Plugin]) -> None:
     trajectory, problem = _standard_path(plugin_class)
@@ -326,6 +333,7 @@ def check_limits(plugin_class: type[Plugin]) -> None:
     "for velocities linear between samples, in the standard problem's inertial frame), never "
     f"exceeds max_acceleration by more than {100 * ACCELERATION_TOLERANCE:g} %",
     kinds=("path_planner",),
+    robots=("free-flyer",),
 )
 def check_acceleration(plugin_class: type[Plugin]) -> None:
     trajectory, problem = _standard_path(plugin_class)
@@ -346,6 +354,7 @@ def check_acceleration(plugin_class: type[Plugin]) -> None:
     "`dcsim.clearance.path_clearance` at every sample of the trajectory and at steps over "
     f"which no gap changes by more than {RESOLUTION:g} robot radius",
     kinds=("path_planner",),
+    robots=("free-flyer",),
 )
 def check_collisions(plugin_class: type[Plugin]) -> None:
     trajectory, problem = _standard_path(plugin_class)
@@ -377,6 +386,7 @@ def _describe(result: object) -> str:
     "obstacles, or the goal outside the bounds, it answers NoPath with a reason, within its "
     "time budget",
     kinds=("path_planner",),
+    robots=("free-flyer",),
 )
 def check_impossible(plugin_class: type[Plugin]) -> None:
     for what, build in _IMPOSSIBLE:
@@ -401,6 +411,7 @@ _STATIC_ONLY_TEXT = "static obstacles only (`handles_moving_obstacles = False`)"
     "they are at the start, and must answer the standard problem, whose obstacles move, "
     "with NoPath whose reason names the moving obstacles, within its time budget",
     kinds=("path_planner",),
+    robots=("free-flyer",),
 )
 def check_obstacle_motion(plugin_class: type[Plugin]) -> None:
     if getattr(plugin_class, "handles_moving_obstacles", True):
@@ -414,6 +425,72 @@ def check_obstacle_motion(plugin_class: type[Plugin]) -> None:
             f"declares it handles {_STATIC_ONLY_TEXT} but answered {_describe(result)} "
             "for the standard problem, whose obstacles move (a NoPath naming them is expected)"
         )
+    if elapsed > 1.2 * problem.time_budget + TIME_SLACK:
+        fail(f"took {elapsed:.3f} s with a budget of {problem.time_budget} s to refuse")
+
+
+def _reach_path(plugin_class: type[Plugin]) -> tuple[Trajectory, PathProblem]:
+    return _path(plugin_class, problems.reach_problem(), "the reach problem")
+
+
+@contract(
+    "reaches_the_target",
+    "on the reach problem (a manipulator's end effector 0.3 m to a target), the trajectory "
+    f"starts at the end effector of the start state (within {_START_TEXT}) and its final "
+    "state is inside the goal region, at rest (`GoalRegion.contains`)",
+    kinds=("path_planner",),
+    robots=("manipulator",),
+)
+def check_reach_endpoints(plugin_class: type[Plugin]) -> None:
+    trajectory, problem = _reach_path(plugin_class)
+    start = problem.start
+    q = np.concatenate([start.position, start.attitude, start.joint_positions])
+    end_effector = problem.model.forward_kinematics(q).end_effector
+    _check_start(trajectory, dataclasses.replace(start, position=end_effector), "the reach problem")
+    final = trajectory.end_state()
+    if not problem.goal.contains(final):
+        fail(
+            f"on the reach problem it ends at {final.position} moving at {final.velocity}: "
+            f"outside {problem.goal!r}"
+        )
+
+
+@contract(
+    "respects_end_effector_limits",
+    "on the reach problem the end effector's speed never exceeds max_speed and the "
+    "acceleration between consecutive samples never exceeds max_acceleration by more than "
+    f"{100 * ACCELERATION_TOLERANCE:g} %",
+    kinds=("path_planner",),
+    robots=("manipulator",),
+)
+def check_reach_limits(plugin_class: type[Plugin]) -> None:
+    trajectory, problem = _reach_path(plugin_class)
+    speeds = np.linalg.norm(trajectory.velocities, axis=1)
+    if speeds.max() > problem.max_speed * (1 + 1e-6):
+        fail(f"the end effector moves at {speeds.max():.4g} m/s, above {problem.max_speed} m/s")
+    rates = np.linalg.norm(np.diff(trajectory.velocities, axis=0), axis=1)
+    rates = rates / np.diff(trajectory.times)
+    if rates.max() > problem.max_acceleration * (1 + ACCELERATION_TOLERANCE):
+        fail(
+            f"the end effector accelerates at {rates.max():.4g} m/s², above "
+            f"{problem.max_acceleration} m/s²"
+        )
+
+
+@contract(
+    "refuses_an_unreachable_target",
+    "a target beyond the arm's reach from its shoulder is answered with NoPath and a "
+    "reason, within the time budget",
+    kinds=("path_planner",),
+    robots=("manipulator",),
+)
+def check_unreachable_target(plugin_class: type[Plugin]) -> None:
+    problem = problems.reach_problem(target=(6.0, 0.0, 0.0))
+    start = time.perf_counter()
+    result = run_plugin(plugin_class, [problem], "a target beyond the arm's reach")[0]
+    elapsed = time.perf_counter() - start
+    if not isinstance(result, NoPath) or not result.reason.strip():
+        fail(f"answered {_describe(result)} for a target beyond the arm's reach")
     if elapsed > 1.2 * problem.time_budget + TIME_SLACK:
         fail(f"took {elapsed:.3f} s with a budget of {problem.time_budget} s to refuse")
 
@@ -451,7 +528,7 @@ def check_command_limits(plugin_class: type[Plugin]) -> None:
     kinds=("controller",),
 )
 def check_rest(plugin_class: type[Plugin]) -> None:
-    if controller_robot(plugin_class) == "manipulator":
+    if problem_robot(plugin_class) == "manipulator":
         robot = problems.manipulator_robot()
         joints = problems.MANIPULATOR_JOINTS
         estimate = StateEstimate(

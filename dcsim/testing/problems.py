@@ -312,6 +312,41 @@ def posed(plugin_class: type[Plugin], problem: PathProblem) -> PathProblem:
     return held_still(problem)
 
 
+REACH_START_JOINTS_DEG = (
+    44.9694989345,
+    30.9901560203,
+    -44.3160315111,
+    -0.698671770567,
+    75.2188521525,
+    54.4117634838,
+)
+"""Joint angles of the thesis's arm with its end effector at [1.4, 0.9, −0.8] m (base at
+the origin, unturned), deg: the start of scenarios/space_manipulator_reach.yaml."""
+
+
+def reach_problem(
+    time_budget: float = 1.0, target: tuple[float, float, float] = (1.5, 0.7, -1.0)
+) -> PathProblem:
+    """The thesis's reach as a path problem: the end effector from [1.4, 0.9, −0.8] m to
+    ``target`` (m), arriving within 1 mm at rest, at most 0.1 m/s and 0.1 m/s²."""
+    robot = thesis_robot()
+    start = RobotState(
+        time=0.0,
+        position=np.zeros(3),
+        joint_positions=np.radians(REACH_START_JOINTS_DEG),
+        joint_velocities=np.zeros(len(REACH_START_JOINTS_DEG)),
+    )
+    return PathProblem(
+        start=start,
+        goal=GoalRegion(position=target, tolerance=1e-3, velocity_tolerance=1e-9),
+        robot_radius=robot.radius,
+        max_speed=0.1,
+        max_acceleration=0.1,
+        time_budget=time_budget,
+        model=robot.model,
+    )
+
+
 MANIPULATOR_JOINTS = np.array([0.76, 0.6, -2.33, 3.08, -2.36, -0.6])
 """A configuration of the thesis's arm away from singularities, rad."""
 

@@ -1,0 +1,105 @@
+"""``end-effector-line`` path planner: a manipulator's end effector straight to its target.
+
+The end effector moves on the segment from where it is (the forward kinematics of the
+problem's start state) to the goal region's centre, at rest at both ends, with the
+minimum-jerk (quintic) time law
+
+    s(τ) = L (10 τ³ − 15 τ⁴ + 6 τ⁵),      τ = (t − t₀) / T,
+
+whose velocity and acceleration are zero at both ends and continuous in between: what
+a model-based controller needs to track the joint references derived from it. Its peak
+speed is ``15 L / (8 T)`` and its peak acceleration ``10 L / (√3 T²)``; ``T`` is the
+shortest duration that keeps both within the problem's limits (or the goal's time, when
+it sets one). The answer is "no path" when the target lies beyond the arm's reach from
+the shoulder (the base held where it is), when no model is given (a free flyer), or
+when the goal's time is too soon. This is the task-space straight line of the source
+thesis 004's reach experiment, until a learned planner takes its place.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dcsim.api import NoPath, PathPlanner, PathProblem, PluginParams, Trajectory, hookimpl, quantity
+
+_PEAK_SPEED = 15.0 / 8.0
+"""Peak speed of the quintic law, in units of L / T."""
+_PEAK_ACCELERATION = 10.0 / np.sqrt(3.0)
+"""Peak acceleration of the quintic law, in units of L / T²."""
+
+
+class EndEffectorLineParams(PluginParams):
+    """Parameters of :class:`EndEffectorLinePlanner`."""
+
+    samples: int = quantity(
+        201, ge=2, le=100_000, description="Trajectory samples from start to target."
+    )
+    min_duration: float = quantity(
+        0.1, unit="s", gt=0, description="Shortest motion, also for a target already reached."
+    )
+
+
+class EndEffectorLinePlanner(PathPlanner):
+    """Straight-line end-effector path with a minimum-jerk time law."""
+
+    name = "end-effector-line"
+    summary = "A manipulator's end effector straight to the target, minimum-jerk time law"
+    Params = EndEffectorLineParams
+    params: EndEffectorLineParams
+    robots = ("manipulator",)
+
+    def plan(self, problem: PathProblem) -> Trajectory | NoPath:
+        """The end effector's straight path to the goal's centre, or why there is none."""
+        model = problem.model
+        if model is None or not hasattr(model, "forward_kinematics"):
+            return NoPath("the problem carries no manipulator model: this planner moves an arm")
+        start = np.concatenate(
+            [problem.start.position, problem.start.attitude, problem.start.joint_positions]
+        )
+        frames = model.forward_kinematics(start)
+        origin, target = frames.end_effector, problem.goal.position
+        shoulder_distance = float(np.linalg.norm(target - frames.origins[0]))
+        if shoulder_distance > model.robot.reach:
+            return NoPath(
+                f"the target is {shoulder_distance:.3f} m from the shoulder, beyond the arm's "
+                f"reach of {model.robot.reach:.3f} m"
+            )
+        length = float(np.linalg.norm(target - origin))
+        duration = self._duration(problem, length)
+        if isinstance(duration, NoPath):
+            return duration
+        tau = np.linspace(0.0, 1.0, self.params.samples)
+        distance = length * tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
+        speed = length / duration * 30.0 * tau**2 * (1.0 - tau) ** 2
+        direction = (target - origin) / length if length > 0 else np.zeros(3)
+        return Trajectory(
+            times=problem.start.time + duration * tau,
+            positions=origin + np.outer(distance, direction),
+            velocities=np.outer(speed, direction),
+            length=length,
+            duration=duration,
+        )
+
+    def _duration(self, problem: PathProblem, length: float) -> float | NoPath:
+        """``T``: the goal's time if set, else the least within the speed and acceleration
+        limits (never below ``min_duration``)."""
+        shortest = max(
+            self.params.min_duration,
+            _PEAK_SPEED * length / problem.max_speed,
+            float(np.sqrt(_PEAK_ACCELERATION * length / problem.max_acceleration)),
+        )
+        if problem.goal.time is None:
+            return shortest
+        available = problem.goal.time - problem.start.time
+        if available < shortest * (1 - 1e-9):
+            return NoPath(
+                f"the target is {length:.3g} m away: reaching it needs {shortest:.3g} s within "
+                f"the speed and acceleration limits, the goal's time leaves {available:.3g} s"
+            )
+        return available
+
+
+@hookimpl
+def dcsim_plugin_classes() -> list[type]:
+    """Register the end-effector line planner."""
+    return [EndEffectorLinePlanner]
