@@ -140,7 +140,8 @@ class Runner:
         self.scenario = setup.scenario
         self.plugins = setup.plugins
         self.mission_class = mission_class(self.scenario.mission.type)
-        self.recorder = Recorder(out_dir, telemetry_columns(self.mission_class.columns), keep_rows)
+        columns = telemetry_columns(self.mission_class.telemetry_columns(self.scenario))
+        self.recorder = Recorder(out_dir, columns, keep_rows)
         self.info = RunInfo(self.scenario, self.scenario.world.seed, out_dir)
         self.progress = progress
         self.world: World | None = None
@@ -312,7 +313,7 @@ class Runner:
             plugins, "controller", "command", t, estimate, reference, surroundings
         )
         laps.lap("controller")
-        self._record(t, estimate, self.mission.mode, self._command.force)
+        self._record(t, estimate, self.mission.mode, self._command)
         self._check_stop(t)
         laps.lap("recording")
 
@@ -382,8 +383,9 @@ class Runner:
         return Prior(position, initial.position_sigma, velocity, initial.velocity_sigma)
 
     # ------------------------------------------------------------------ records
-    def _record(self, t: float, estimate: StateEstimate, mode: str, force: np.ndarray) -> None:
+    def _record(self, t: float, estimate: StateEstimate, mode: str, command: Command) -> None:
         out = self.outputs = self.world.outputs()
+        out["command"] = command
         row: dict[str, Any] = {"time": t}
         row.update(zip(("x", "y", "z"), out["position"], strict=True))
         row.update(zip(("vx", "vy", "vz"), out["velocity"], strict=True))
@@ -397,7 +399,7 @@ class Runner:
             delta_v=out["delta_v"],
             nearest_obstacle=out["nearest_obstacle_distance"],
         )
-        row.update(zip(("fx", "fy", "fz"), force, strict=True))
+        row.update(zip(("fx", "fy", "fz"), command.force, strict=True))
         self._accumulate(out, estimate)
         self.recorder.row(row)
         self._hook("dcsim_run_step", run=self.info, row=row)
@@ -411,7 +413,7 @@ class Runner:
             velocity=[last["est_vx"], last["est_vy"], last["est_vz"]],
             converged=bool(last["converged"]),
         )
-        self._record(self.world.time, estimate, mode, np.zeros(3))
+        self._record(self.world.time, estimate, mode, Command())
 
     def _event(self, name: str, at: float | None = None, **data: Any) -> None:
         event = {"t": self.world.time if at is None else at, "event": name, **data}

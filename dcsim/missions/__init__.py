@@ -1,7 +1,8 @@
 """Mission types, selected in a scenario by ``mission.type``.
 
-Built in: ``debris`` (:class:`~dcsim.missions.debris.DebrisMission`) and ``transfer``
-(:class:`~dcsim.missions.transfer.TransferMission`). A new mission
+Built in: ``debris`` (:class:`~dcsim.missions.debris.DebrisMission`), ``transfer``
+(:class:`~dcsim.missions.transfer.TransferMission`) and ``reach``
+(:class:`~dcsim.missions.reach.ReachMission`). A new mission
 derives from :class:`~dcsim.missions.base.Mission`, declares its ``Settings`` section,
 and is added with :func:`register_mission`.
 """
@@ -11,12 +12,14 @@ from __future__ import annotations
 from dcsim.interfaces import PLUGIN_KINDS
 from dcsim.missions.base import Mission
 from dcsim.missions.debris import DebrisMission
+from dcsim.missions.reach import ReachMission
 from dcsim.missions.transfer import TransferMission
 from dcsim.scenario.model import Scenario
 
 _MISSIONS: dict[str, type[Mission]] = {
     DebrisMission.type: DebrisMission,
     TransferMission.type: TransferMission,
+    ReachMission.type: ReachMission,
 }
 
 
@@ -68,6 +71,7 @@ def mission_class(mission_type: str) -> type[Mission]:
 __all__ = [
     "DebrisMission",
     "Mission",
+    "ReachMission",
     "TransferMission",
     "mission_class",
     "mission_types",

@@ -60,7 +60,8 @@ class Mission(ABC):
         The mission's modes; :attr:`mode` is one of them (telemetry records its name,
         FMU outputs its index).
     columns : tuple of str
-        The mission's own telemetry columns, recorded after ``mode`` and ``converged``.
+        The mission's own telemetry columns, recorded after ``mode`` and ``converged``
+        (:meth:`telemetry_columns` gives them for a scenario).
     robots : tuple of str
         The robot types (``robot.type``) it can fly; a scenario pairing it with another
         is refused before the run.
@@ -107,8 +108,15 @@ class Mission(ABC):
         return Surroundings(observations.obstacles(), self.safety_distance)
 
     # ------------------------------------------------------------------ records
+    @classmethod
+    def telemetry_columns(cls, scenario: Scenario) -> tuple[str, ...]:
+        """The mission's own telemetry columns for ``scenario``: :attr:`columns`, unless
+        the mission's columns depend on the robot (one per joint, say)."""
+        return cls.columns
+
     def telemetry(self, outputs: Mapping[str, Any]) -> dict[str, Any]:
-        """Values of :attr:`columns` now, given the world's outputs (:meth:`World.outputs`)."""
+        """Values of the mission's columns now, given the world's outputs
+        (:meth:`World.outputs`, with the controller's ``command`` of this tick added)."""
         return {}
 
     def plot(

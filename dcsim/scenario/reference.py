@@ -21,6 +21,7 @@ from dcsim.params import field_bounds, field_unit
 from dcsim.scenario.model import (
     MotionSpec,
     PluginChoice,
+    ReachMissionSection,
     Scenario,
     SphericalPoint,
     TransferMissionSection,
@@ -88,8 +89,11 @@ def _child_path(prefix: str, name: str, annotation: Any) -> str:
 def _sections() -> dict[type[BaseModel], list[str]]:
     """Every model class reachable from Scenario and the mission sections, with the key
     paths it appears at."""
-    paths: dict[type[BaseModel], list[str]] = {Scenario: [""], TransferMissionSection: ["mission"]}
-    queue: list[tuple[str, type[BaseModel]]] = [("", Scenario), ("mission", TransferMissionSection)]
+    missions = (TransferMissionSection, ReachMissionSection)
+    paths: dict[type[BaseModel], list[str]] = {Scenario: [""]}
+    paths.update({section: ["mission"] for section in missions})
+    queue: list[tuple[str, type[BaseModel]]] = [("", Scenario)]
+    queue += [("mission", section) for section in missions]
     while queue:
         prefix, model = queue.pop(0)
         for name, info in model.model_fields.items():

@@ -1,0 +1,172 @@
+"""Joint references that carry a manipulator's end effector along a path, the base held.
+
+The end-effector path ``x_d(t)`` is the cubic Hermite curve through a trajectory's
+samples (positions and velocities), so it and its velocity and acceleration are defined
+at every instant. It becomes joint angles by closed-loop inverse kinematics at the rate
+level (the velocity form of the source thesis 004's eqs 3.12–3.13):
+
+    θ̇ = J⁺(θ) (ẋ_d(t) + K (x_d(t) − x(θ)))
+
+with ``J`` the position rows of the joint columns of eq. 3.8 (3 × n, the base held at
+its start pose), ``J⁺ = Jᵀ (J Jᵀ)⁻¹`` its pseudo-inverse, which resolves the arm's
+redundancy by the least joint rates, and ``K`` (1/s) a gain that pulls the integration's
+drift back onto the path. The equation is integrated with scipy's DOP853 to tight
+tolerances; the joint accelerations are the central difference of ``θ̇`` along the
+solution. Angles, rates and accelerations are therefore consistent with one another,
+which a computed-torque controller needs to track them to its model's accuracy.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.interpolate import CubicHermiteSpline
+
+from dcsim.messages import Trajectory
+from dcsim.robots.kinematics import Array
+from dcsim.robots.manipulator import ManipulatorModel
+
+_DIFFERENCE_STEP = 1e-4
+"""Time step of the central difference that gives the joint accelerations, s."""
+
+
+@dataclass(frozen=True)
+class JointSample:
+    """The references at one instant.
+
+    Attributes
+    ----------
+    angles, rates, accelerations : ndarray (n,)
+        Joint angles (rad), rates (rad/s) and accelerations (rad/s²).
+    end_effector, end_effector_velocity : ndarray (3,)
+        The end-effector path's position (m) and velocity (m/s), world frame.
+    """
+
+    angles: Array
+    rates: Array
+    accelerations: Array
+    end_effector: Array
+    end_effector_velocity: Array
+
+
+class SingularPath(ValueError):
+    """The path leads the arm into a singularity (``det(J Jᵀ)`` at its tolerance)."""
+
+
+class JointPath:
+    """Joint references along an end-effector trajectory (see the module).
+
+    Parameters
+    ----------
+    model : ManipulatorModel
+        The robot's model.
+    start : array_like (7 + n,)
+        The state the path starts from; its base pose is held throughout.
+    trajectory : Trajectory
+        The end effector's path, world frame; held at its ends outside its times.
+    gain : float
+        ``K``, 1/s.
+    singular_tolerance : float
+        ``det(J Jᵀ)`` (m⁶) at or below which the path is refused.
+
+    Raises
+    ------
+    SingularPath
+        If the arm meets a singularity on the way.
+    """
+
+    def __init__(
+        self,
+        model: ManipulatorModel,
+        start: np.ndarray,
+        trajectory: Trajectory,
+        gain: float = 20.0,
+        singular_tolerance: float = 1e-9,
+    ) -> None:
+        self.model = model
+        self._base = np.asarray(start[:7], dtype=float)
+        self.gain = gain
+        self.singular_tolerance = singular_tolerance
+        self.start_time, self.end_time = float(trajectory.times[0]), float(trajectory.times[-1])
+        self._path = CubicHermiteSpline(
+            trajectory.times, trajectory.positions, trajectory.velocities, extrapolate=False
+        )
+        self._initial = np.asarray(start[7:], dtype=float)
+        self._final = self._initial
+        self._angles = None
+        if self.end_time > self.start_time:
+            self._angles = self._integrate(self._initial)
+
+    def _integrate(self, angles: Array):
+        """Solve the module's equation from ``angles``; keep the final angles and return
+        the dense solution."""
+
+        def singular(t: float, theta: Array) -> float:
+            return self._det_jjt(theta) - self.singular_tolerance
+
+        singular.terminal = True
+        solution = solve_ivp(
+            self._rates,
+            (self.start_time, self.end_time),
+            angles,
+            method="DOP853",
+            rtol=1e-8,
+            atol=1e-10,
+            dense_output=True,
+            events=singular,
+        )
+        if solution.status == 1:
+            raise SingularPath(
+                f"the arm meets a singularity at t = {solution.t_events[0][0]:.3f} s on the path"
+            )
+        if solution.status != 0:
+            raise SingularPath(f"the joint path could not be integrated: {solution.message}")
+        self._final = solution.y[:, -1]
+        return solution.sol
+
+    def _state(self, theta: Array) -> Array:
+        return np.concatenate([self._base, theta])
+
+    def _det_jjt(self, theta: Array) -> float:
+        return self.model.det_jjt(self._state(theta), position_only=True)
+
+    def _path_at(self, t: float) -> tuple[Array, Array, Array]:
+        """End-effector path position, velocity and acceleration at ``t`` (held at the ends)."""
+        inside = min(max(t, self.start_time), self.end_time)
+        moving = self.start_time < t < self.end_time
+        position = self._path(inside)
+        if not moving:
+            return position, np.zeros(3), np.zeros(3)
+        return position, self._path(t, 1), self._path(t, 2)
+
+    def _rates(self, t: float, theta: Array) -> Array:
+        """``θ̇`` of the module's equation."""
+        q = self._state(theta)
+        jac = self.model.jacobian(q)[:3, 6:]
+        position, velocity, _ = self._path_at(t)
+        drift = position - self.model.forward_kinematics(q).end_effector
+        wanted = velocity + self.gain * drift
+        return jac.T @ np.linalg.solve(jac @ jac.T, wanted)
+
+    def angles_at(self, t: float) -> Array:
+        """Joint angles at ``t`` (s), held at the path's ends, rad."""
+        if t <= self.start_time:
+            return self._initial.copy()
+        if t >= self.end_time:
+            return self._final.copy()
+        return self._angles(t)
+
+    def at(self, t: float) -> JointSample:
+        """The references at time ``t`` (s); before and after the path, at rest at its ends."""
+        angles = self.angles_at(t)
+        position, velocity, _ = self._path_at(t)
+        if not self.start_time < t < self.end_time:
+            zero = np.zeros_like(angles)
+            return JointSample(angles, zero, zero.copy(), position, velocity)
+        h = min(_DIFFERENCE_STEP, t - self.start_time, self.end_time - t)
+        before = self._rates(t - h, self.angles_at(t - h))
+        after = self._rates(t + h, self.angles_at(t + h))
+        rates = self._rates(t, angles)
+        return JointSample(angles, rates, (after - before) / (2 * h), position, velocity)
