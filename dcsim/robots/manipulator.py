@@ -248,6 +248,13 @@ class ManipulatorModel:
         qd = self._velocity(qd)
         return self.coriolis_matrix(q, qd) @ qd
 
+    def centre_of_mass(self, q: ArrayLike) -> Array:
+        """Centre of mass of the whole robot (base and links), world frame, m (3,)."""
+        kin = self.kinematics(q)
+        masses = self._dh.masses
+        total = self._dh.base_mass + masses.sum()
+        return (self._dh.base_mass * kin.base_position + masses @ kin.coms) / total
+
     def momentum(self, q: ArrayLike, qd: ArrayLike) -> Array:
         """Linear momentum (kg·m/s) and angular momentum about the base's centre of mass
         (kg·m²/s) of the whole robot, world frame: the top rows of ``M q̇`` (6,)."""
@@ -264,7 +271,7 @@ class ManipulatorModel:
         self,
         target: ArrayLike,
         q0: ArrayLike,
-        base: Literal["held", "floating"] = "held",
+        base: Literal["held", "floating", "centre-of-mass"] = "held",
         damping: float = 0.0,
         tolerance: float = 1e-10,
         max_iterations: int = 100,
@@ -279,10 +286,15 @@ class ManipulatorModel:
             End-effector position, world frame, m.
         q0 : array_like (7 + n,)
             Seed state.
-        base : {"held", "floating"}
+        base : {"held", "floating", "centre-of-mass"}
             ``"held"``: only the joints move (the position rows of eq. 3.8's joint
             columns). ``"floating"``: base position and attitude are unknowns too (all
             columns of eq. 3.8; attitude steps are world rotation vectors).
+            ``"centre-of-mass"``: the joints move, the base's attitude is held and its
+            position follows so that the robot's centre of mass stays where it is (the
+            base's translation free, as under partial base control at zero momentum):
+            the Jacobian is ``J_θ − J_v M_vθ / m_total`` (position rows), and after each
+            step the base is placed to restore the centre of mass exactly.
         damping : float
             ``λ`` of the damped variant ``J* = Jᵀ (J Jᵀ + λ² 1)⁻¹``, m; 0 is eq. 3.12.
         tolerance : float
@@ -298,21 +310,34 @@ class ManipulatorModel:
         """
         target = np.asarray(target, dtype=float)
         q = np.array(q0, dtype=float)
-        if base == "held" and self._beyond_reach(q, target):
+        centre = self.centre_of_mass(q)
+        if base != "floating" and self._beyond_reach(q, target):
             return self._ik_result(q, target, "unreachable", 0)
         for iteration in range(max_iterations):
             error = target - self.kinematics(q).end_effector
             if np.linalg.norm(error) <= tolerance:
                 return self._ik_result(q, target, "converged", iteration)
-            jac = self.jacobian(q)[:3, 6:] if base == "held" else self.jacobian(q)[:3]
+            jac = self._ik_jacobian(q, base)
             jjt = jac @ jac.T
             if damping == 0.0 and np.linalg.det(jjt) <= singular_tolerance:
                 return self._ik_result(q, target, "singular", iteration)
             step = jac.T @ np.linalg.solve(jjt + damping**2 * np.eye(3), error)
             q = self._advance(q, step, base)
+            if base == "centre-of-mass":
+                q[:3] += centre - self.centre_of_mass(q)
         error = np.linalg.norm(target - self.kinematics(q).end_effector)
         status: IKStatus = "converged" if error <= tolerance else "not-converged"
         return self._ik_result(q, target, status, max_iterations)
+
+    def _ik_jacobian(self, q: Array, base: str) -> Array:
+        """The end-effector position's Jacobian over the unknowns of ``base``'s mode."""
+        jac = self.jacobian(q)[:3]
+        if base == "held":
+            return jac[:, 6:]
+        if base == "floating":
+            return jac
+        coupling = self.mass_matrix(q)[:3]  # [m_total 1, −m_total [r_sg×], M_vθ]
+        return jac[:, 6:] - jac[:, :3] @ coupling[:, 6:] / coupling[0, 0]
 
     def _beyond_reach(self, q: Array, target: Array) -> bool:
         shoulder = self.kinematics(q).origins[0]

@@ -117,7 +117,7 @@ def test_free_floating_jacobian_is_the_jacobian_at_zero_momentum(model):
     )
 
 
-@pytest.mark.parametrize("base", ["held", "floating"])
+@pytest.mark.parametrize("base", ["held", "floating", "centre-of-mass"])
 @pytest.mark.parametrize("seed", range(3))
 def test_inverse_kinematics_converges_from_nearby_seeds(model, base, seed):
     rng = np.random.default_rng(seed)
@@ -131,6 +131,19 @@ def test_inverse_kinematics_converges_from_nearby_seeds(model, base, seed):
     assert np.linalg.norm(model.forward_kinematics(result.q).end_effector - target) <= 1e-10
     if base == "held":
         np.testing.assert_array_equal(result.q[:7], seed_q[:7])
+    if base == "centre-of-mass":  # the base's attitude held, the whole robot's centre kept
+        np.testing.assert_array_equal(result.q[3:7], seed_q[3:7])
+        np.testing.assert_allclose(
+            model.centre_of_mass(result.q), model.centre_of_mass(seed_q), atol=1e-12
+        )
+
+
+def test_centre_of_mass_weighs_the_base_and_every_link(model):
+    q = state(np.full(N, 0.3))
+    frames = model.forward_kinematics(q)
+    masses = np.array([20.0, 15.0, 15.0, 15.0, 15.0, 20.0])
+    expected = (1000.0 * q[:3] + masses @ frames.link_coms) / 1100.0
+    np.testing.assert_allclose(model.centre_of_mass(q), expected, atol=1e-15)
 
 
 def test_inverse_kinematics_reports_an_unreachable_target(model):
