@@ -44,7 +44,8 @@ Space manipulator model (DH kinematics and dynamics of the source thesis 004)
 Geometry
     :func:`spherical_to_cartesian`, :func:`quaternion_between`, :func:`rotate`, :func:`unit`,
     :func:`clip_norm`, :func:`quaternion_multiply`, :func:`quaternion_conjugate`,
-    :func:`rotation_vector`, :func:`quaternion_from_rotation_vector`, :func:`slerp`.
+    :func:`rotation_vector`, :func:`quaternion_from_rotation_vector`, :func:`slerp`,
+    :func:`facing_axis`, :func:`sight_angle`.
 FMUs (FMI 2.0 co-simulation, through fmpy)
     :class:`FmuDescription`, :class:`FmuInstance`, :class:`FmuError`,
     :class:`FmuCallError`.
@@ -76,12 +77,14 @@ from dcsim.errors import (
 from dcsim.fmu.instance import FmuCallError, FmuDescription, FmuError, FmuInstance
 from dcsim.geometry import (
     clip_norm,
+    facing_axis,
     quaternion_between,
     quaternion_conjugate,
     quaternion_from_rotation_vector,
     quaternion_multiply,
     rotate,
     rotation_vector,
+    sight_angle,
     slerp,
     spherical_to_cartesian,
     unit,
@@ -219,6 +222,8 @@ __all__ = [
     "RobotSpec",
     "RobotState",
     "rotate",
+    "facing_axis",
+    "sight_angle",
     "rotation_vector",
     "ScenarioError",
     "Shape",

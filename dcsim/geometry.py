@@ -98,6 +98,24 @@ def rotate(q: ArrayLike, v: ArrayLike) -> Vector:
     return v + w * t + np.cross(u, t)
 
 
+_BODY_AXES = np.vstack([np.eye(3), -np.eye(3)])
+
+
+def facing_axis(q: ArrayLike, direction: ArrayLike) -> Vector:
+    """The body axis (±x, ±y or ±z, body frame) that points most nearly along world
+    ``direction`` when the body has attitude ``q = [x, y, z, w]``: the side that faces it."""
+    in_world = np.array([rotate(q, axis) for axis in _BODY_AXES])
+    return _BODY_AXES[int(np.argmax(in_world @ np.asarray(direction, dtype=float)))].copy()
+
+
+def sight_angle(q: ArrayLike, axis: ArrayLike, direction: ArrayLike) -> float:
+    """Angle between body ``axis`` (body frame, any length) turned by attitude ``q`` and
+    world ``direction``, rad in [0, π]."""
+    facing = unit(rotate(q, axis))
+    cosine = float(facing @ unit(direction))
+    return float(np.arccos(np.clip(cosine, -1.0, 1.0)))
+
+
 def quaternion_multiply(p: ArrayLike, q: ArrayLike) -> Vector:
     """Hamilton product ``p ⊗ q`` of quaternions ``[x, y, z, w]`` (rotation q, then p)."""
     p = np.asarray(p, dtype=float)

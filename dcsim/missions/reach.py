@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from dcsim.geometry import rotate
+from dcsim.geometry import facing_axis, sight_angle
 from dcsim.interfaces import Plugin
 from dcsim.messages import (
     GoalRegion,
@@ -51,8 +51,6 @@ from dcsim.missions.base import Emit, Mission
 from dcsim.robots.joint_path import JointPath, SingularPath
 from dcsim.scenario.model import ReachMissionSection, Scenario
 from dcsim.world import World
-
-_BASE_AXES = np.vstack([np.eye(3), -np.eye(3)])
 
 
 class ReachMission(Mission):
@@ -212,20 +210,14 @@ class ReachMission(Mission):
         return self.model.forward_kinematics(_configuration(state)).end_effector
 
     def _facing_axis(self, start: RobotState) -> np.ndarray:
-        """The base-frame unit direction of the side that must face the target."""
+        """The base-frame direction of the side that must face the target."""
         if self.settings.facing_axis is not None:
-            axis = np.asarray(self.settings.facing_axis, dtype=float)
-            return axis / np.linalg.norm(axis)
-        direction = self.target - start.position
-        in_world = np.array([rotate(start.attitude, axis) for axis in _BASE_AXES])
-        return _BASE_AXES[int(np.argmax(in_world @ direction))]
+            return np.asarray(self.settings.facing_axis, dtype=float)
+        return facing_axis(start.attitude, self.target - start.position)
 
     def _target_angle(self, state: RobotState) -> float:
         """Angle between the base's target-facing side and the target's direction, rad."""
-        facing = rotate(state.attitude, self.facing_axis)
-        direction = self.target - state.position
-        cosine = facing @ direction / np.linalg.norm(direction)
-        return float(np.arccos(np.clip(cosine, -1.0, 1.0)))
+        return sight_angle(state.attitude, self.facing_axis, self.target - state.position)
 
     # ------------------------------------------------------------------ records
     def telemetry(self, outputs: Mapping[str, Any]) -> dict[str, Any]:

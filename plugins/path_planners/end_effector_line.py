@@ -2,30 +2,22 @@
 
 The end effector moves on the segment from where it is (the forward kinematics of the
 problem's start state) to the goal region's centre, at rest at both ends, with the
-minimum-jerk (quintic) time law
-
-    s(τ) = L (10 τ³ − 15 τ⁴ + 6 τ⁵),      τ = (t − t₀) / T,
-
-whose velocity and acceleration are zero at both ends and continuous in between: what
-a model-based controller needs to track the joint references derived from it. Its peak
-speed is ``15 L / (8 T)`` and its peak acceleration ``10 L / (√3 T²)``; ``T`` is the
-shortest duration that keeps both within the problem's limits (or the goal's time, when
-it sets one). The answer is "no path" when the target lies beyond the arm's reach from
-the shoulder (the base held where it is), when no model is given (a free flyer), or
-when the goal's time is too soon. This is the task-space straight line of the source
-thesis 004's reach experiment, until a learned planner takes its place.
+minimum-jerk (quintic) time law of :mod:`minimum_jerk`, whose velocity and acceleration
+are continuous: what a model-based controller needs to track the joint references
+derived from it. The move's duration is the shortest that keeps its peak speed and
+acceleration within the problem's limits (or the goal's time, when it sets one). The
+answer is "no path" when the target lies beyond the arm's reach from the shoulder (the
+base held where it is), when no model is given (a free flyer), or when the goal's time
+is too soon. This is the task-space straight line of the source thesis 004's reach
+experiment, and the baseline of the learned planner.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from dcsim_plugins.path_planners.minimum_jerk import minimum_jerk_move, shortest_duration
 
 from dcsim.api import NoPath, PathPlanner, PathProblem, PluginParams, Trajectory, hookimpl, quantity
-
-_PEAK_SPEED = 15.0 / 8.0
-"""Peak speed of the quintic law, in units of L / T."""
-_PEAK_ACCELERATION = 10.0 / np.sqrt(3.0)
-"""Peak acceleration of the quintic law, in units of L / T²."""
 
 
 class EndEffectorLineParams(PluginParams):
@@ -68,14 +60,13 @@ class EndEffectorLinePlanner(PathPlanner):
         duration = self._duration(problem, length)
         if isinstance(duration, NoPath):
             return duration
-        tau = np.linspace(0.0, 1.0, self.params.samples)
-        distance = length * tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
-        speed = length / duration * 30.0 * tau**2 * (1.0 - tau) ** 2
-        direction = (target - origin) / length if length > 0 else np.zeros(3)
+        times, positions, velocities = minimum_jerk_move(
+            origin, target, duration, self.params.samples
+        )
         return Trajectory(
-            times=problem.start.time + duration * tau,
-            positions=origin + np.outer(distance, direction),
-            velocities=np.outer(speed, direction),
+            times=problem.start.time + times,
+            positions=positions,
+            velocities=velocities,
             length=length,
             duration=duration,
         )
@@ -83,10 +74,8 @@ class EndEffectorLinePlanner(PathPlanner):
     def _duration(self, problem: PathProblem, length: float) -> float | NoPath:
         """``T``: the goal's time if set, else the least within the speed and acceleration
         limits (never below ``min_duration``)."""
-        shortest = max(
-            self.params.min_duration,
-            _PEAK_SPEED * length / problem.max_speed,
-            float(np.sqrt(_PEAK_ACCELERATION * length / problem.max_acceleration)),
+        shortest = shortest_duration(
+            length, problem.max_speed, problem.max_acceleration, self.params.min_duration
         )
         if problem.goal.time is None:
             return shortest
