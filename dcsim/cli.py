@@ -791,6 +791,80 @@ def bench_ant_colony_command(
         click.echo(f"plot: {plot_path}")
 
 
+@bench_group.command("q-learning")
+@click.option(
+    "--scenario",
+    default="scenarios/space_manipulator_reach.yaml",
+    show_default=True,
+    help="A reach scenario: its robot, start, target and limits.",
+)
+@click.option(
+    "--episodes",
+    default="500,1000,2000",
+    show_default=True,
+    help="Comma-separated training lengths of the working-cells table.",
+)
+@click.option("--seeds", type=click.IntRange(1, 1000), default=5, show_default=True)
+@click.option(
+    "--margins",
+    default="1,2,3,4,5,6",
+    show_default=True,
+    help="Comma-separated grid margins (cells) of the environment-size sweep.",
+)
+@click.option(
+    "--size-episodes",
+    type=click.IntRange(1),
+    default=2000,
+    show_default=True,
+    help="Training episodes of the environment-size sweep and the reward curves.",
+)
+@click.option(
+    "--figures",
+    "figures_dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=None,
+    help="Write q_learning_rewards.png, q_learning_sizes.png and the two application "
+    "cases' q_learning_start_a.png and q_learning_start_b.png here.",
+)
+def bench_q_learning_command(
+    scenario: str,
+    episodes: str,
+    seeds: int,
+    margins: str,
+    size_episodes: int,
+    figures_dir: Path | None,
+) -> None:
+    """The q-learning planner against the exact answers of its cell environment.
+
+    The thesis's Table 7.3 (working cells for its three (α, γ) at equal episodes, as a
+    share of the cells from which the target can be reached at all), the greedy return's
+    gap to the optimum that value iteration finds, the cumulative reward per episode
+    (Figs 7.2-7.3), build and training time against the environment's size (Fig. 7.4),
+    and the two application cases of §7.4 with the arm's state along their paths (Figs
+    7.5-7.13). Prints Markdown tables for docs/benchmarks.md; progress goes to stderr.
+    """
+    from dcsim.bench import q_learning as bench
+
+    counts = [int(v) for v in _numbers(episodes, "--episodes")]
+    widths = [int(v) for v in _numbers(margins, "--margins")]
+    progress = lambda line: click.echo(line, err=True)  # noqa: E731
+    problem = bench.reach_problem(scenario)
+    rows, reachable, cells = bench.working_table(problem, counts, seeds, progress=progress)
+    sizes = bench.size_sweep(problem, widths, size_episodes, progress=progress)
+    cases = bench.run_applications(scenario)
+    click.echo(bench.markdown(rows, reachable, cells, sizes, cases))
+    if figures_dir is not None:
+        figures_dir.mkdir(parents=True, exist_ok=True)
+        bench.plot_curves(
+            bench.reward_curves(problem, size_episodes), figures_dir / "q_learning_rewards.png"
+        )
+        bench.plot_sizes(sizes, figures_dir / "q_learning_sizes.png")
+        target = bench.target_of(scenario)
+        for case, name in zip(cases, ("start_a", "start_b"), strict=True):
+            bench.plot_application(case, target, figures_dir / f"q_learning_{name}.png")
+        click.echo(f"\nfigures in {figures_dir}")
+
+
 def _words(text: str, option: str) -> list[str]:
     """The comma-separated words of an option (an error when there are none)."""
     words = [word.strip() for word in text.split(",") if word.strip()]

@@ -72,8 +72,7 @@ def test_unknown_name_suggests_the_closest():
     with pytest.raises(
         PluginNotFoundError,
         match=r"available: ant-colony, end-effector-line, grid-astar, multi-burn, ompl-control, "
-        r"ompl-geometric, "
-        r"straight-line\); "
+        r"ompl-geometric, q-learning, straight-line\); "
         r"did you mean 'straight-line'\?",
     ):
         registry.get("path_planner", "straight_line")

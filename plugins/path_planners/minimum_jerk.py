@@ -42,3 +42,48 @@ def minimum_jerk_move(
     shape = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
     rate = 30.0 * tau**2 * (1.0 - tau) ** 2 / duration
     return duration * tau, origin + np.outer(shape, offset), np.outer(rate, offset)
+
+
+def minimum_jerk_curve(
+    points: np.ndarray, max_speed: float, max_acceleration: float, samples: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Rest to rest along a smooth curve through ``points`` (k, 3), m.
+
+    The curve is the piecewise-cubic Hermite interpolant through the points over their
+    cumulative chord length ``σ`` that keeps every coordinate monotone between points
+    (PCHIP: it never overshoots a corner; a straight line for two points), travelled with
+    the minimum-jerk law ``σ(t) = L (10 τ³ − 15 τ⁴ + 6 τ⁵)``. The duration starts from
+    the straight move's and grows until the speed ``|x'(σ)| σ̇`` and the acceleration
+    ``|x''(σ) σ̇² + x'(σ) σ̈|`` on the samples are within the limits.
+
+    Returns
+    -------
+    times, positions, velocities : ndarray
+        ``samples`` points: s since the start, m and m/s.
+    """
+    from scipy.interpolate import PchipInterpolator
+
+    chords = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    sigma = np.concatenate([[0.0], np.cumsum(chords)])
+    length = float(sigma[-1])
+    curve = PchipInterpolator(sigma, points)
+    tau = np.linspace(0.0, 1.0, samples)
+    shape = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
+    rate = 30.0 * tau**2 * (1.0 - tau) ** 2
+    bend = 60.0 * tau * (1.0 - tau) * (1.0 - 2.0 * tau)
+    along = length * shape
+    tangent, curvature = curve(along, 1), curve(along, 2)
+    duration = shortest_duration(length, max_speed, max_acceleration)
+    for _ in range(60):
+        speed = np.linalg.norm(tangent * (length * rate / duration)[:, None], axis=1).max()
+        acceleration = np.linalg.norm(
+            curvature * ((length * rate / duration) ** 2)[:, None]
+            + tangent * (length * bend / duration**2)[:, None],
+            axis=1,
+        ).max()
+        stretch = max(speed / max_speed, np.sqrt(acceleration / max_acceleration))
+        if stretch <= 1.0 + 1e-9:
+            break
+        duration *= stretch * (1.0 + 1e-6)
+    velocities = tangent * (length * rate / duration)[:, None]
+    return duration * tau, curve(along), velocities

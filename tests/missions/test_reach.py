@@ -71,6 +71,23 @@ def test_partial_control_tracks_the_joints_without_thrust(partial_control):
     )
 
 
+def test_q_learning_and_full_control_reach_the_target_within_every_constraint(tmp_path):
+    summary, telemetry = fly(
+        tmp_path / "run",
+        "path_planner.plugin=q-learning",
+        "world.duration=15",
+        "world.physics_step=0.001",
+    )
+    assert summary["reached"] and summary["final_target_distance_m"] <= 1e-3
+    joints = np.column_stack([telemetry[f"joint_{i}"] for i in range(1, 7)])
+    assert np.degrees(np.abs(joints)).max() < 90.0  # the thesis's joint limits
+    assert telemetry["det_jjt"].min() > 1e-3  # no singularity
+    assert np.degrees(telemetry["target_angle"]).max() < 60.0  # the target in sight
+    moved = telemetry["ee_displacement"] > 0.0
+    ratio = telemetry["base_displacement"][moved] / telemetry["ee_displacement"][moved]
+    assert ratio.max() <= 0.5  # the base moves less than half the end effector
+
+
 def test_reach_writes_one_column_per_joint_and_its_plots(full_control, tmp_path):
     _, telemetry = full_control
     for i in range(1, 7):

@@ -1,0 +1,336 @@
+"""``q-learning`` path planner: a space manipulator's end-effector path learnt by tabular
+Q-learning on a grid of cells (the source thesis 004, chapter 5 and §7.3–7.4).
+
+:mod:`cell_environment` builds the thesis's environment for the problem (cells, six
+actions, terminal cells for joint limits, singularities and the target out of sight, a
+better reward when the base moves little); :mod:`tabular_q` trains the table with the
+thesis's ε-greedy rule and temporal-difference update; the greedy path from the start
+cell is the answer. The Q-table can be kept in a file (``q_table_file``, ``npz``): it is
+loaded when it was trained on the same environment and schedule, else trained and
+written. Training draws from the planner's generator, so a seed gives the same table.
+
+The flight follows the cell centres from the start (the end effector's own position:
+the lattice is anchored there) to the target's cell, then on to the target itself. The
+staircase of centres is first simplified (Ramer–Douglas–Peucker) to the fewest points
+that keep every centre within ``smoothing`` cells of the path (0 keeps every centre),
+then flown on the cubic spline through those points, rest to rest, with a minimum-jerk
+time law within the problem's speed and acceleration limits
+(:func:`minimum_jerk_curve`): a staircase flown corner by corner would stop at every
+cell. "No path" when the target is beyond the arm's
+reach, when its cell breaks a constraint, or when the greedy path enters a terminal
+cell, comes back to a cell, or does not arrive.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import time
+from pathlib import Path
+
+import numpy as np
+from dcsim_plugins.path_planners.cell_environment import (
+    CellEnvironment,
+    CellRules,
+    build_environment,
+)
+from dcsim_plugins.path_planners.deadline import OutOfTime
+from dcsim_plugins.path_planners.minimum_jerk import minimum_jerk_curve
+from dcsim_plugins.path_planners.tabular_q import (
+    Rollout,
+    Schedule,
+    Training,
+    greedy_rollout,
+    train,
+)
+
+from dcsim.api import (
+    NoPath,
+    PathPlanner,
+    PathProblem,
+    PluginError,
+    PluginParams,
+    Trajectory,
+    hookimpl,
+    quantity,
+)
+
+
+class QLearningParams(PluginParams):
+    """Parameters of :class:`QLearningPlanner`."""
+
+    cell_size: float = quantity(0.05, unit="m", gt=0, description="Side of a grid cell.")
+    margin: int = quantity(
+        2, ge=0, le=50, description="Cells added on every side of the box of start and target."
+    )
+    episodes: int = quantity(2000, ge=1, le=10_000_000, description="Training episodes.")
+    max_steps: int = quantity(200, ge=1, description="Most actions in one episode.")
+    learning_rate: float = quantity(0.9, gt=0, le=1, description="α of eq. 5.1.")
+    discount: float = quantity(0.9, ge=0, le=1, description="γ of eq. 5.1.")
+    epsilon_start: float = quantity(
+        0.1, ge=0, le=1, description="ε (probability of the greedy action) in the first episode."
+    )
+    epsilon_end: float = quantity(0.9, ge=0, le=1, description="ε in the last episode.")
+    joint_limit_deg: float = quantity(
+        90.0,
+        unit="deg",
+        gt=0,
+        le=180,
+        description="Joint angle magnitude beyond which a cell is terminal.",
+    )
+    sight_limit_deg: float = quantity(
+        60.0,
+        unit="deg",
+        gt=0,
+        le=180,
+        description="Angle between the base's facing side and the "
+        "target beyond which a cell is terminal.",
+    )
+    singular_det: float = quantity(
+        1e-3,
+        unit="m^6",
+        ge=0,
+        description="det(J Jᵀ) of the position Jacobian at or below which "
+        "a cell is terminal (a singularity).",
+    )
+    base_ratio: float = quantity(
+        0.5,
+        gt=0,
+        description="Base displacement, as a fraction of the end effector's, above "
+        "which a move pays base_penalty.",
+    )
+    target_reward: float = quantity(100.0, description="Reward for entering the target's cell.")
+    terminal_reward: float = quantity(-100.0, description="Reward for entering a terminal cell.")
+    step_reward: float = quantity(-1.0, description="Reward of any other move.")
+    base_penalty: float = quantity(
+        -1.0, description="Added to step_reward where the base moves too much."
+    )
+    smoothing: float = quantity(
+        1.0,
+        unit="cells",
+        ge=0,
+        le=10,
+        description="Largest distance of a visited cell's centre from the flown path, in cells.",
+    )
+    samples: int = quantity(
+        201, ge=2, le=100_000, description="Trajectory samples from start to target."
+    )
+    q_table_file: str | None = quantity(
+        None,
+        description="npz file to load the Q-table from (when it was trained on the same "
+        "environment and schedule) or to save it to; null: train every time.",
+    )
+
+
+class QLearningPlanner(PathPlanner):
+    """Tabular Q-learning of the end effector's path over a grid of cells."""
+
+    name = "q-learning"
+    summary = "A manipulator's end-effector path by tabular Q-learning on a cell grid (thesis 004)"
+    Params = QLearningParams
+    params: QLearningParams
+    robots = ("manipulator",)
+
+    # ------------------------------------------------------------------ parts
+    def rules(self) -> CellRules:
+        """The environment's constants from the parameters."""
+        p = self.params
+        return CellRules(
+            cell_size=p.cell_size,
+            margin=p.margin,
+            joint_limit=np.radians(p.joint_limit_deg),
+            sight_limit=np.radians(p.sight_limit_deg),
+            singular_det=p.singular_det,
+            base_ratio=p.base_ratio,
+            target_reward=p.target_reward,
+            terminal_reward=p.terminal_reward,
+            step_reward=p.step_reward,
+            base_penalty=p.base_penalty,
+        )
+
+    def schedule(self) -> Schedule:
+        """The training constants from the parameters."""
+        p = self.params
+        return Schedule(
+            episodes=p.episodes,
+            max_steps=p.max_steps,
+            alpha=p.learning_rate,
+            gamma=p.discount,
+            epsilon_start=p.epsilon_start,
+            epsilon_end=p.epsilon_end,
+        )
+
+    def environment(self, problem: PathProblem, deadline: float = float("inf")) -> CellEnvironment:
+        """The cell environment of ``problem`` (:func:`build_environment`), built by
+        ``deadline`` (``time.perf_counter()``) or :class:`OutOfTime`."""
+        return build_environment(problem, self.rules(), deadline)
+
+    def train(self, environment: CellEnvironment, deadline: float = float("inf")) -> Training:
+        """A Q-table trained on ``environment`` with the planner's generator, by
+        ``deadline`` (``time.perf_counter()``) or :class:`OutOfTime`."""
+        starts = np.flatnonzero(~environment.ends)
+        return train(
+            environment.next_cell,
+            environment.reward,
+            environment.ends,
+            starts,
+            self.schedule(),
+            self.rng,
+            deadline,
+        )
+
+    def greedy_path(self, environment: CellEnvironment, q: np.ndarray) -> Rollout:
+        """The greedy path of table ``q`` from the environment's start cell."""
+        return greedy_rollout(
+            q,
+            environment.next_cell,
+            environment.reward,
+            environment.ends,
+            environment.target,
+            environment.start,
+            self.params.discount,
+        )
+
+    # ------------------------------------------------------------------ plan
+    def plan(self, problem: PathProblem) -> Trajectory | NoPath:
+        """Learn (or load) the table and return the greedy end-effector path."""
+        refusal = _refusal(problem)
+        if refusal is not None:
+            return refusal
+        began = time.perf_counter()
+        deadline = began + problem.time_budget
+        try:
+            environment = self.environment(problem, deadline)
+            if environment.terminal[environment.target]:
+                reason = environment.reasons[environment.target]
+                return NoPath(f"the target's cell breaks a constraint: {reason}")
+            q, loaded = self._table(environment, deadline)
+        except OutOfTime as late:
+            return NoPath(
+                f"the planning budget of {problem.time_budget:g} s ran out ({late} done): "
+                "give it more time, or fewer cells or episodes (a q_table_file trained on this "
+                "environment skips the training)"
+            )
+        rollout = self.greedy_path(environment, q)
+        if rollout.outcome != "target":
+            return NoPath(_no_path_reason(environment, rollout.cells, rollout.outcome))
+        statistics = {
+            "cells": float(environment.cells),
+            "terminal_cells": float(environment.terminal.sum()),
+            "moves": float(len(rollout.cells) - 1),
+            "discounted_return": rollout.discounted_return,
+            "loaded_q_table": float(loaded),
+        }
+        return self._trajectory(problem, environment, rollout.cells, statistics)
+
+    def _table(self, environment: CellEnvironment, deadline: float) -> tuple[np.ndarray, bool]:
+        """The Q-table: loaded from ``q_table_file`` if it fits, else trained (and saved)."""
+        path = None if self.params.q_table_file is None else Path(self.params.q_table_file)
+        fingerprint = _fingerprint(environment, self.schedule())
+        if path is not None and path.exists():
+            try:
+                with np.load(path) as saved:
+                    if str(saved["fingerprint"]) == fingerprint:
+                        return saved["q"], True
+            except (OSError, ValueError, KeyError) as error:
+                raise PluginError(f"q-learning: cannot read the Q-table {path}: {error}") from None
+        q = self.train(environment, deadline).q
+        if path is not None:
+            _save(path, q, fingerprint)
+        return q, False
+
+    def _trajectory(
+        self, problem: PathProblem, environment: CellEnvironment, cells: list[int], statistics
+    ) -> Trajectory:
+        """The smooth rest-to-rest flight through the cell path's centres to the target."""
+        points = environment.centres(np.asarray(cells))
+        target = np.asarray(problem.goal.position, dtype=float)
+        if np.linalg.norm(points[-1] - target) > 1e-9:
+            points = np.vstack([points, target])
+        points = simplified(points, self.params.smoothing * environment.cell_size)
+        times, positions, velocities = minimum_jerk_curve(
+            points, problem.max_speed, problem.max_acceleration, self.params.samples
+        )
+        return Trajectory(
+            times=problem.start.time + times,
+            positions=positions,
+            velocities=velocities,
+            length=float(np.linalg.norm(np.diff(positions, axis=0), axis=1).sum()),
+            duration=float(times[-1]),
+            statistics=statistics,
+        )
+
+
+def _refusal(problem: PathProblem) -> NoPath | None:
+    """Why the problem cannot be planned at all, or None."""
+    model = problem.model
+    if model is None or not hasattr(model, "inverse_kinematics"):
+        return NoPath("the problem carries no manipulator model: this planner moves an arm")
+    start = problem.start
+    q = np.concatenate([start.position, start.attitude, start.joint_positions])
+    shoulder = model.forward_kinematics(q).origins[0]
+    distance = float(np.linalg.norm(problem.goal.position - shoulder))
+    if distance > model.robot.reach:
+        return NoPath(
+            f"the target is {distance:.3f} m from the shoulder, beyond the arm's reach of "
+            f"{model.robot.reach:.3f} m"
+        )
+    return None
+
+
+def simplified(points: np.ndarray, tolerance: float) -> np.ndarray:
+    """The fewest of ``points`` (k, 3), ends kept, whose polyline passes within
+    ``tolerance`` (m) of every dropped point (Ramer–Douglas–Peucker)."""
+    if len(points) < 3:
+        return points
+    first, last = points[0], points[-1]
+    chord = last - first
+    offsets = points[1:-1] - first
+    span = float(chord @ chord)
+    if span > 0.0:
+        along = np.clip(offsets @ chord / span, 0.0, 1.0)
+        offsets = offsets - along[:, None] * chord
+    distances = np.linalg.norm(offsets, axis=1)
+    farthest = int(np.argmax(distances)) + 1
+    if distances[farthest - 1] <= tolerance:
+        return np.vstack([first, last])
+    head = simplified(points[: farthest + 1], tolerance)
+    return np.vstack([head[:-1], simplified(points[farthest:], tolerance)])
+
+
+def _no_path_reason(environment: CellEnvironment, cells: list[int], outcome: str) -> str:
+    last = cells[-1]
+    where = np.array2string(environment.centres(np.array([last]))[0], precision=3)
+    if outcome == "terminal":
+        return (
+            f"the greedy path enters a terminal cell at {where} m after {len(cells) - 1} moves "
+            f"({environment.reasons[last]}): train longer or change the grid"
+        )
+    if outcome == "loop":
+        return f"the greedy path comes back to the cell at {where} m: train longer"
+    return f"the greedy path does not reach the target within {len(cells) - 1} moves"
+
+
+def _fingerprint(environment: CellEnvironment, schedule: Schedule) -> str:
+    """A digest of what the table was trained on."""
+    digest = hashlib.sha256()
+    for array in (environment.next_cell, environment.reward, environment.ends):
+        digest.update(np.ascontiguousarray(array).tobytes())
+    digest.update(repr(schedule).encode())
+    return digest.hexdigest()
+
+
+def _save(path: Path, q: np.ndarray, fingerprint: str) -> None:
+    """Write the table atomically (a reader sees the old file or the new)."""
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        partial = path.with_name(path.name + ".partial.npz")
+        np.savez(partial, q=q, fingerprint=np.array(fingerprint))
+        partial.replace(path)
+    except OSError as error:
+        raise PluginError(f"q-learning: cannot write the Q-table {path}: {error}") from None
+
+
+@hookimpl
+def dcsim_plugin_classes() -> list[type]:
+    """Register the Q-learning planner."""
+    return [QLearningPlanner]
