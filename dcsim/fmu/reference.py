@@ -1,4 +1,4 @@
-"""Generate the variable tables of docs/fmu.md (``make docs``)."""
+"""Generate the variable tables of docs/fmu.md (``make docs``) from the default scenario."""
 
 from __future__ import annotations
 
@@ -6,7 +6,13 @@ import sys
 from pathlib import Path
 
 from dcsim.docgen import update_block
-from dcsim.fmu.variables import CLOSED_LOOP, DEFAULT_BEACONS, FmuVariable, plant_variables
+from dcsim.fmu.variables import (
+    DEFAULT_BEACONS,
+    FmuVariable,
+    closed_loop_variables,
+    plant_variables,
+)
+from dcsim.scenario import load_scenario
 
 
 def variables_table(variables: list[FmuVariable]) -> str:
@@ -26,11 +32,25 @@ BEGIN_PLANT = "<!-- begin: plant variables (make docs) -->"
 END_PLANT = "<!-- end: plant variables -->"
 
 
+def generated_blocks() -> list[tuple[str, str, str]]:
+    """``(begin marker, end marker, table)`` of every generated block of docs/fmu.md.
+
+    The closed-loop and plant tables of the default scenario (the plant with K =
+    :data:`DEFAULT_BEACONS`).
+    """
+    default = load_scenario()
+    return [
+        (BEGIN_CLOSED, END_CLOSED, variables_table(closed_loop_variables(default))),
+        (BEGIN_PLANT, END_PLANT, variables_table(plant_variables(default, DEFAULT_BEACONS))),
+    ]
+
+
 def write_reference(path: Path) -> bool:
-    """Regenerate both variable tables in ``path``; return True if it changed."""
-    changed = update_block(path, BEGIN_CLOSED, END_CLOSED, variables_table(CLOSED_LOOP))
-    plant = variables_table(plant_variables(DEFAULT_BEACONS))
-    return update_block(path, BEGIN_PLANT, END_PLANT, plant) or changed
+    """Regenerate every variable table in ``path``; return True if it changed."""
+    changed = False
+    for begin, end, table in generated_blocks():
+        changed = update_block(path, begin, end, table) or changed
+    return changed
 
 
 if __name__ == "__main__":

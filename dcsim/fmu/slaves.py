@@ -3,7 +3,8 @@
 An exported FMU carries a tiny script defining a subclass of :class:`ClosedLoopSlave` or
 :class:`PlantSlave`, and the resolved scenario as the resource ``scenario.yaml``. The
 slaves are thin adapters: the closed-loop one drives the :class:`~dcsim.runner.Runner`
-that ``dcsim run`` uses, the plant one a :class:`~dcsim.world.World`.
+that ``dcsim run`` uses, the plant one a :class:`~dcsim.world.World`. A slave declares
+its variables when it is instantiated, from that scenario (:mod:`dcsim.fmu.variables`).
 
 Time. The world advances in whole control periods (``world.control_period``). A
 ``doStep`` from ``t`` to ``t + h`` flies every control period that ends at or before
@@ -32,11 +33,11 @@ from pythonfmu.enums import Fmi2Initial, Fmi2Status, Fmi2Variability
 
 from dcsim.fmu.variables import (
     AXES,
-    CLOSED_LOOP,
     DEFAULT_BEACONS,
     PARAMETERS,
     QUATERNION,
     FmuVariable,
+    closed_loop_variables,
     plant_variables,
 )
 from dcsim.runner import Runner
@@ -76,16 +77,24 @@ _FMI_TYPES = {float: Real, int: Integer, bool: Boolean}
 class _ScenarioSlave(Fmi2Slave):
     """What both slaves share: the scenario, parameters, inputs and stepping in periods.
 
-    Subclasses set :attr:`variables` and implement ``_open``, ``_advance``,
-    ``_outputs`` and ``_close``.
-    """
+    Subclasses implement ``_declare`` (their variables for the scenario), ``_open``,
+    ``_advance``, ``_outputs`` and ``_close``.
 
-    variables: list[FmuVariable] = []
+    Attributes
+    ----------
+    scenario : Scenario
+        The resolved scenario the FMU carries.
+    variables : list of FmuVariable
+        The FMU's variables, declared from :attr:`scenario`.
+    values : dict of str to object
+        Every variable's current value, by name.
+    """
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
         self.scenario_path = Path(self.resources) / SCENARIO_RESOURCE
         self.scenario: Scenario = load_scenario(self.scenario_path)
+        self.variables: list[FmuVariable] = self._declare()
         self.author = "dcsim"
         self.description = f"dcsim scenario {self.scenario.name!r}: {self.scenario.description}"
         self.default_experiment = DefaultExperiment(
@@ -105,6 +114,10 @@ class _ScenarioSlave(Fmi2Slave):
             self.register_variable(self._fmi_variable(variable))
 
     # ------------------------------------------------------------------ variables
+    def _declare(self) -> list[FmuVariable]:
+        """The FMU's variables for :attr:`scenario`."""
+        raise NotImplementedError
+
     def _initial_values(self) -> dict[str, Any]:
         """Start values: parameters from the scenario, the state at t = 0, zeros."""
         values: dict[str, Any] = {v.name: v.type(0) for v in self.variables}
@@ -290,7 +303,8 @@ class ClosedLoopSlave(_ScenarioSlave):
     outputs at a period boundary equal the telemetry row ``dcsim run`` records there.
     """
 
-    variables = CLOSED_LOOP
+    def _declare(self) -> list[FmuVariable]:
+        return closed_loop_variables(self.scenario)
 
     def _open(self) -> None:
         setup = prepare_run(self.scenario_path, self._overrides(), seed=self.values["seed"])
@@ -333,9 +347,8 @@ class PlantSlave(_ScenarioSlave):
 
     nearest_beacons = DEFAULT_BEACONS
 
-    def __init__(self, **kwargs: Any) -> None:
-        self.variables = plant_variables(self.nearest_beacons)
-        super().__init__(**kwargs)
+    def _declare(self) -> list[FmuVariable]:
+        return plant_variables(self.scenario, self.nearest_beacons)
 
     def _initial_values(self) -> dict[str, Any]:
         values = super()._initial_values()

@@ -1,16 +1,18 @@
 """The variables of dcsim's FMUs: name, causality, type, unit and meaning.
 
-The tables here define what the exported FMUs offer; the slaves register exactly these
-variables and ``docs/fmu.md`` lists them (:mod:`dcsim.fmu.reference`, ``make docs``). Vectors
-are three (or four) scalar variables named ``name.x``, ``name.y``, ``name.z`` (``.w``
-for a quaternion's scalar part), world frame of the scenario.
+The functions here define what an exported FMU offers, from the scenario it carries:
+the slaves register exactly these variables and ``docs/fmu.md`` lists them for the
+default scenario (:mod:`dcsim.fmu.reference`, ``make docs``). Vectors are three (or
+four) scalar variables named ``name.x``, ``name.y``, ``name.z`` (``.w`` for a
+quaternion's scalar part), world frame of the scenario.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from dcsim.missions import DebrisMission
+from dcsim.missions import mission_class
+from dcsim.scenario.model import Scenario
 
 AXES = ("x", "y", "z")
 QUATERNION = ("x", "y", "z", "w")
@@ -66,42 +68,50 @@ _STATE = [
     *_vector("angular_velocity", "output", "rad/s", "Collector angular velocity (true)."),
 ]
 
-_MODES = ", ".join(f"{index} {mode}" for index, mode in enumerate(DebrisMission.modes))
 
-CLOSED_LOOP = [
-    *PARAMETERS,
-    *_vector("disturbance_force", "input", "N", "External force on the collector."),
-    *_vector("disturbance_torque", "input", "N.m", "External torque on the collector."),
-    *_STATE,
-    FmuVariable("mode", "output", int, "", f"Mission mode, by index (debris: {_MODES})."),
-    FmuVariable("captured", "output", int, "", "Targets grabbed so far (carried or delivered)."),
-    FmuVariable("delivered", "output", int, "", "Targets delivered to the drop point."),
-    FmuVariable("collisions", "output", int, "", "Collisions so far."),
-    FmuVariable("fuel_used", "output", float, "kg", "Propellant used."),
-    FmuVariable("delta_v", "output", float, "m/s", "Delta-v spent."),
-    FmuVariable(
-        "localisation_error", "output", float, "m", "Distance from the estimate to the truth."
-    ),
-    FmuVariable(
-        "run_status",
-        "output",
-        int,
-        "",
-        "0 running, 1 completed, 2 stopped by a stop rule, 3 failed (then the world coasts).",
-    ),
-]
-"""Variables of the closed-loop FMU (``dcsim fmu export``)."""
+def closed_loop_variables(scenario: Scenario) -> list[FmuVariable]:
+    """Variables of the closed-loop FMU of ``scenario`` (``dcsim fmu export``)."""
+    mission = mission_class(scenario.mission.type)
+    modes = ", ".join(f"{index} {mode}" for index, mode in enumerate(mission.modes))
+    return [
+        *PARAMETERS,
+        *_vector("disturbance_force", "input", "N", "External force on the collector."),
+        *_vector("disturbance_torque", "input", "N.m", "External torque on the collector."),
+        *_STATE,
+        FmuVariable(
+            "mode", "output", int, "", f"Mission mode, by index ({mission.type}: {modes})."
+        ),
+        FmuVariable(
+            "captured", "output", int, "", "Targets grabbed so far (carried or delivered)."
+        ),
+        FmuVariable("delivered", "output", int, "", "Targets delivered to the drop point."),
+        FmuVariable("collisions", "output", int, "", "Collisions so far."),
+        FmuVariable("fuel_used", "output", float, "kg", "Propellant used."),
+        FmuVariable("delta_v", "output", float, "m/s", "Delta-v spent."),
+        FmuVariable(
+            "localisation_error", "output", float, "m", "Distance from the estimate to the truth."
+        ),
+        FmuVariable(
+            "run_status",
+            "output",
+            int,
+            "",
+            "0 running, 1 completed, 2 stopped by a stop rule, 3 failed (then the world coasts).",
+        ),
+    ]
 
 
 DEFAULT_BEACONS = 4
 """How many nearest beacons' ranges the plant FMU outputs unless told otherwise (K)."""
 
 
-def plant_variables(beacons: int) -> list[FmuVariable]:
-    """Variables of the plant-only FMU (``dcsim fmu export --plant-only``).
+def plant_variables(scenario: Scenario, beacons: int) -> list[FmuVariable]:
+    """Variables of the plant-only FMU of ``scenario`` (``dcsim fmu export --plant-only``).
 
     Parameters
     ----------
+    scenario : Scenario
+        The scenario exported.
     beacons : int
         How many nearest beacons' ranges the FMU outputs (K).
     """
