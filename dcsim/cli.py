@@ -1081,7 +1081,8 @@ def fmu_group() -> None:
 @click.option(
     "--plant-only",
     is_flag=True,
-    help="Export the world alone: force and torque in, true state and sensors out.",
+    help="Export the world alone: force and torque (and a manipulator's joint torques) in, "
+    "true state and sensors out.",
 )
 @click.option(
     "--beacons",
@@ -1106,8 +1107,9 @@ def fmu_export_command(
 
     The closed-loop FMU runs the whole scenario (world, localiser, planners, controller,
     mission) with disturbance force and torque as inputs; --plant-only exports the world
-    alone. The resolved scenario travels inside the FMU; importing it needs Python with
-    dcsim installed.
+    alone. A manipulator's FMUs also output its joint angles and rates and its end
+    effector, and its plant FMU takes the joint torques. The resolved scenario travels
+    inside the FMU; importing it needs Python with dcsim installed.
     """
     from dcsim.fmu.export import export_fmu
     from dcsim.fmu.variables import DEFAULT_BEACONS

@@ -126,6 +126,7 @@ def test_robot_state_checks_its_attitude_and_joints():
     np.testing.assert_array_equal(
         state.generalised_velocity, [0.1, 0.2, 0.3, 0.01, 0.02, 0.03, 1.0, 2.0]
     )
+    np.testing.assert_array_equal(state.configuration, [1, 2, 3, 0, 0, 0, 1, 0.5, -0.5])
     assert RobotState().joint_positions.shape == (0,)
     with pytest.raises(ValueError, match="attitude must be a unit quaternion, its norm is 2"):
         RobotState(attitude=[0, 0, 0, 2])

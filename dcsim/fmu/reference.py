@@ -1,4 +1,9 @@
-"""Generate the variable tables of docs/fmu.md (``make docs``)."""
+"""Generate the variable tables of docs/fmu.md (``make docs``).
+
+The free flyer's tables are those of the packaged default scenario; the manipulator's
+table is generated from the repository's reach scenario
+(``scenarios/space_manipulator_reach.yaml``, six joints).
+"""
 
 from __future__ import annotations
 
@@ -6,7 +11,20 @@ import sys
 from pathlib import Path
 
 from dcsim.docgen import update_block
-from dcsim.fmu.variables import CLOSED_LOOP, DEFAULT_BEACONS, FmuVariable, plant_variables
+from dcsim.fmu.variables import (
+    DEFAULT_BEACONS,
+    FmuVariable,
+    arm_outputs,
+    closed_loop_variables,
+    joint_torque_inputs,
+    plant_variables,
+)
+from dcsim.scenario import load_scenario
+
+MANIPULATOR_SCENARIO = (
+    Path(__file__).resolve().parents[2] / "scenarios" / "space_manipulator_reach.yaml"
+)
+"""The scenario the manipulator's table is generated from."""
 
 
 def variables_table(variables: list[FmuVariable]) -> str:
@@ -24,13 +42,37 @@ BEGIN_CLOSED = "<!-- begin: closed-loop variables (make docs) -->"
 END_CLOSED = "<!-- end: closed-loop variables -->"
 BEGIN_PLANT = "<!-- begin: plant variables (make docs) -->"
 END_PLANT = "<!-- end: plant variables -->"
+BEGIN_MANIPULATOR = "<!-- begin: manipulator variables (make docs) -->"
+END_MANIPULATOR = "<!-- end: manipulator variables -->"
+
+
+def generated_blocks() -> list[tuple[str, str, str]]:
+    """``(begin marker, end marker, table)`` of every generated block of docs/fmu.md.
+
+    The closed-loop and plant tables of the default scenario (the plant with K =
+    :data:`DEFAULT_BEACONS`), and the variables a manipulator's FMUs add (the plant's
+    joint torque inputs, then the joint and end-effector outputs of both variants) for
+    :data:`MANIPULATOR_SCENARIO`.
+    """
+    default = load_scenario()
+    robot = load_scenario(MANIPULATOR_SCENARIO).robot
+    return [
+        (BEGIN_CLOSED, END_CLOSED, variables_table(closed_loop_variables(default))),
+        (BEGIN_PLANT, END_PLANT, variables_table(plant_variables(default, DEFAULT_BEACONS))),
+        (
+            BEGIN_MANIPULATOR,
+            END_MANIPULATOR,
+            variables_table([*joint_torque_inputs(robot), *arm_outputs(robot)]),
+        ),
+    ]
 
 
 def write_reference(path: Path) -> bool:
-    """Regenerate both variable tables in ``path``; return True if it changed."""
-    changed = update_block(path, BEGIN_CLOSED, END_CLOSED, variables_table(CLOSED_LOOP))
-    plant = variables_table(plant_variables(DEFAULT_BEACONS))
-    return update_block(path, BEGIN_PLANT, END_PLANT, plant) or changed
+    """Regenerate every variable table in ``path``; return True if it changed."""
+    changed = False
+    for begin, end, table in generated_blocks():
+        changed = update_block(path, begin, end, table) or changed
+    return changed
 
 
 if __name__ == "__main__":

@@ -3,7 +3,9 @@
 An exported FMU carries a tiny script defining a subclass of :class:`ClosedLoopSlave` or
 :class:`PlantSlave`, and the resolved scenario as the resource ``scenario.yaml``. The
 slaves are thin adapters: the closed-loop one drives the :class:`~dcsim.runner.Runner`
-that ``dcsim run`` uses, the plant one a :class:`~dcsim.world.World`.
+that ``dcsim run`` uses, the plant one a :class:`~dcsim.world.World`. A slave declares
+its variables when it is instantiated, from that scenario (:mod:`dcsim.fmu.variables`):
+a manipulator's joints are variables of its FMUs.
 
 Time. The world advances in whole control periods (``world.control_period``). A
 ``doStep`` from ``t`` to ``t + h`` flies every control period that ends at or before
@@ -32,17 +34,22 @@ from pythonfmu.enums import Fmi2Initial, Fmi2Status, Fmi2Variability
 
 from dcsim.fmu.variables import (
     AXES,
-    CLOSED_LOOP,
     DEFAULT_BEACONS,
-    PARAMETERS,
+    JOINT_ANGLE,
+    JOINT_RATE,
+    JOINT_TORQUE,
     QUATERNION,
     FmuVariable,
+    closed_loop_variables,
+    joint_count,
     plant_variables,
 )
+from dcsim.messages import RobotState
+from dcsim.robots.manipulator import ManipulatorModel
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
 from dcsim.scenario import Scenario, load_scenario
-from dcsim.scenario.model import point_to_cartesian
+from dcsim.scenario.model import ManipulatorSection, point_to_cartesian
 from dcsim.seeding import component_rng
 from dcsim.world import World, WorldInputs
 
@@ -76,16 +83,25 @@ _FMI_TYPES = {float: Real, int: Integer, bool: Boolean}
 class _ScenarioSlave(Fmi2Slave):
     """What both slaves share: the scenario, parameters, inputs and stepping in periods.
 
-    Subclasses set :attr:`variables` and implement ``_open``, ``_advance``,
-    ``_outputs`` and ``_close``.
-    """
+    Subclasses implement ``_declare`` (their variables for the scenario), ``_open``,
+    ``_advance``, ``_world``, ``_outputs`` and ``_close``.
 
-    variables: list[FmuVariable] = []
+    Attributes
+    ----------
+    scenario : Scenario
+        The resolved scenario the FMU carries.
+    variables : list of FmuVariable
+        The FMU's variables, declared from :attr:`scenario`.
+    values : dict of str to object
+        Every variable's current value, by name.
+    """
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
         self.scenario_path = Path(self.resources) / SCENARIO_RESOURCE
         self.scenario: Scenario = load_scenario(self.scenario_path)
+        self.variables: list[FmuVariable] = self._declare()
+        self._joints = joint_count(self.scenario.robot)
         self.author = "dcsim"
         self.description = f"dcsim scenario {self.scenario.name!r}: {self.scenario.description}"
         self.default_experiment = DefaultExperiment(
@@ -105,18 +121,39 @@ class _ScenarioSlave(Fmi2Slave):
             self.register_variable(self._fmi_variable(variable))
 
     # ------------------------------------------------------------------ variables
+    def _declare(self) -> list[FmuVariable]:
+        """The FMU's variables for :attr:`scenario`."""
+        raise NotImplementedError
+
     def _initial_values(self) -> dict[str, Any]:
         """Start values: parameters from the scenario, the state at t = 0, zeros."""
         values: dict[str, Any] = {v.name: v.type(0) for v in self.variables}
         values["seed"] = self.scenario.world.seed
         robot = self.scenario.robot
-        for variable in PARAMETERS:
-            if variable.name.startswith("robot."):
+        for variable in self.variables:
+            if variable.causality == "parameter" and variable.name.startswith("robot."):
                 values[variable.name] = float(getattr(robot, variable.name.removeprefix("robot.")))
-        self._put_vector(values, "position", point_to_cartesian(robot.initial.position))
-        self._put_vector(values, "velocity", np.asarray(robot.initial.velocity, dtype=float))
-        values["attitude.w"] = 1.0
+        state = _initial_state(self.scenario)
+        end_effector = None
+        if isinstance(robot, ManipulatorSection):
+            model = ManipulatorModel(robot.dh_robot())
+            end_effector = model.forward_kinematics(state.configuration).end_effector
+        self._put_state(values, state, end_effector)
         return values
+
+    def _put_state(
+        self, values: dict[str, Any], state: RobotState, end_effector: np.ndarray | None
+    ) -> None:
+        """Put the base's state, and a manipulator's joints and end effector, into ``values``."""
+        self._put_vector(values, "position", state.position)
+        self._put_vector(values, "velocity", state.velocity)
+        self._put_vector(values, "attitude", state.attitude)
+        self._put_vector(values, "angular_velocity", state.angular_velocity)
+        for i in range(1, self._joints + 1):
+            values[JOINT_ANGLE.format(i)] = float(state.joint_positions[i - 1])
+            values[JOINT_RATE.format(i)] = float(state.joint_velocities[i - 1])
+        if end_effector is not None:
+            self._put_vector(values, "end_effector", end_effector)
 
     @staticmethod
     def _put_vector(values: dict[str, Any], name: str, vector: np.ndarray) -> None:
@@ -125,6 +162,10 @@ class _ScenarioSlave(Fmi2Slave):
 
     def _vector(self, name: str) -> np.ndarray:
         return np.array([self.values[f"{name}.{axis}"] for axis in AXES])
+
+    def _joint_torques(self) -> np.ndarray:
+        """The joint torque inputs, DH order, N·m ((0,) for a free flyer)."""
+        return np.array([self.values[JOINT_TORQUE.format(i)] for i in range(1, self._joints + 1)])
 
     def _fmi_variable(self, variable: FmuVariable) -> Any:
         cls = _FMI_TYPES[variable.type]
@@ -256,9 +297,9 @@ class _ScenarioSlave(Fmi2Slave):
 
     def _publish(self) -> None:
         """Copy the current outputs into the FMU's variables."""
-        values, out = self.values, self._outputs()
-        for name in ("position", "velocity", "attitude", "angular_velocity"):
-            self._put_vector(values, name, out[name])
+        values, out, world = self.values, self._outputs(), self._world()
+        end_effector = world.end_effector() if self._joints else None
+        self._put_state(values, world.robot_state(), end_effector)
         values["collisions"] = int(out["collisions"])
         values["fuel_used"] = float(out["fuel_used"])
         values["delta_v"] = float(out["delta_v"])
@@ -276,6 +317,9 @@ class _ScenarioSlave(Fmi2Slave):
     def _advance(self) -> None:
         raise NotImplementedError
 
+    def _world(self) -> World:
+        raise NotImplementedError
+
     def _outputs(self) -> dict[str, Any]:
         raise NotImplementedError
 
@@ -290,7 +334,8 @@ class ClosedLoopSlave(_ScenarioSlave):
     outputs at a period boundary equal the telemetry row ``dcsim run`` records there.
     """
 
-    variables = CLOSED_LOOP
+    def _declare(self) -> list[FmuVariable]:
+        return closed_loop_variables(self.scenario)
 
     def _open(self) -> None:
         setup = prepare_run(self.scenario_path, self._overrides(), seed=self.values["seed"])
@@ -300,14 +345,18 @@ class ClosedLoopSlave(_ScenarioSlave):
     def _advance(self) -> None:
         self.runner.advance(self._vector("disturbance_force"), self._vector("disturbance_torque"))
 
+    def _world(self) -> World:
+        return self.runner.world
+
     def _outputs(self) -> dict[str, Any]:
         return self.runner.outputs
 
     def _publish_more(self, out: dict[str, Any]) -> None:
         runner, values = self.runner, self.values
         values["mode"] = runner.mission_class.modes.index(runner.mode)
-        values["captured"] = int(out["captured"])
-        values["delivered"] = int(out["delivered"])
+        if "captured" in values:  # a robot that carries targets
+            values["captured"] = int(out["captured"])
+            values["delivered"] = int(out["delivered"])
         values["localisation_error"] = float(
             np.linalg.norm(out["position"] - runner.estimate.position)
         )
@@ -323,7 +372,8 @@ class ClosedLoopSlave(_ScenarioSlave):
 
 
 class PlantSlave(_ScenarioSlave):
-    """The world alone as an FMU: force and torque in, true state and sensors out.
+    """The world alone as an FMU: force and torque (and a manipulator's joint torques) in,
+    true state and sensors out.
 
     Attributes
     ----------
@@ -333,13 +383,14 @@ class PlantSlave(_ScenarioSlave):
 
     nearest_beacons = DEFAULT_BEACONS
 
-    def __init__(self, **kwargs: Any) -> None:
-        self.variables = plant_variables(self.nearest_beacons)
-        super().__init__(**kwargs)
+    def _declare(self) -> list[FmuVariable]:
+        return plant_variables(self.scenario, self.nearest_beacons)
 
     def _initial_values(self) -> dict[str, Any]:
         values = super()._initial_values()
-        values["mass"] = float(self.scenario.robot.mass)
+        robot = self.scenario.robot
+        arm = robot.links if isinstance(robot, ManipulatorSection) else []
+        values["mass"] = float(robot.mass) + sum(link.mass for link in arm)
         for k in range(1, self.nearest_beacons + 1):
             values[f"beacon[{k}].id"] = -1
         return values
@@ -352,8 +403,15 @@ class PlantSlave(_ScenarioSlave):
         self._collided = False
 
     def _advance(self) -> None:
-        inputs = WorldInputs(force=self._vector("force"), torque=self._vector("torque"))
+        inputs = WorldInputs(
+            force=self._vector("force"),
+            torque=self._vector("torque"),
+            joint_torques=self._joint_torques(),
+        )
         self._collided |= bool(self.world.step(inputs))
+
+    def _world(self) -> World:
+        return self.world
 
     def _outputs(self) -> dict[str, Any]:
         return self.world.outputs()
@@ -377,3 +435,22 @@ class PlantSlave(_ScenarioSlave):
 
     def _close(self) -> None:
         self.world.close()
+
+
+def _initial_state(scenario: Scenario) -> RobotState:
+    """The robot's true state at t = 0 as the scenario gives it (base and joints)."""
+    robot = scenario.robot
+    initial = robot.initial
+    attitude = np.asarray(initial.attitude, dtype=float)
+    if isinstance(robot, ManipulatorSection):
+        angles, rates = robot.initial_joints()
+    else:
+        angles = rates = np.zeros(0)
+    return RobotState(
+        position=point_to_cartesian(initial.position),
+        velocity=initial.velocity,
+        attitude=attitude / np.linalg.norm(attitude),
+        angular_velocity=initial.angular_velocity,
+        joint_positions=angles,
+        joint_velocities=rates,
+    )

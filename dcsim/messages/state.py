@@ -65,6 +65,12 @@ class RobotState(Message):
         """``[v_base, ω_base, θ̇]``, shape (6 + n,), SI units."""
         return np.concatenate([self.velocity, self.angular_velocity, self.joint_velocities])
 
+    @property
+    def configuration(self) -> Vector:
+        """``q = [r_base, quaternion x, y, z, w, θ]``, shape (7 + n,): the configuration a
+        manipulator's model takes (base centre of mass in m, joint angles in rad)."""
+        return np.concatenate([self.position, self.attitude, self.joint_positions])
+
 
 @message
 class StateEstimate(RobotState):

@@ -268,6 +268,18 @@ class World:
             joint_velocities=rates,
         )
 
+    def end_effector(self) -> np.ndarray:
+        """True end-effector position of a manipulator (origin of DH frame n), world frame, m.
+
+        Raises
+        ------
+        ValueError
+            For a free flyer, which has no arm.
+        """
+        if self._arm is None:
+            raise ValueError("a free flyer has no end effector")
+        return self._arm.model.forward_kinematics(self.robot_state().configuration).end_effector
+
     def robot_spec(self) -> RobotSpec:
         """The collector's current mass, inertia, limits and bounding radius (cargo included).
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,7 +13,7 @@ from fmpy.validation import validate_fmu
 from dcsim.errors import ScenarioError
 from dcsim.fmu.export import export_fmu
 from dcsim.fmu.instance import FmuCallError, FmuError, FmuInstance
-from dcsim.fmu.variables import CLOSED_LOOP, plant_variables
+from dcsim.fmu.variables import closed_loop_variables, plant_variables
 from dcsim.missions import DebrisMission
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
@@ -110,7 +111,12 @@ def test_fmpy_validation_finds_no_problems(variant, request):
 
 
 def test_variables_are_those_documented(closed_loop_fmu, plant_fmu):
-    for path, table in ((closed_loop_fmu, CLOSED_LOOP), (plant_fmu, plant_variables(4))):
+    scenario = load_scenario()
+    variants = (
+        (closed_loop_fmu, closed_loop_variables(scenario)),
+        (plant_fmu, plant_variables(scenario, 4)),
+    )
+    for path, table in variants:
         with FmuInstance(path) as fmu:
             described = {n: (v.causality, v.type) for n, v in fmu.description.variables.items()}
         types = {float: "Real", int: "Integer", bool: "Boolean"}
@@ -118,16 +124,26 @@ def test_variables_are_those_documented(closed_loop_fmu, plant_fmu):
 
 
 def test_docs_list_the_variables():
-    from pathlib import Path
-
     from dcsim.docgen import block
     from dcsim.fmu import reference as r
 
     text = (Path(__file__).resolve().parents[2] / "docs" / "fmu.md").read_text()
-    stale = "docs/fmu.md is stale: run `make docs`"
-    assert block(text, r.BEGIN_CLOSED, r.END_CLOSED) == r.variables_table(CLOSED_LOOP), stale
-    plant = r.variables_table(plant_variables(r.DEFAULT_BEACONS))
-    assert block(text, r.BEGIN_PLANT, r.END_PLANT) == plant, stale
+    for begin, end, table in r.generated_blocks():
+        assert block(text, begin, end) == table, "docs/fmu.md is stale: run `make docs`"
+
+
+def test_every_free_flyer_scenario_has_the_default_scenarios_variables():
+    def signature(variables):
+        return [(v.name, v.causality, v.type) for v in variables]
+
+    default = load_scenario()
+    expected = signature(closed_loop_variables(default)), signature(plant_variables(default, 4))
+    scenarios = sorted((Path(__file__).resolve().parents[2] / "scenarios").glob("*.yaml"))
+    free_flyers = [s for s in map(load_scenario, scenarios) if s.robot.type == "free-flyer"]
+    assert {s.mission.type for s in free_flyers} == {"debris", "transfer"}
+    for scenario in free_flyers:
+        got = signature(closed_loop_variables(scenario)), signature(plant_variables(scenario, 4))
+        assert got == expected, scenario.name
 
 
 @SHARES_DEFAULT_RUN

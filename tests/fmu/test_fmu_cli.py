@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+from pathlib import Path
 
 import numpy as np
 from fmpy.validation import validate_fmu
@@ -13,6 +14,13 @@ def test_export_writes_a_valid_fmu_of_either_kind(dcsim_cli, tmp_path):
         done = dcsim_cli("fmu", "export", "-o", str(tmp_path / name), *args)
         assert done.returncode == 0, done.stderr
         assert validate_fmu(str(tmp_path / name)) == []
+
+
+def test_export_takes_a_manipulator_scenario(dcsim_cli, tmp_path):
+    reach = Path(__file__).resolve().parents[2] / "scenarios" / "space_manipulator_reach.yaml"
+    done = dcsim_cli("fmu", "export", str(reach), "--plant-only", "-o", str(tmp_path / "arm.fmu"))
+    assert done.returncode == 0, done.stderr
+    assert validate_fmu(str(tmp_path / "arm.fmu")) == []
 
 
 def test_export_reports_a_bad_override_or_name_without_a_traceback(dcsim_cli, tmp_path):

@@ -249,6 +249,8 @@ def test_the_world_is_a_system_with_named_inputs_outputs_and_parameters():
         "collisions",
         "nearest_obstacle_distance",
     } <= set(outputs)
+    with pytest.raises(ValueError, match="no end effector"):
+        world.end_effector()
     world.inputs = WorldInputs(disturbance_force=np.array([0.0, 0.0, 2.0]))
     world.step()
     assert world.outputs()["velocity"][2] > 0 and world.outputs()["fuel_used"] == 0.0

@@ -75,6 +75,7 @@ def test_end_effector_of_the_world_is_the_models(tmp_path):
     link = pb.getLinkState(w.collector, end, computeForwardKinematics=1, physicsClientId=w.client)
     model = w.robot_spec().model
     np.testing.assert_allclose(link[4], model.forward_kinematics(q).end_effector, atol=1e-12)
+    np.testing.assert_array_equal(w.end_effector(), model.forward_kinematics(q).end_effector)
     # PyBullet's link orientation comes back to ~4e-8 (its quaternion conversion).
     rotation = np.array(pb.getMatrixFromQuaternion(link[5])).reshape(3, 3)
     np.testing.assert_allclose(rotation, model.forward_kinematics(q).rotations[-1], atol=1e-7)
