@@ -39,8 +39,8 @@ Space manipulator model (DH kinematics and dynamics of the source thesis 004)
     :func:`manipulator_model` from a :class:`DHRobot` (a :class:`ManipulatorBase` and
     :class:`DHLink` rows); :func:`thesis_manipulator` (the thesis's robot),
     :func:`manipulator_urdf`, :func:`load_robot_model` (the model of a scenario file's
-    manipulator); results :class:`ForwardKinematics`,
-    :class:`InverseKinematicsResult`.
+    manipulator), :func:`load_reach_problem` (the path problem of a reach scenario);
+    results :class:`ForwardKinematics`, :class:`InverseKinematicsResult`.
 Geometry
     :func:`spherical_to_cartesian`, :func:`quaternion_between`, :func:`rotate`, :func:`unit`,
     :func:`clip_norm`, :func:`quaternion_multiply`, :func:`quaternion_conjugate`,
@@ -136,7 +136,7 @@ from dcsim.params import PluginParams, quantity
 from dcsim.plancost import leg_delta_v, legs_delta_v, plan_cost, plan_delta_v, plan_duration
 from dcsim.registry import PluginRegistry
 from dcsim.robots.dh import DHLink, DHRobot, ManipulatorBase, thesis_manipulator
-from dcsim.robots.loading import load_robot_model
+from dcsim.robots.loading import load_reach_problem, load_robot_model
 from dcsim.robots.manipulator import (
     ForwardKinematics,
     InverseKinematicsResult,
@@ -178,6 +178,7 @@ __all__ = [
     "LinearMotion",
     "Localiser",
     "load_robot_model",
+    "load_reach_problem",
     "manipulator_model",
     "manipulator_urdf",
     "ManipulatorBase",

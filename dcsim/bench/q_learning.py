@@ -32,9 +32,9 @@ import numpy as np
 
 from dcsim.bench.cell_optimum import optimal_values, reachable_cells, working_cells
 from dcsim.bench.figures import pyplot, save
-from dcsim.messages import GoalRegion, PathProblem, RobotState, Trajectory
+from dcsim.messages import PathProblem, Trajectory
 from dcsim.registry import PluginRegistry
-from dcsim.robots.manipulator import ManipulatorModel
+from dcsim.robots.loading import load_reach_problem
 from dcsim.scenario.loader import load_scenario
 
 THESIS_SETTINGS = ((0.9, 0.9), (0.5, 0.8), (0.2, 0.5))
@@ -47,41 +47,9 @@ Progress = Callable[[str], None]
 
 
 def reach_problem(scenario: str | Path, start: Sequence[float] | None = None) -> PathProblem:
-    """The reach problem of a manipulator scenario, from its start or with the end
-    effector moved to ``start`` (m) by inverse kinematics with the base held.
-
-    Raises
-    ------
-    ValueError
-        If ``start`` cannot be reached from the scenario's configuration.
-    """
-    loaded = load_scenario(scenario)
-    robot, mission = loaded.robot, loaded.mission
-    model = ManipulatorModel(robot.dh_robot())
-    angles, _ = robot.initial_joints()
-    initial = robot.initial
-    q = np.concatenate([initial.position, initial.attitude, angles])
-    q[3:7] /= np.linalg.norm(q[3:7])
-    if start is not None:
-        solved = model.inverse_kinematics(start, q)
-        if not solved.converged:
-            raise ValueError(f"the end effector cannot start at {list(start)}: {solved.status}")
-        q = solved.q
-    state = RobotState(
-        time=0.0,
-        position=q[:3],
-        attitude=q[3:7],
-        joint_positions=q[7:],
-        joint_velocities=np.zeros(q.size - 7),
-    )
-    return PathProblem(
-        start=state,
-        goal=GoalRegion(position=mission.target, tolerance=mission.tolerance),
-        max_speed=mission.max_speed,
-        max_acceleration=mission.max_acceleration,
-        time_budget=mission.planning_budget,
-        model=model,
-    )
+    """The reach problem of a manipulator scenario (:func:`load_reach_problem`), from its
+    start or with the end effector moved to ``start`` (m)."""
+    return load_reach_problem(scenario, start)
 
 
 def _planner(params: dict[str, Any], seed: int):

@@ -162,7 +162,7 @@ class ReachMission(Mission):
         if isinstance(result, NoPath):
             self._refuse(result.reason)
             return
-        q = np.concatenate([start.position, start.attitude, start.joint_positions])
+        q = start.configuration
         try:
             self.joint_path = JointPath(self.model, q, result, gain=self.settings.ik_gain)
         except SingularPath as error:
@@ -173,16 +173,7 @@ class ReachMission(Mission):
         self._go("REACH")
 
     def _problem(self, start: RobotState) -> PathProblem:
-        settings = self.settings
-        return PathProblem(
-            start=start,
-            goal=GoalRegion(position=self.target, tolerance=settings.tolerance),
-            robot_radius=self.world.robot_spec().radius,
-            max_speed=settings.max_speed,
-            max_acceleration=settings.max_acceleration,
-            time_budget=settings.planning_budget,
-            model=self.model,
-        )
+        return reach_problem(self.scenario, start, self.model)
 
     def _refuse(self, reason: str) -> None:
         self.reason = reason
@@ -207,7 +198,7 @@ class ReachMission(Mission):
 
     # ------------------------------------------------------------------ geometry
     def _end_effector(self, state: RobotState) -> np.ndarray:
-        return self.model.forward_kinematics(_configuration(state)).end_effector
+        return self.model.forward_kinematics(state.configuration).end_effector
 
     def _facing_axis(self, start: RobotState) -> np.ndarray:
         """The base-frame direction of the side that must face the target."""
@@ -223,7 +214,7 @@ class ReachMission(Mission):
     def telemetry(self, outputs: Mapping[str, Any]) -> dict[str, Any]:
         """The columns of :meth:`telemetry_columns` from the true state."""
         state = self.world.robot_state()
-        q = _configuration(state)
+        q = state.configuration
         end_effector = self.model.forward_kinematics(q).end_effector
         reference = self.reference
         ref_end_effector = (
@@ -361,6 +352,31 @@ class _RunningFigures:
         self.target_distance = row.target_distance
 
 
-def _configuration(state: RobotState) -> np.ndarray:
-    """The model's ``q = [r, quaternion, θ]`` of a state."""
-    return np.concatenate([state.position, state.attitude, state.joint_positions])
+def reach_problem(scenario: Scenario, start: RobotState, model: Any) -> PathProblem:
+    """The path problem a reach scenario poses from ``start``.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A reach scenario: its target, tolerance, limits and planning budget.
+    start : RobotState
+        The robot's state (base and joints) the path starts from.
+    model : ManipulatorModel
+        The robot's model, carried by the problem.
+
+    Returns
+    -------
+    PathProblem
+        For the end effector: a goal region of radius ``tolerance`` about the target, the
+        end effector's speed and acceleration limits.
+    """
+    settings = scenario.mission
+    return PathProblem(
+        start=start,
+        goal=GoalRegion(position=settings.target, tolerance=settings.tolerance),
+        robot_radius=scenario.robot.radius,
+        max_speed=settings.max_speed,
+        max_acceleration=settings.max_acceleration,
+        time_budget=settings.planning_budget,
+        model=model,
+    )

@@ -444,7 +444,7 @@ def _reach_path(plugin_class: type[Plugin]) -> tuple[Trajectory, PathProblem]:
 def check_reach_endpoints(plugin_class: type[Plugin]) -> None:
     trajectory, problem = _reach_path(plugin_class)
     start = problem.start
-    q = np.concatenate([start.position, start.attitude, start.joint_positions])
+    q = start.configuration
     end_effector = problem.model.forward_kinematics(q).end_effector
     _check_start(trajectory, dataclasses.replace(start, position=end_effector), "the reach problem")
     final = trajectory.end_state()

@@ -157,7 +157,7 @@ class ComputedTorqueController(Controller):
 
 def generalised_state(estimate: StateEstimate) -> tuple[np.ndarray, np.ndarray]:
     """The model's ``q = [r, quaternion, θ]`` (7 + n,) and ``q̇ = [v, ω, θ̇]`` (6 + n,)."""
-    q = np.concatenate([estimate.position, estimate.attitude, estimate.joint_positions])
+    q = estimate.configuration
     return q, estimate.generalised_velocity
 
 

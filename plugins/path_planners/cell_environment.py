@@ -154,7 +154,7 @@ def build_environment(
         If the deadline passes first.
     """
     model, start = problem.model, problem.start
-    q0 = np.concatenate([start.position, start.attitude, start.joint_positions])
+    q0 = start.configuration
     first = model.forward_kinematics(q0).end_effector
     target_offset = np.rint((problem.goal.position - first) / rules.cell_size).astype(int)
     lower = np.minimum(0, target_offset) - rules.margin

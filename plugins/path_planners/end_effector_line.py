@@ -45,9 +45,7 @@ class EndEffectorLinePlanner(PathPlanner):
         model = problem.model
         if model is None or not hasattr(model, "forward_kinematics"):
             return NoPath("the problem carries no manipulator model: this planner moves an arm")
-        start = np.concatenate(
-            [problem.start.position, problem.start.attitude, problem.start.joint_positions]
-        )
+        start = problem.start.configuration
         frames = model.forward_kinematics(start)
         origin, target = frames.end_effector, problem.goal.position
         shoulder_distance = float(np.linalg.norm(target - frames.origins[0]))

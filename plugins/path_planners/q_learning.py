@@ -266,7 +266,7 @@ def _refusal(problem: PathProblem) -> NoPath | None:
     if model is None or not hasattr(model, "inverse_kinematics"):
         return NoPath("the problem carries no manipulator model: this planner moves an arm")
     start = problem.start
-    q = np.concatenate([start.position, start.attitude, start.joint_positions])
+    q = start.configuration
     shoulder = model.forward_kinematics(q).origins[0]
     distance = float(np.linalg.norm(problem.goal.position - shoulder))
     if distance > model.robot.reach:

@@ -127,9 +127,7 @@ def test_a_free_flyer_controller_is_refused_for_the_manipulator(dcsim_cli):
 def joint_path():
     problem = reach_problem()
     trajectory = EndEffectorLinePlanner(None, np.random.default_rng(0)).plan(problem)
-    start = np.concatenate(
-        [problem.start.position, problem.start.attitude, problem.start.joint_positions]
-    )
+    start = problem.start.configuration
     return problem.model, start, trajectory, JointPath(problem.model, start, trajectory)
 
 
@@ -166,9 +164,7 @@ def test_references_rest_at_the_ends_of_the_path(joint_path):
 def test_a_path_through_a_singularity_is_refused():
     model = manipulator_model(thesis_manipulator())
     problem = reach_problem()
-    start = np.concatenate(
-        [problem.start.position, problem.start.attitude, problem.start.joint_positions]
-    )
+    start = problem.start.configuration
     shoulder = model.forward_kinematics(start).origins[0]
     # straight out to the full reach: the arm must stretch to a line, where J Jᵀ is singular
     direction = TARGET - shoulder

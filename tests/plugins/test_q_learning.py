@@ -65,9 +65,7 @@ def test_the_lattice_is_anchored_at_the_end_effector_and_holds_the_target(small)
 def test_cell_states_keep_the_centre_of_mass_and_the_attitude(small):
     model = reach_problem().model
     problem = reach_problem()
-    q0 = np.concatenate(
-        [problem.start.position, problem.start.attitude, problem.start.joint_positions]
-    )
+    q0 = problem.start.configuration
     centre = model.centre_of_mass(q0)
     for cell in (small.start, small.target, 7):
         q = np.concatenate([small.base_positions[cell], q0[3:7], small.joints[cell]])
