@@ -586,6 +586,55 @@ def bench_fmu_command(scenario: Path | None, duration: float, repeats: int) -> N
     click.echo(markdown_table(result))
 
 
+@bench_group.command("manipulator")
+@click.option(
+    "--states",
+    type=click.IntRange(min=1),
+    default=64,
+    show_default=True,
+    help="Random states (fixed seed) each call is timed at.",
+)
+@click.option(
+    "--repeats",
+    type=click.IntRange(min=1),
+    default=30,
+    show_default=True,
+    help="Timing rounds over every call in turn; each call's best round counts.",
+)
+@click.option(
+    "--number",
+    type=click.IntRange(min=1),
+    default=10,
+    show_default=True,
+    help="Passes over the states per call and round.",
+)
+@click.option(
+    "--scenario",
+    type=click.Path(exists=True, dir_okay=False, path_type=Path),
+    help="Also run this scenario once and report its real-time factor.",
+)
+def bench_manipulator_command(
+    states: int, repeats: int, number: int, scenario: Path | None
+) -> None:
+    """The manipulator model's time per call against PyBullet's and Pinocchio's.
+
+    Forward kinematics, the end effector's Jacobian, M, C and C q̇ of the thesis's robot,
+    timed with timeit (best of REPEATS rounds) at STATES random states, for dcsim, PyBullet and
+    Pinocchio (if installed), with dcsim's ratio to Pinocchio and whether M + C is
+    within 10× of Pinocchio's. Prints a Markdown table for docs/benchmarks.md.
+    """
+    from dcsim.bench import manipulator as bench
+
+    result = bench.bench_manipulator(
+        states, repeats, number, progress=lambda line: click.echo(line, err=True)
+    )
+    click.echo(bench.markdown_table(result))
+    click.echo(f"\n{bench.agreement_line(result)}")
+    if scenario is not None:
+        speed = bench.scenario_speed(scenario, registry=_registry())
+        click.echo(f"\n{bench.scenario_line(speed)}")
+
+
 @bench_group.command("grid-search")
 @click.option(
     "--scenario",

@@ -193,6 +193,15 @@ def test_bench_world_prints_a_table_for_each_size(dcsim_cli):
     assert "5 objects: bare stepping" in result.stderr
 
 
+def test_bench_manipulator_prints_the_table_and_the_verdict(dcsim_cli):
+    result = dcsim_cli("bench", "manipulator", "--states", "2", "--repeats", "1", "--number", "1")
+    assert result.returncode == 0, result.stderr
+    assert "| M + C, two calls |" in result.stdout
+    assert "M + C within 10× of Pinocchio: " in result.stdout
+    assert "agreement with dcsim over the 2 states" in result.stdout
+    assert "dcsim: timed 6 quantities at 2 states" in result.stderr
+
+
 def test_bench_localisers_prints_the_bound_and_every_localiser(dcsim_cli, tmp_path):
     plot = tmp_path / "localisers.png"
     result = dcsim_cli("bench", "localisers", "--runs", "1", "--steps", "20", "--plot", str(plot))

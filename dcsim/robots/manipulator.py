@@ -21,9 +21,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from dcsim.geometry import quaternion_from_rotation_vector, quaternion_multiply
-from dcsim.robots import dynamics
+from dcsim.robots import kernels
 from dcsim.robots.dh import DHRobot
-from dcsim.robots.kinematics import Array, DHArrays, Kinematics, cross, kinematics, skew
+from dcsim.robots.kinematics import Array, DHArrays, Kinematics, kinematics, state_vector
 from dcsim.robots.urdf import urdf_text
 
 IKStatus = Literal["converged", "unreachable", "singular", "not-converged"]
@@ -156,19 +156,7 @@ class ManipulatorModel:
             Rows: end-effector linear velocity (m/s), angular velocity (rad/s), world frame;
             columns in the order of ``qd = [v_b, ω_b, θ̇]``.
         """
-        return self._jacobian(self.kinematics(q))
-
-    @staticmethod
-    def _jacobian(kin: Kinematics) -> Array:
-        n = kin.axes.shape[0]
-        reach = kin.end_effector - kin.base_position
-        jac = np.zeros((6, 6 + n))
-        jac[:3, :3] = np.eye(3)
-        jac[:3, 3:6] = -skew(reach)
-        jac[:3, 6:] = cross(kin.axes, kin.end_effector - kin.joint_points).T
-        jac[3:, 3:6] = np.eye(3)
-        jac[3:, 6:] = kin.axes.T
-        return jac
+        return self.kinematics(q).jacobian
 
     def free_floating_jacobian(self, q: ArrayLike) -> Array:
         """Jacobian of the free-floating robot at zero momentum: ``[v_ee; ω_ee] = J* θ̇``.
@@ -187,8 +175,7 @@ class ManipulatorModel:
         ndarray (6, n)
             Rows: end-effector linear (m/s) and angular (rad/s) velocity, world frame.
         """
-        kin = self.kinematics(q)
-        jac, m = self._jacobian(kin), dynamics.mass_matrix(self._dh, kin)
+        jac, m = self.jacobian(q), self.mass_matrix(q)
         return jac[:, 6:] - jac[:, :6] @ np.linalg.solve(m[:6, :6], m[:6, 6:])
 
     def det_jjt(self, q: ArrayLike, position_only: bool = False) -> float:
@@ -223,7 +210,8 @@ class ManipulatorModel:
         ndarray (6 + n, 6 + n)
             Symmetric positive definite, in the order of ``qd``: kg, kg·m, kg·m².
         """
-        return dynamics.mass_matrix(self._dh, self.kinematics(q))
+        dh = self._dh
+        return kernels.mass_matrix(state_vector(q, self.n_joints), dh.links, dh.bodies, dh.mount)
 
     def coriolis_matrix(self, q: ArrayLike, qd: ArrayLike) -> Array:
         """Coriolis and centrifugal matrix ``C(q, q̇)`` of eqs 4.23–4.33.
@@ -240,8 +228,28 @@ class ManipulatorModel:
         ndarray (6 + n, 6 + n)
             ``C`` with ``M q̈ + C q̇ = τ`` and ``Ṁ − 2C`` skew-symmetric.
         """
-        qd = self._velocity(qd)
-        return dynamics.coriolis_matrix(self._dh, self.kinematics(q), qd)
+        return self.dynamics(q, qd)[1]
+
+    def dynamics(self, q: ArrayLike, qd: ArrayLike) -> tuple[Array, Array]:
+        """``M(q)`` and ``C(q, q̇)`` from one kinematics pass: the results of
+        :meth:`mass_matrix` and :meth:`coriolis_matrix`, for less than the two calls cost.
+
+        Parameters
+        ----------
+        q : array_like (7 + n,)
+            State.
+        qd : array_like (6 + n,)
+            Generalised velocity ``[v_b, ω_b, θ̇]``, world frame.
+
+        Returns
+        -------
+        mass : ndarray (6 + n, 6 + n)
+            ``M(q)``: kg, kg·m, kg·m².
+        coriolis : ndarray (6 + n, 6 + n)
+            ``C(q, q̇)``: kg/s, kg·m/s, kg·m²/s.
+        """
+        dh, q = self._dh, state_vector(q, self.n_joints)
+        return kernels.mass_and_coriolis(q, self._velocity(qd), dh.links, dh.bodies, dh.mount)
 
     def bias(self, q: ArrayLike, qd: ArrayLike) -> Array:
         """Velocity-dependent generalised force ``C(q, q̇) q̇`` (6 + n,): N, N·m, N·m."""
@@ -250,10 +258,8 @@ class ManipulatorModel:
 
     def centre_of_mass(self, q: ArrayLike) -> Array:
         """Centre of mass of the whole robot (base and links), world frame, m (3,)."""
-        kin = self.kinematics(q)
-        masses = self._dh.masses
-        total = self._dh.base_mass + masses.sum()
-        return (self._dh.base_mass * kin.base_position + masses @ kin.coms) / total
+        masses = self._dh.bodies[:, 0]
+        return masses @ self.kinematics(q).body_coms / masses.sum()
 
     def momentum(self, q: ArrayLike, qd: ArrayLike) -> Array:
         """Linear momentum (kg·m/s) and angular momentum about the base's centre of mass
@@ -262,7 +268,7 @@ class ManipulatorModel:
         return self.mass_matrix(q)[:6] @ qd
 
     def _velocity(self, qd: ArrayLike) -> Array:
-        qd = np.asarray(qd, dtype=float)
+        qd = np.ascontiguousarray(qd, dtype=float)
         if qd.shape != (6 + self.n_joints,):
             raise ValueError(f"qd must have 6 + {self.n_joints} entries, got shape {qd.shape}")
         return qd

@@ -167,4 +167,5 @@ def _configuration_rate(q: np.ndarray, qd: np.ndarray) -> np.ndarray:
 
 def _acceleration(model, q: np.ndarray, qd: np.ndarray, tau: np.ndarray) -> np.ndarray:
     """``q̈ = M⁻¹ (τ − C q̇)`` (eq. 4.3)."""
-    return np.linalg.solve(model.mass_matrix(q), tau - model.bias(q, qd))
+    mass, coriolis = model.dynamics(q, qd)
+    return np.linalg.solve(mass, tau - coriolis @ qd)

@@ -11,14 +11,11 @@ for every body of the world.
 
 from __future__ import annotations
 
-import tempfile
-from pathlib import Path
-
 import numpy as np
 
 from dcsim.robots.manipulator import ManipulatorModel
 from dcsim.scenario.model import ManipulatorSection, point_to_cartesian
-from dcsim.world.pybullet_client import pb
+from dcsim.world.pybullet_client import load_urdf, pb
 
 
 class ArmBody:
@@ -45,7 +42,7 @@ class ArmBody:
         self._client = client
         self.robot = robot.dh_robot()
         self.model = ManipulatorModel(self.robot)
-        self.body = _load_urdf(client, self.model.urdf())
+        self.body = load_urdf(client, self.model.urdf())
         count = pb.getNumJoints(self.body, physicsClientId=client)
         self.joints = [
             j
@@ -135,17 +132,4 @@ class ArmBody:
             mass=mass,
             localInertiaDiagonal=self.robot.base.inertia.tolist(),
             physicsClientId=self._client,
-        )
-
-
-def _load_urdf(client: int, text: str) -> int:
-    """Load URDF ``text`` as a floating-base multibody with the file's inertias."""
-    with tempfile.TemporaryDirectory(prefix="dcsim-urdf-") as folder:
-        path = Path(folder) / "robot.urdf"
-        path.write_text(text, encoding="utf-8")
-        return pb.loadURDF(
-            str(path),
-            useFixedBase=False,
-            flags=pb.URDF_USE_INERTIA_FROM_FILE,
-            physicsClientId=client,
         )

@@ -1,4 +1,4 @@
-"""PyBullet, imported without its banner, and DIRECT clients.
+"""PyBullet, imported without its banner, DIRECT clients and URDF loading.
 
 PyBullet prints ``pybullet build time: ...`` from C on standard error when it is
 imported, which would clutter every command's output; the import here sends it to a
@@ -10,6 +10,8 @@ from __future__ import annotations
 import ctypes
 import os
 import sys
+import tempfile
+from pathlib import Path
 from types import ModuleType
 
 
@@ -37,3 +39,17 @@ def connect_direct() -> int:
     client = pb.connect(pb.DIRECT)
     pb.setGravity(0, 0, 0, physicsClientId=client)
     return client
+
+
+def load_urdf(client: int, text: str) -> int:
+    """Load URDF ``text`` as a floating-base multibody with the file's inertias and
+    return its body id."""
+    with tempfile.TemporaryDirectory(prefix="dcsim-urdf-") as folder:
+        path = Path(folder) / "robot.urdf"
+        path.write_text(text, encoding="utf-8")
+        return pb.loadURDF(
+            str(path),
+            useFixedBase=False,
+            flags=pb.URDF_USE_INERTIA_FROM_FILE,
+            physicsClientId=client,
+        )

@@ -1,8 +1,8 @@
 """``computed-torque`` controller: full control of a space manipulator by feedback
 linearisation (the source thesis 004, eqs 6.1–6.7).
 
-With the robot's own model ``M(q)``, ``C(q, q̇)`` (on ``RobotSpec.model``) the
-generalised force
+With the robot's own model ``M(q)``, ``C(q, q̇)`` (on ``RobotSpec.model``, both from
+one call of its ``dynamics(q, q̇)`` per tick) the generalised force
 
     τ = M(q) u + C(q, q̇) q̇,      u = q̈_d + K_D ė + K_P e                (6.1, 6.4)
 
@@ -106,9 +106,7 @@ class ComputedTorqueController(Controller):
             limits do not match the model's joints.
         """
         model = robot.model
-        if model is None or not all(
-            hasattr(model, attr) for attr in ("mass_matrix", "coriolis_matrix", "n_joints")
-        ):
+        if model is None or not all(hasattr(model, attr) for attr in ("dynamics", "n_joints")):
             raise PluginError(
                 f"controller '{self.name}' needs a manipulator's model (mass and Coriolis "
                 f"matrices) on RobotSpec.model, got {type(model).__name__}; use it with "
@@ -137,7 +135,8 @@ class ComputedTorqueController(Controller):
         torques and clipped to the robot's limits."""
         q, qd = generalised_state(estimate)
         u = self.outer_loop(estimate, reference)
-        tau = self.model.mass_matrix(q) @ u + self.model.coriolis_matrix(q, qd) @ qd
+        mass, coriolis = self.model.dynamics(q, qd)
+        tau = mass @ u + coriolis @ qd
         return self.limited(tau[:3], tau[3:6], tau[6:])
 
     def outer_loop(self, estimate: StateEstimate, reference: Reference) -> np.ndarray:

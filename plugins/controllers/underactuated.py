@@ -99,9 +99,7 @@ class UnderactuatedController(ComputedTorqueController):
         """Base torque and joint torques of eq. 6.22; zero base force."""
         q, qd = generalised_state(estimate)
         u = self.outer_loop(estimate, reference)[_ACTUATED]
-        reduced_m, reduced_c1, reduced_c2 = reduced_dynamics(
-            self.model.mass_matrix(q), self.model.coriolis_matrix(q, qd)
-        )
+        reduced_m, reduced_c1, reduced_c2 = reduced_dynamics(*self.model.dynamics(q, qd))
         f = reduced_m @ u + reduced_c1 @ qd[_ACTUATED] + reduced_c2 @ qd[_UNACTUATED]
         return self.limited(np.zeros(3), f[:3], f[3:])
 

@@ -4,17 +4,15 @@ loading the URDF dcsim generates."""
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
-import pinocchio as pin
-import pybullet
 import pytest
 
+from dcsim.bench.reference_models import BulletModel, PinocchioModel
+from dcsim.bench.reference_models import random_state as reference_state
 from dcsim.geometry import quaternion_from_rotation_vector, quaternion_multiply
 from dcsim.robots.dh import DHLink, DHRobot, ManipulatorBase, thesis_manipulator
-from dcsim.robots.kinematics import rotation_matrix
 from dcsim.robots.manipulator import ManipulatorModel
+from dcsim.world.pybullet_client import pb
 
 N = 6
 SEEDS = range(4)
@@ -29,11 +27,7 @@ def model() -> ManipulatorModel:
 
 
 def random_state(seed: int) -> tuple[np.ndarray, np.ndarray]:
-    rng = np.random.default_rng(seed)
-    quaternion = rng.normal(size=4)
-    quaternion /= np.linalg.norm(quaternion)
-    q = np.concatenate([rng.normal(size=3), quaternion, rng.uniform(-math.pi, math.pi, N)])
-    return q, rng.normal(size=6 + N)
+    return reference_state(np.random.default_rng(seed), N)
 
 
 def advance(q: np.ndarray, qd: np.ndarray, dt: float) -> np.ndarray:
@@ -75,117 +69,66 @@ def test_coriolis_vanishes_at_rest(model):
     np.testing.assert_array_equal(model.bias(q, np.zeros(6 + N)), 0.0)
 
 
-# --- PyBullet: [ω_b, v_b, θ̇] in the base frame, inverse dynamics returns [F_b, M_b, τ] ---
+# --- PyBullet and Pinocchio (dcsim.bench.reference_models maps their orders to ours) ---
 
 
 @pytest.fixture(scope="module")
-def bullet(model, tmp_path_factory):
-    path = tmp_path_factory.mktemp("urdf") / "manipulator.urdf"
-    path.write_text(model.urdf())
-    client = pybullet.connect(pybullet.DIRECT)
-    body = pybullet.loadURDF(
-        str(path), flags=pybullet.URDF_USE_INERTIA_FROM_FILE, physicsClientId=client
-    )
-    pybullet.setGravity(0, 0, 0, physicsClientId=client)
-    yield client, body
-    pybullet.disconnect(client)
+def bullet(model):
+    with BulletModel(model) as built:
+        yield built
 
 
-def bullet_map(q: np.ndarray) -> np.ndarray:
-    """``T`` with PyBullet's velocity = ``T`` · ours."""
-    rotation_t, n = rotation_matrix(q[3:7]).T, q.size - 7
-    t = np.zeros((6 + n, 6 + n))
-    t[:3, 3:6], t[3:6, :3], t[6:, 6:] = rotation_t, rotation_t, np.eye(n)
-    return t
+@pytest.fixture(scope="module")
+def pinocchio_model(model):
+    return PinocchioModel(model)
 
 
 def test_pybullet_reads_every_mass_from_the_urdf(bullet):
-    client, body = bullet
     masses = [
-        pybullet.getDynamicsInfo(body, link, physicsClientId=client)[0] for link in range(-1, 7)
+        pb.getDynamicsInfo(bullet.body, link, physicsClientId=bullet.client)[0]
+        for link in range(-1, 7)
     ]
     assert masses == [1000.0, 20.0, 15.0, 15.0, 15.0, 15.0, 20.0, 0.0]
 
 
 @pytest.mark.parametrize("seed", SEEDS)
 def test_mass_matrix_agrees_with_pybullet(model, bullet, seed):
-    client, body = bullet
     q, _ = random_state(seed)
-    t = bullet_map(q)
-    theirs = np.array(pybullet.calculateMassMatrix(body, list(q[7:]), physicsClientId=client))
-    assert relative_error(model.mass_matrix(q), t.T @ theirs @ t) <= RELATIVE
+    assert relative_error(model.mass_matrix(q), bullet.mass_matrix(q)) <= RELATIVE
 
 
 @pytest.mark.parametrize("seed", SEEDS)
 def test_bias_agrees_with_pybullet_inverse_dynamics(model, bullet, seed):
-    client, body = bullet
     q, qd = random_state(seed)
-    t = bullet_map(q)
-    out = pybullet.calculateInverseDynamics(
-        body, list(q), list(t @ qd), [0.0] * (6 + N), physicsClientId=client
-    )
-    out = np.asarray(out)
-    theirs = t.T @ np.concatenate([out[3:6], out[:3], out[6:]])
-    assert relative_error(model.bias(q, qd), theirs) <= RELATIVE
+    assert relative_error(model.bias(q, qd), bullet.bias(q, qd)) <= RELATIVE
 
 
-# --- Pinocchio: free flyer with [v, ω] of the base frame in the base frame ---
-
-
-@pytest.fixture(scope="module")
-def pinocchio_model(model):
-    built = pin.buildModelFromXML(model.urdf(), pin.JointModelFreeFlyer())
-    built.gravity.setZero()
-    return built, built.createData()
-
-
-def pinocchio_map(q: np.ndarray) -> np.ndarray:
-    """``T`` with Pinocchio's velocity = ``T`` · ours."""
-    rotation_t, n = rotation_matrix(q[3:7]).T, q.size - 7
-    t = np.zeros((6 + n, 6 + n))
-    t[:3, :3], t[3:6, 3:6], t[6:, 6:] = rotation_t, rotation_t, np.eye(n)
-    return t
+@pytest.mark.parametrize("seed", SEEDS)
+def test_end_effector_jacobian_agrees_with_pybullet(model, bullet, seed):
+    q, _ = random_state(seed)
+    assert relative_error(model.jacobian(q), bullet.jacobian(q)) <= RELATIVE
 
 
 @pytest.mark.parametrize("seed", SEEDS)
 def test_mass_matrix_agrees_with_pinocchio(model, pinocchio_model, seed):
-    built, data = pinocchio_model
     q, _ = random_state(seed)
-    t = pinocchio_map(q)
-    theirs = pin.crba(built, data, q)
-    theirs = np.triu(theirs) + np.triu(theirs, 1).T
-    assert relative_error(model.mass_matrix(q), t.T @ theirs @ t) <= RELATIVE
+    assert relative_error(model.mass_matrix(q), pinocchio_model.mass_matrix(q)) <= RELATIVE
 
 
 @pytest.mark.parametrize("seed", SEEDS)
 def test_bias_agrees_with_pinocchio(model, pinocchio_model, seed):
-    """Pinocchio's base velocity is in the turning base frame: zero world acceleration is
-    its acceleration ``[−ω × v, 0, 0]`` (local), so C q̇ is RNEA there."""
-    built, data = pinocchio_model
     q, qd = random_state(seed)
-    t = pinocchio_map(q)
-    v = t @ qd
-    acceleration = np.zeros(6 + N)
-    acceleration[:3] = -np.cross(v[3:6], v[:3])
-    theirs = t.T @ pin.rnea(built, data, q, v, acceleration)
-    assert relative_error(model.bias(q, qd), theirs) <= RELATIVE
+    assert relative_error(model.bias(q, qd), pinocchio_model.bias(q, qd)) <= RELATIVE
 
 
 @pytest.mark.parametrize("seed", SEEDS)
 def test_end_effector_jacobian_agrees_with_pinocchio(model, pinocchio_model, seed):
-    built, data = pinocchio_model
     q, _ = random_state(seed)
-    frame = built.getFrameId("end_effector")
-    pin.computeJointJacobians(built, data, q)
-    pin.updateFramePlacements(built, data)
-    theirs = pin.getFrameJacobian(built, data, frame, pin.LOCAL_WORLD_ALIGNED) @ pinocchio_map(q)
-    assert relative_error(model.jacobian(q), theirs) <= RELATIVE
-    np.testing.assert_allclose(
-        data.oMf[frame].translation, model.forward_kinematics(q).end_effector, atol=1e-12
-    )
-    np.testing.assert_allclose(
-        data.oMf[frame].rotation, model.forward_kinematics(q).end_effector_rotation, atol=1e-12
-    )
+    assert relative_error(model.jacobian(q), pinocchio_model.jacobian(q)) <= RELATIVE
+    position, rotation = pinocchio_model.end_effector_pose(q)
+    fk = model.forward_kinematics(q)
+    np.testing.assert_allclose(position, fk.end_effector, atol=1e-12)
+    np.testing.assert_allclose(rotation, fk.end_effector_rotation, atol=1e-12)
 
 
 def skewed_robot() -> DHRobot:
@@ -213,45 +156,14 @@ def skewed_robot() -> DHRobot:
     return DHRobot(base=base, links=links, name="skewed")
 
 
-def test_a_robot_with_offsets_and_twists_agrees_with_pinocchio_and_pybullet(tmp_path):
+def test_a_robot_with_offsets_and_twists_agrees_with_pinocchio_and_pybullet():
     model = ManipulatorModel(skewed_robot())
-    n = model.n_joints
-    built = pin.buildModelFromXML(model.urdf(), pin.JointModelFreeFlyer())
-    built.gravity.setZero()
-    data = built.createData()
-    path = tmp_path / "skewed.urdf"
-    path.write_text(model.urdf())
-    client = pybullet.connect(pybullet.DIRECT)
-    try:
-        body = pybullet.loadURDF(
-            str(path), flags=pybullet.URDF_USE_INERTIA_FROM_FILE, physicsClientId=client
-        )
-        rng = np.random.default_rng(11)
+    pinocchio_model = PinocchioModel(model)
+    rng = np.random.default_rng(11)
+    with BulletModel(model) as bullet:
         for _ in range(3):
-            quaternion = rng.normal(size=4)
-            q = np.concatenate(
-                [rng.normal(size=3), quaternion / np.linalg.norm(quaternion), rng.uniform(-3, 3, n)]
-            )
-            qd = rng.normal(size=6 + n)
-            t_pin, t_bullet = pinocchio_map(q), bullet_map(q)
-            m_pin = pin.crba(built, data, q)
-            m_pin = np.triu(m_pin) + np.triu(m_pin, 1).T
-            assert relative_error(model.mass_matrix(q), t_pin.T @ m_pin @ t_pin) <= RELATIVE
-            m_bullet = np.array(
-                pybullet.calculateMassMatrix(body, list(q[7:]), physicsClientId=client)
-            )
-            assert (
-                relative_error(model.mass_matrix(q), t_bullet.T @ m_bullet @ t_bullet) <= RELATIVE
-            )
-            v = t_pin @ qd
-            acceleration = np.zeros(6 + n)
-            acceleration[:3] = -np.cross(v[3:6], v[:3])
-            bias_pin = t_pin.T @ pin.rnea(built, data, q, v, acceleration)
-            assert relative_error(model.bias(q, qd), bias_pin) <= RELATIVE
-            pin.computeJointJacobians(built, data, q)
-            pin.updateFramePlacements(built, data)
-            frame = built.getFrameId("end_effector")
-            jac = pin.getFrameJacobian(built, data, frame, pin.LOCAL_WORLD_ALIGNED) @ t_pin
-            assert relative_error(model.jacobian(q), jac) <= RELATIVE
-    finally:
-        pybullet.disconnect(client)
+            q, qd = reference_state(rng, model.n_joints)
+            for reference in (pinocchio_model, bullet):
+                assert relative_error(model.mass_matrix(q), reference.mass_matrix(q)) <= RELATIVE
+                assert relative_error(model.bias(q, qd), reference.bias(q, qd)) <= RELATIVE
+                assert relative_error(model.jacobian(q), reference.jacobian(q)) <= RELATIVE
