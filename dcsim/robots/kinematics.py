@@ -12,20 +12,28 @@ Bodies are numbered base first: body 0 is the base, body ``i`` link ``i``.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import ModuleType
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from dcsim.robots import kernels
 from dcsim.robots.dh import DHRobot
 
 Array = NDArray[np.float64]
 
 
+def compiled() -> ModuleType:
+    """:mod:`dcsim.robots.kernels`, imported on first use: loading numba takes a third of
+    a second, which commands that never touch a manipulator should not pay."""
+    from dcsim.robots import kernels
+
+    return kernels
+
+
 def rotation_matrix(quaternion: ArrayLike) -> Array:
     """Rotation matrix (body to world) of a quaternion ``[x, y, z, w]``, normalised first."""
     out = np.empty((3, 3))
-    kernels.quaternion_rotation(np.array(quaternion, dtype=float), out)
+    compiled().quaternion_rotation(np.array(quaternion, dtype=float), out)
     return out
 
 
@@ -151,4 +159,4 @@ def state_vector(q: ArrayLike, n: int) -> Array:
 def kinematics(dh: DHArrays, q: ArrayLike) -> Kinematics:
     """World-frame kinematics of state ``q`` (7 + n,) (eqs 3.1–3.6, 3.8, 3.10, 4.18, 4.20)."""
     q = state_vector(q, dh.n_joints)
-    return Kinematics(q[:3], *kernels.world_kinematics(q, dh.links, dh.bodies, dh.mount))
+    return Kinematics(q[:3], *compiled().world_kinematics(q, dh.links, dh.bodies, dh.mount))

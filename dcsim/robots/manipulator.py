@@ -21,9 +21,15 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from dcsim.geometry import quaternion_from_rotation_vector, quaternion_multiply
-from dcsim.robots import kernels
 from dcsim.robots.dh import DHRobot
-from dcsim.robots.kinematics import Array, DHArrays, Kinematics, kinematics, state_vector
+from dcsim.robots.kinematics import (
+    Array,
+    DHArrays,
+    Kinematics,
+    compiled,
+    kinematics,
+    state_vector,
+)
 from dcsim.robots.urdf import urdf_text
 
 IKStatus = Literal["converged", "unreachable", "singular", "not-converged"]
@@ -211,7 +217,7 @@ class ManipulatorModel:
             Symmetric positive definite, in the order of ``qd``: kg, kg·m, kg·m².
         """
         dh = self._dh
-        return kernels.mass_matrix(state_vector(q, self.n_joints), dh.links, dh.bodies, dh.mount)
+        return compiled().mass_matrix(state_vector(q, self.n_joints), dh.links, dh.bodies, dh.mount)
 
     def coriolis_matrix(self, q: ArrayLike, qd: ArrayLike) -> Array:
         """Coriolis and centrifugal matrix ``C(q, q̇)`` of eqs 4.23–4.33.
@@ -249,7 +255,7 @@ class ManipulatorModel:
             ``C(q, q̇)``: kg/s, kg·m/s, kg·m²/s.
         """
         dh, q = self._dh, state_vector(q, self.n_joints)
-        return kernels.mass_and_coriolis(q, self._velocity(qd), dh.links, dh.bodies, dh.mount)
+        return compiled().mass_and_coriolis(q, self._velocity(qd), dh.links, dh.bodies, dh.mount)
 
     def bias(self, q: ArrayLike, qd: ArrayLike) -> Array:
         """Velocity-dependent generalised force ``C(q, q̇) q̇`` (6 + n,): N, N·m, N·m."""
