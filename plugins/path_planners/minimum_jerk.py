@@ -44,46 +44,27 @@ def minimum_jerk_move(
     return duration * tau, origin + np.outer(shape, offset), np.outer(rate, offset)
 
 
-def minimum_jerk_curve(
+def minimum_jerk_legs(
     points: np.ndarray, max_speed: float, max_acceleration: float, samples: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Rest to rest along a smooth curve through ``points`` (k, 3), m.
-
-    The curve is the piecewise-cubic Hermite interpolant through the points over their
-    cumulative chord length ``σ`` that keeps every coordinate monotone between points
-    (PCHIP: it never overshoots a corner; a straight line for two points), travelled with
-    the minimum-jerk law ``σ(t) = L (10 τ³ − 15 τ⁴ + 6 τ⁵)``. The duration starts from
-    the straight move's and grows until the speed ``|x'(σ)| σ̇`` and the acceleration
-    ``|x''(σ) σ̇² + x'(σ) σ̈|`` on the samples are within the limits.
+    """Rest to rest from point to point of ``points`` (k, 3), m: one minimum-jerk move per
+    leg, each as short as the limits allow, about ``samples`` points in all (at least two
+    per leg).
 
     Returns
     -------
     times, positions, velocities : ndarray
-        ``samples`` points: s since the start, m and m/s.
+        s since the start, m and m/s; each corner appears once, at rest.
     """
-    from scipy.interpolate import PchipInterpolator
-
-    chords = np.linalg.norm(np.diff(points, axis=0), axis=1)
-    sigma = np.concatenate([[0.0], np.cumsum(chords)])
-    length = float(sigma[-1])
-    curve = PchipInterpolator(sigma, points)
-    tau = np.linspace(0.0, 1.0, samples)
-    shape = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
-    rate = 30.0 * tau**2 * (1.0 - tau) ** 2
-    bend = 60.0 * tau * (1.0 - tau) * (1.0 - 2.0 * tau)
-    along = length * shape
-    tangent, curvature = curve(along, 1), curve(along, 2)
-    duration = shortest_duration(length, max_speed, max_acceleration)
-    for _ in range(60):
-        speed = np.linalg.norm(tangent * (length * rate / duration)[:, None], axis=1).max()
-        acceleration = np.linalg.norm(
-            curvature * ((length * rate / duration) ** 2)[:, None]
-            + tangent * (length * bend / duration**2)[:, None],
-            axis=1,
-        ).max()
-        stretch = max(speed / max_speed, np.sqrt(acceleration / max_acceleration))
-        if stretch <= 1.0 + 1e-9:
-            break
-        duration *= stretch * (1.0 + 1e-6)
-    velocities = tangent * (length * rate / duration)[:, None]
-    return duration * tau, curve(along), velocities
+    lengths = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    shares = np.maximum(2, np.ceil(samples * lengths / lengths.sum()).astype(int))
+    times, positions, velocities = [np.zeros(1)], [points[:1]], [np.zeros((1, 3))]
+    clock = 0.0
+    for origin, end, length, count in zip(points[:-1], points[1:], lengths, shares, strict=True):
+        duration = shortest_duration(float(length), max_speed, max_acceleration)
+        t, x, v = minimum_jerk_move(origin, end, duration, int(count))
+        times.append(clock + t[1:])
+        positions.append(x[1:])
+        velocities.append(v[1:])
+        clock += duration
+    return np.concatenate(times), np.vstack(positions), np.vstack(velocities)

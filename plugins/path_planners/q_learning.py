@@ -11,12 +11,11 @@ written. Training draws from the planner's generator, so a seed gives the same t
 
 The flight follows the cell centres from the start (the end effector's own position:
 the lattice is anchored there) to the target's cell, then on to the target itself. The
-staircase of centres is first simplified (Ramer–Douglas–Peucker) to the fewest points
-that keep every centre within ``smoothing`` cells of the path (0 keeps every centre),
-then flown on the cubic spline through those points, rest to rest, with a minimum-jerk
-time law within the problem's speed and acceleration limits
-(:func:`minimum_jerk_curve`): a staircase flown corner by corner would stop at every
-cell. "No path" when the target is beyond the arm's
+staircase of centres is first simplified (Ramer–Douglas–Peucker) to the fewest corners
+that keep every visited centre within ``smoothing`` cells of the path (0 keeps every
+centre), then flown leg by leg, each leg a rest-to-rest minimum-jerk move within the
+problem's speed and acceleration limits (:func:`minimum_jerk_legs`): a staircase flown
+cell by cell would stop at every cell. "No path" when the target is beyond the arm's
 reach, when its cell breaks a constraint, or when the greedy path enters a terminal
 cell, comes back to a cell, or does not arrive.
 """
@@ -34,7 +33,7 @@ from dcsim_plugins.path_planners.cell_environment import (
     build_environment,
 )
 from dcsim_plugins.path_planners.deadline import OutOfTime
-from dcsim_plugins.path_planners.minimum_jerk import minimum_jerk_curve
+from dcsim_plugins.path_planners.minimum_jerk import minimum_jerk_legs
 from dcsim_plugins.path_planners.tabular_q import (
     Rollout,
     Schedule,
@@ -241,13 +240,13 @@ class QLearningPlanner(PathPlanner):
     def _trajectory(
         self, problem: PathProblem, environment: CellEnvironment, cells: list[int], statistics
     ) -> Trajectory:
-        """The smooth rest-to-rest flight through the cell path's centres to the target."""
+        """The flight along the simplified cell path to the target, leg by leg."""
         points = environment.centres(np.asarray(cells))
         target = np.asarray(problem.goal.position, dtype=float)
         if np.linalg.norm(points[-1] - target) > 1e-9:
             points = np.vstack([points, target])
         points = simplified(points, self.params.smoothing * environment.cell_size)
-        times, positions, velocities = minimum_jerk_curve(
+        times, positions, velocities = minimum_jerk_legs(
             points, problem.max_speed, problem.max_acceleration, self.params.samples
         )
         return Trajectory(
