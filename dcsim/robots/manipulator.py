@@ -264,8 +264,7 @@ class ManipulatorModel:
 
     def centre_of_mass(self, q: ArrayLike) -> Array:
         """Centre of mass of the whole robot (base and links), world frame, m (3,)."""
-        masses = self._dh.bodies[:, 0]
-        return masses @ self.kinematics(q).body_coms / masses.sum()
+        return self._centre(self.kinematics(q))
 
     def momentum(self, q: ArrayLike, qd: ArrayLike) -> Array:
         """Linear momentum (kg·m/s) and angular momentum about the base's centre of mass
@@ -322,38 +321,44 @@ class ManipulatorModel:
         """
         target = np.asarray(target, dtype=float)
         q = np.array(q0, dtype=float)
-        centre = self.centre_of_mass(q)
-        if base != "floating" and self._beyond_reach(q, target):
+        kin = self.kinematics(q)
+        centre = self._centre(kin)
+        if base != "floating" and np.linalg.norm(target - kin.origins[0]) > self.robot.reach:
             return self._ik_result(q, target, "unreachable", 0)
         for iteration in range(max_iterations):
-            error = target - self.kinematics(q).end_effector
+            error = target - kin.end_effector
             if np.linalg.norm(error) <= tolerance:
                 return self._ik_result(q, target, "converged", iteration)
-            jac = self._ik_jacobian(q, base)
+            jac = self._ik_jacobian(kin, base)
             jjt = jac @ jac.T
             if damping == 0.0 and np.linalg.det(jjt) <= singular_tolerance:
                 return self._ik_result(q, target, "singular", iteration)
             step = jac.T @ np.linalg.solve(jjt + damping**2 * np.eye(3), error)
             q = self._advance(q, step, base)
-            if base == "centre-of-mass":
-                q[:3] += centre - self.centre_of_mass(q)
-        error = np.linalg.norm(target - self.kinematics(q).end_effector)
+            kin = self.kinematics(q)
+            if base == "centre-of-mass":  # a pure translation of the whole robot
+                q[:3] += centre - self._centre(kin)
+                kin = self.kinematics(q)
+        error = np.linalg.norm(target - kin.end_effector)
         status: IKStatus = "converged" if error <= tolerance else "not-converged"
         return self._ik_result(q, target, status, max_iterations)
 
-    def _ik_jacobian(self, q: Array, base: str) -> Array:
+    def _centre(self, kin: Kinematics) -> Array:
+        """The whole robot's centre of mass in ``kin``, m."""
+        masses = self._dh.bodies[:, 0]
+        return masses @ kin.body_coms / masses.sum()
+
+    def _ik_jacobian(self, kin: Kinematics, base: str) -> Array:
         """The end-effector position's Jacobian over the unknowns of ``base``'s mode."""
-        jac = self.jacobian(q)[:3]
+        jac = kin.jacobian[:3]
         if base == "held":
             return jac[:, 6:]
         if base == "floating":
             return jac
-        coupling = self.mass_matrix(q)[:3]  # [m_total 1, −m_total [r_sg×], M_vθ]
-        return jac[:, 6:] - jac[:, :3] @ coupling[:, 6:] / coupling[0, 0]
-
-    def _beyond_reach(self, q: Array, target: Array) -> bool:
-        shoulder = self.kinematics(q).origins[0]
-        return bool(np.linalg.norm(target - shoulder) > self.robot.reach)
+        masses = self._dh.bodies[:, 0]
+        # the centre of mass's velocity per joint rate, base still: Σ m_i J_v,i / m_total
+        centre_rates = np.einsum("b,bij->ij", masses, kin.body_jacobians[:, :3, 6:]) / masses.sum()
+        return jac[:, 6:] - jac[:, :3] @ centre_rates
 
     def _advance(self, q: Array, step: Array, base: str) -> Array:
         q = q.copy()
