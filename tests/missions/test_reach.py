@@ -22,9 +22,9 @@ START = np.array([1.4, 0.9, -0.8])
 TARGET = np.array([1.5, 0.7, -1.0])
 
 
-def fly(out: Path, *overrides: str) -> tuple[dict, dict[str, np.ndarray]]:
-    """Run the shipped reach scenario; return its summary and telemetry columns."""
-    summary = Runner(prepare_run(SCENARIO, list(overrides)), out).run()
+def read_run(out: Path) -> tuple[dict, dict[str, np.ndarray]]:
+    """A run directory's summary and telemetry columns."""
+    summary = json.loads((out / "summary.json").read_text())
     with open(out / "telemetry.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
     columns = {k: np.array([float(r[k]) for r in rows]) for k in rows[0] if k != "mode"}
@@ -32,9 +32,23 @@ def fly(out: Path, *overrides: str) -> tuple[dict, dict[str, np.ndarray]]:
     return summary, columns
 
 
+def fly(out: Path, *overrides: str) -> tuple[dict, dict[str, np.ndarray]]:
+    """Run the shipped reach scenario; return its summary and telemetry columns."""
+    Runner(prepare_run(SCENARIO, list(overrides)), out).run()
+    return read_run(out)
+
+
 @pytest.fixture(scope="module")
-def full_control(tmp_path_factory):
-    return fly(tmp_path_factory.mktemp("computed-torque"))
+def full_control_run(tmp_path_factory) -> Path:
+    """The run directory of the shipped scenario (full control)."""
+    out = tmp_path_factory.mktemp("computed-torque") / "run"
+    fly(out)
+    return out
+
+
+@pytest.fixture(scope="module")
+def full_control(full_control_run):
+    return read_run(full_control_run)
 
 
 @pytest.fixture(scope="module")
@@ -98,9 +112,8 @@ def test_reach_writes_one_column_per_joint_and_its_plots(full_control, tmp_path)
     assert np.degrees(telemetry["target_angle"]).max() < 60.0
 
 
-def test_reach_run_directory_has_the_plots(tmp_path):
-    out = tmp_path / "run"
-    fly(out, "world.duration=0.5")
+def test_reach_run_directory_has_the_plots(full_control_run):
+    out = full_control_run
     assert {p.name for p in (out / "plots").iterdir()} == {"path.png", "timeline.png", "joints.png"}
     events = [json.loads(line) for line in (out / "events.jsonl").read_text().splitlines()]
     assert events[0]["event"] == "path" and events[0]["length"] == pytest.approx(0.3)
