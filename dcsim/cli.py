@@ -893,11 +893,12 @@ def bench_q_learning_command(
     7.5-7.13). Prints Markdown tables for docs/benchmarks.md; progress goes to stderr.
     """
     from dcsim.bench import q_learning as bench
+    from dcsim.robots.loading import load_reach_problem
 
     counts = [int(v) for v in _numbers(episodes, "--episodes")]
     widths = [int(v) for v in _numbers(margins, "--margins")]
     progress = lambda line: click.echo(line, err=True)  # noqa: E731
-    problem = bench.reach_problem(scenario)
+    problem = load_reach_problem(scenario)
     rows, reachable, cells = bench.working_table(problem, counts, seeds, progress=progress)
     sizes = bench.size_sweep(problem, widths, size_episodes, progress=progress)
     cases = bench.run_applications(scenario)

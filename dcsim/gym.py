@@ -37,6 +37,7 @@ from dcsim.robots.loading import load_reach_problem
 from dcsim.scenario.loader import packaged_scenario_path
 
 ENVIRONMENT_ID = "dcsim/ManipulatorReachCells-v0"
+"""The id ``gymnasium.make`` knows the environment by, once this module is imported."""
 
 
 class ReachCellsEnv(gymnasium.Env):

@@ -6,7 +6,7 @@ components over time.
 
 ``timeline.png``: the end-effector tracking error and distance to the target, det(J Jᵀ)
 of the arm's position Jacobian (zero at a singularity), the angle between the base's
-target-facing side and the target (±60° is the thesis's sight limit), the base's
+target-facing side and the target (60° is the thesis's sight limit), the base's
 displacement against half the end effector's (the thesis's criterion), the commanded
 base torque and joint torques, and the change of total linear and angular momentum.
 

@@ -46,12 +46,6 @@ SECOND_START = (1.2, 0.9, -1.1)
 Progress = Callable[[str], None]
 
 
-def reach_problem(scenario: str | Path, start: Sequence[float] | None = None) -> PathProblem:
-    """The reach problem of a manipulator scenario (:func:`load_reach_problem`), from its
-    start or with the end effector moved to ``start`` (m)."""
-    return load_reach_problem(scenario, start)
-
-
 def _planner(params: dict[str, Any], seed: int):
     registry = PluginRegistry.discover()
     return registry.create("path_planner", "q-learning", params, np.random.default_rng(seed))
@@ -399,8 +393,8 @@ def plot_application(case: Application, target: np.ndarray, path: Path) -> None:
 def run_applications(scenario: str | Path, seed: int = 0) -> list[Application]:
     """The two application cases of §7.4: the scenario's start and :data:`SECOND_START`."""
     return [
-        application(reach_problem(scenario), seed),
-        application(reach_problem(scenario, SECOND_START), seed),
+        application(load_reach_problem(scenario), seed),
+        application(load_reach_problem(scenario, SECOND_START), seed),
     ]
 
 

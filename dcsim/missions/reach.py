@@ -168,6 +168,9 @@ class ReachMission(Mission):
         except SingularPath as error:
             self._refuse(str(error))
             return
+        except ValueError as error:  # a planner's malformed answer
+            self._refuse(f"the path planner's answer cannot be followed: {error}")
+            return
         self.trajectory = result
         self.emit("path", duration=result.duration, length=result.length)
         self._go("REACH")

@@ -1,9 +1,10 @@
 """Joint references that carry a manipulator's end effector along a path, the base held.
 
 The end-effector path ``x_d(t)`` is the cubic Hermite curve through a trajectory's
-samples (positions and velocities), so it and its velocity and acceleration are defined
-at every instant. It becomes joint angles by closed-loop inverse kinematics at the rate
-level (the velocity form of the source thesis 004's eqs 3.12–3.13):
+samples (positions and velocities): its position and velocity are continuous, its
+acceleration is linear between samples (it may jump at a sample). It becomes joint
+angles by closed-loop inverse kinematics at the rate level (the velocity form of the
+source thesis 004's eqs 3.12–3.13):
 
     θ̇ = J⁺(θ) (ẋ_d(t) + K (x_d(t) − x(θ)))
 
@@ -52,7 +53,8 @@ class JointSample:
 
 
 class SingularPath(ValueError):
-    """The path leads the arm into a singularity (``det(J Jᵀ)`` at its tolerance)."""
+    """The path leads the arm into a singularity (``det(J Jᵀ)`` at its tolerance), or
+    starts in one."""
 
 
 class JointPath:
@@ -74,7 +76,11 @@ class JointPath:
     Raises
     ------
     SingularPath
-        If the arm meets a singularity on the way.
+        If the arm starts in a singularity (an arm of fewer than three joints always
+        does) or meets one on the way.
+    ValueError
+        If the trajectory cannot be followed (fewer than two samples, times not
+        increasing).
     """
 
     def __init__(
@@ -89,6 +95,15 @@ class JointPath:
         self._base = np.asarray(start[:7], dtype=float)
         self.gain = gain
         self.singular_tolerance = singular_tolerance
+        if model.n_joints < 3:
+            raise SingularPath(
+                f"an arm of {model.n_joints} joint(s) cannot move its end effector freely in "
+                "three dimensions: give at least three links"
+            )
+        if self._det_jjt(np.asarray(start[7:], dtype=float)) <= singular_tolerance:
+            raise SingularPath("the arm starts in a singularity (det(J Jᵀ) at its tolerance)")
+        if len(trajectory.times) < 2 or np.any(np.diff(trajectory.times) <= 0.0):
+            raise ValueError("the path needs two samples or more at increasing times")
         self.start_time, self.end_time = float(trajectory.times[0]), float(trajectory.times[-1])
         self._path = CubicHermiteSpline(
             trajectory.times, trajectory.positions, trajectory.velocities, extrapolate=False
@@ -107,7 +122,22 @@ class JointPath:
             return self._det_jjt(theta) - self.singular_tolerance
 
         singular.terminal = True
-        solution = solve_ivp(
+        try:
+            solution = self._solve(angles, singular)
+        except np.linalg.LinAlgError:
+            raise SingularPath("the arm meets a singularity on the path") from None
+        if solution.status == 1:
+            raise SingularPath(
+                f"the arm meets a singularity at t = {solution.t_events[0][0]:.3f} s on the path"
+            )
+        if solution.status != 0:
+            raise SingularPath(f"the joint path could not be integrated: {solution.message}")
+        self._final = solution.y[:, -1]
+        return solution.sol
+
+    def _solve(self, angles: Array, singular):
+        """scipy's DOP853 over the path, to 1e-8 relative, stopping at a singularity."""
+        return solve_ivp(
             self._rates,
             (self.start_time, self.end_time),
             angles,
@@ -117,14 +147,6 @@ class JointPath:
             dense_output=True,
             events=singular,
         )
-        if solution.status == 1:
-            raise SingularPath(
-                f"the arm meets a singularity at t = {solution.t_events[0][0]:.3f} s on the path"
-            )
-        if solution.status != 0:
-            raise SingularPath(f"the joint path could not be integrated: {solution.message}")
-        self._final = solution.y[:, -1]
-        return solution.sol
 
     def _state(self, theta: Array) -> Array:
         return np.concatenate([self._base, theta])

@@ -33,6 +33,7 @@ from dcsim.messages import (
     TaskRequest,
 )
 from dcsim.motion import LinearMotion, StaticMotion
+from dcsim.scenario.loader import packaged_scenario_path
 from dcsim.testing.manipulator import thesis_robot
 
 BEACONS = np.array(
@@ -312,39 +313,18 @@ def posed(plugin_class: type[Plugin], problem: PathProblem) -> PathProblem:
     return held_still(problem)
 
 
-REACH_START_JOINTS_DEG = (
-    44.9694989345,
-    30.9901560203,
-    -44.3160315111,
-    -0.698671770567,
-    75.2188521525,
-    54.4117634838,
-)
-"""Joint angles of the thesis's arm with its end effector at [1.4, 0.9, −0.8] m (base at
-the origin, unturned), deg: the start of scenarios/space_manipulator_reach.yaml."""
-
-
 def reach_problem(
     time_budget: float = 5.0, target: tuple[float, float, float] = (1.5, 0.7, -1.0)
 ) -> PathProblem:
-    """The thesis's reach as a path problem: the end effector from [1.4, 0.9, −0.8] m to
-    ``target`` (m), arriving within 1 mm at rest, at most 0.1 m/s and 0.1 m/s², with the
-    reach mission's default planning budget (s)."""
-    robot = thesis_robot()
-    start = RobotState(
-        time=0.0,
-        position=np.zeros(3),
-        joint_positions=np.radians(REACH_START_JOINTS_DEG),
-        joint_velocities=np.zeros(len(REACH_START_JOINTS_DEG)),
-    )
-    return PathProblem(
-        start=start,
-        goal=GoalRegion(position=target, tolerance=1e-3, velocity_tolerance=1e-9),
-        robot_radius=robot.radius,
-        max_speed=0.1,
-        max_acceleration=0.1,
-        time_budget=time_budget,
-        model=robot.model,
+    """The packaged reach scenario's problem (the thesis's robot and reach): the end
+    effector from [1.4, 0.9, −0.8] m to ``target`` (m), arriving within 1 mm, at most
+    0.1 m/s and 0.1 m/s², with ``time_budget`` (s) to plan."""
+    from dcsim.robots.loading import load_reach_problem  # the missions load the world engine
+
+    point = [float(v) for v in target]
+    overrides = [f"mission.target={point!r}", f"mission.planning_budget={float(time_budget)!r}"]
+    return load_reach_problem(
+        packaged_scenario_path("space_manipulator_reach.yaml"), None, overrides
     )
 
 

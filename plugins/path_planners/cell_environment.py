@@ -38,8 +38,6 @@ ACTIONS = np.array([[0, 0, 1], [0, 0, -1], [0, -1, 0], [0, 1, 0], [1, 0, 0], [-1
 """Algorithm 5.1's actions in its order: upward, downward, rightward, leftward,
 frontward, backward (cell index steps along x, y, z)."""
 
-ACTION_NAMES = ("+z", "-z", "-y", "+y", "+x", "-x")
-
 
 @dataclass(frozen=True)
 class CellRules:
@@ -59,6 +57,11 @@ class CellRules:
         Largest base displacement as a fraction of the end effector's.
     target_reward, terminal_reward, step_reward, base_penalty : float
         Rewards (see the module).
+    max_cells : int
+        Most cells a grid may have (a larger one is refused before anything is built).
+    facing_axis : tuple of float or None
+        Base-frame direction of the side that must face the target; None: the base axis
+        nearest the target's direction at the start (as the reach mission judges it).
     """
 
     cell_size: float = 0.05
@@ -71,6 +74,8 @@ class CellRules:
     terminal_reward: float = -100.0
     step_reward: float = -1.0
     base_penalty: float = -1.0
+    max_cells: int = 200_000
+    facing_axis: tuple[float, float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -152,6 +157,8 @@ def build_environment(
     ------
     OutOfTime
         If the deadline passes first.
+    TooManyCells
+        If the grid would have more than ``rules.max_cells`` cells.
     """
     model, start = problem.model, problem.start
     q0 = start.configuration
@@ -160,6 +167,11 @@ def build_environment(
     lower = np.minimum(0, target_offset) - rules.margin
     upper = np.maximum(0, target_offset) + rules.margin
     shape = tuple(int(v) for v in upper - lower + 1)
+    if np.prod(shape, dtype=float) > rules.max_cells:
+        raise TooManyCells(
+            f"the grid would have {' × '.join(map(str, shape))} cells, more than max_cells = "
+            f"{rules.max_cells}: use larger cells or a smaller margin"
+        )
     origin = first + rules.cell_size * lower
     indices = np.column_stack(np.unravel_index(np.arange(np.prod(shape)), shape))
     centres = origin + rules.cell_size * indices
@@ -196,6 +208,10 @@ def build_environment(
     )
 
 
+class TooManyCells(ValueError):
+    """The grid the rules ask for is larger than they allow."""
+
+
 def _transitions(indices: np.ndarray, shape: tuple[int, int, int]) -> np.ndarray:
     """``next_cell`` (cells, 6): each action's cell, or the same cell at the grid's edge."""
     moved = indices[:, None, :] + ACTIONS[None, :, :]
@@ -222,7 +238,11 @@ def _cell_states(
     deadline: float,
 ) -> _CellStates:
     """The arm at every cell centre and the constraint each breaks ("" for none)."""
-    side = facing_axis(q0[3:7], target - q0[:3])
+    side = (
+        facing_axis(q0[3:7], target - q0[:3])
+        if rules.facing_axis is None
+        else np.asarray(rules.facing_axis, dtype=float)
+    )
     n = q0.size - 7
     joints = np.full((len(centres), n), np.nan)
     bases = np.tile(q0[:3], (len(centres), 1))

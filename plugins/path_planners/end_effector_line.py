@@ -42,18 +42,11 @@ class EndEffectorLinePlanner(PathPlanner):
 
     def plan(self, problem: PathProblem) -> Trajectory | NoPath:
         """The end effector's straight path to the goal's centre, or why there is none."""
-        model = problem.model
-        if model is None or not hasattr(model, "forward_kinematics"):
-            return NoPath("the problem carries no manipulator model: this planner moves an arm")
-        start = problem.start.configuration
-        frames = model.forward_kinematics(start)
-        origin, target = frames.end_effector, problem.goal.position
-        shoulder_distance = float(np.linalg.norm(target - frames.origins[0]))
-        if shoulder_distance > model.robot.reach:
-            return NoPath(
-                f"the target is {shoulder_distance:.3f} m from the shoulder, beyond the arm's "
-                f"reach of {model.robot.reach:.3f} m"
-            )
+        refusal = unreachable(problem)
+        if refusal is not None:
+            return refusal
+        origin = problem.model.forward_kinematics(problem.start.configuration).end_effector
+        target = problem.goal.position
         length = float(np.linalg.norm(target - origin))
         duration = self._duration(problem, length)
         if isinstance(duration, NoPath):
@@ -84,6 +77,22 @@ class EndEffectorLinePlanner(PathPlanner):
                 f"the speed and acceleration limits, the goal's time leaves {available:.3g} s"
             )
         return available
+
+
+def unreachable(problem: PathProblem) -> NoPath | None:
+    """Why no end-effector path can be planned at all: no manipulator model, or a target
+    beyond the arm's reach from its shoulder (the base where it is); None otherwise."""
+    model = problem.model
+    if model is None or not hasattr(model, "forward_kinematics"):
+        return NoPath("the problem carries no manipulator model: this planner moves an arm")
+    shoulder = model.forward_kinematics(problem.start.configuration).origins[0]
+    distance = float(np.linalg.norm(problem.goal.position - shoulder))
+    if distance > model.robot.reach:
+        return NoPath(
+            f"the target is {distance:.3f} m from the shoulder, beyond the arm's reach of "
+            f"{model.robot.reach:.3f} m"
+        )
+    return None
 
 
 @hookimpl

@@ -49,13 +49,17 @@ def minimum_jerk_legs(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Rest to rest from point to point of ``points`` (k, 3), m: one minimum-jerk move per
     leg, each as short as the limits allow, about ``samples`` points in all (at least two
-    per leg).
+    per leg). Repeated points are dropped; a single point gives a rest of 0.1 s.
 
     Returns
     -------
     times, positions, velocities : ndarray
         s since the start, m and m/s; each corner appears once, at rest.
     """
+    steps = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    points = points[np.concatenate([[True], steps > 0.0])]  # no leg of zero length
+    if len(points) == 1:  # already there: rest for a moment
+        return np.array([0.0, 0.1]), np.vstack([points, points]), np.zeros((2, 3))
     lengths = np.linalg.norm(np.diff(points, axis=0), axis=1)
     shares = np.maximum(2, np.ceil(samples * lengths / lengths.sum()).astype(int))
     times, positions, velocities = [np.zeros(1)], [points[:1]], [np.zeros((1, 3))]

@@ -23,6 +23,8 @@ cell, comes back to a cell, or does not arrive.
 from __future__ import annotations
 
 import hashlib
+import os
+import tempfile
 import time
 from pathlib import Path
 
@@ -30,9 +32,11 @@ import numpy as np
 from dcsim_plugins.path_planners.cell_environment import (
     CellEnvironment,
     CellRules,
+    TooManyCells,
     build_environment,
 )
 from dcsim_plugins.path_planners.deadline import OutOfTime
+from dcsim_plugins.path_planners.end_effector_line import unreachable
 from dcsim_plugins.path_planners.minimum_jerk import minimum_jerk_legs
 from dcsim_plugins.path_planners.tabular_q import (
     Rollout,
@@ -110,6 +114,15 @@ class QLearningParams(PluginParams):
         le=10,
         description="Largest distance of a visited cell's centre from the flown path, in cells.",
     )
+    facing_axis: tuple[float, float, float] | None = quantity(
+        None,
+        description="Base-frame direction of the side that must face the target (give the "
+        "reach mission's facing_axis); null: the base axis nearest the target's direction "
+        "at the start, as the mission's default.",
+    )
+    max_cells: int = quantity(
+        200_000, ge=1, description="Largest grid; a problem that needs more is refused."
+    )
     samples: int = quantity(
         201, ge=2, le=100_000, description="Trajectory samples from start to target."
     )
@@ -144,6 +157,8 @@ class QLearningPlanner(PathPlanner):
             terminal_reward=p.terminal_reward,
             step_reward=p.step_reward,
             base_penalty=p.base_penalty,
+            max_cells=p.max_cells,
+            facing_axis=p.facing_axis,
         )
 
     def schedule(self) -> Schedule:
@@ -192,17 +207,21 @@ class QLearningPlanner(PathPlanner):
     # ------------------------------------------------------------------ plan
     def plan(self, problem: PathProblem) -> Trajectory | NoPath:
         """Learn (or load) the table and return the greedy end-effector path."""
-        refusal = _refusal(problem)
+        refusal = unreachable(problem)
         if refusal is not None:
             return refusal
         began = time.perf_counter()
         deadline = began + problem.time_budget
         try:
             environment = self.environment(problem, deadline)
+            if environment.start == environment.target:  # nothing to learn: one move
+                return self._trajectory(problem, environment, [environment.start], {})
             if environment.terminal[environment.target]:
                 reason = environment.reasons[environment.target]
                 return NoPath(f"the target's cell breaks a constraint: {reason}")
             q, loaded = self._table(environment, deadline)
+        except TooManyCells as large:
+            return NoPath(str(large))
         except OutOfTime as late:
             return NoPath(
                 f"the planning budget of {problem.time_budget:g} s ran out ({late} done): "
@@ -230,7 +249,7 @@ class QLearningPlanner(PathPlanner):
                 with np.load(path) as saved:
                     if str(saved["fingerprint"]) == fingerprint:
                         return saved["q"], True
-            except (OSError, ValueError, KeyError) as error:
+            except (OSError, ValueError, KeyError, TypeError) as error:  # TypeError: a .npy
                 raise PluginError(f"q-learning: cannot read the Q-table {path}: {error}") from None
         q = self.train(environment, deadline).q
         if path is not None:
@@ -257,23 +276,6 @@ class QLearningPlanner(PathPlanner):
             duration=float(times[-1]),
             statistics=statistics,
         )
-
-
-def _refusal(problem: PathProblem) -> NoPath | None:
-    """Why the problem cannot be planned at all, or None."""
-    model = problem.model
-    if model is None or not hasattr(model, "inverse_kinematics"):
-        return NoPath("the problem carries no manipulator model: this planner moves an arm")
-    start = problem.start
-    q = start.configuration
-    shoulder = model.forward_kinematics(q).origins[0]
-    distance = float(np.linalg.norm(problem.goal.position - shoulder))
-    if distance > model.robot.reach:
-        return NoPath(
-            f"the target is {distance:.3f} m from the shoulder, beyond the arm's reach of "
-            f"{model.robot.reach:.3f} m"
-        )
-    return None
 
 
 def simplified(points: np.ndarray, tolerance: float) -> np.ndarray:
@@ -322,9 +324,10 @@ def _save(path: Path, q: np.ndarray, fingerprint: str) -> None:
     """Write the table atomically (a reader sees the old file or the new)."""
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        partial = path.with_name(path.name + ".partial.npz")
-        np.savez(partial, q=q, fingerprint=np.array(fingerprint))
-        partial.replace(path)
+        handle, name = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".npz")
+        with os.fdopen(handle, "wb") as partial:  # one file per writer: no two share it
+            np.savez(partial, q=q, fingerprint=np.array(fingerprint))
+        Path(name).replace(path)
     except OSError as error:
         raise PluginError(f"q-learning: cannot write the Q-table {path}: {error}") from None
 

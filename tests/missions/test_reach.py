@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from dcsim_plugins.path_planners.end_effector_line import EndEffectorLinePlanner
 
-from dcsim.api import manipulator_model, thesis_manipulator
+from dcsim.api import Trajectory, manipulator_model, thesis_manipulator
 from dcsim.robots.joint_path import JointPath, SingularPath
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
@@ -186,3 +186,40 @@ def test_a_path_through_a_singularity_is_refused():
     trajectory = EndEffectorLinePlanner(None, np.random.default_rng(0)).plan(edge_problem)
     with pytest.raises(SingularPath, match="singularity"):
         JointPath(model, start, trajectory)
+
+
+TWO_LINKS = """\
+name: two-links
+world: {frame: geocentric, physics_step: 0.001, control_period: 0.01, duration: 0.1}
+robot:
+  type: manipulator
+  mass: 1000
+  propellant_mass: 50
+  inertia: [166.67, 166.67, 166.67]
+  mount: [0.5, 0, 0]
+  links:
+    - {a: 0.7, alpha_deg: 90, mass: 20, inertia: [0.2, 1.87, 1.87]}
+    - {a: 0.4, alpha_deg: 0, mass: 15, inertia: [0.1, 1.25, 1.25]}
+  initial: {joint_angles_deg: [30, 40]}
+mission: {type: reach, target: [1.2, 0.3, 0.2]}
+"""
+
+
+def test_an_arm_of_two_joints_is_refused_with_a_reason(tmp_path):
+    scenario = tmp_path / "two_links.yaml"
+    scenario.write_text(TWO_LINKS)
+    summary = Runner(prepare_run(scenario), None).run()
+    assert summary["status"] == "stopped"
+    assert "at least three links" in summary["reason"]
+
+
+def test_an_unusable_trajectory_is_refused():
+    problem = reach_problem()
+    start = problem.start.configuration
+    one_sample = Trajectory(times=[0.0], positions=[[1.4, 0.9, -0.8]], velocities=[[0, 0, 0]])
+    with pytest.raises(ValueError, match="two samples"):
+        JointPath(problem.model, start, one_sample)
+    stretched = np.concatenate([start[:7], np.zeros(6)])  # the arm straight: singular
+    line = EndEffectorLinePlanner(None, np.random.default_rng(0)).plan(problem)
+    with pytest.raises(SingularPath, match="starts in a singularity"):
+        JointPath(problem.model, stretched, line)

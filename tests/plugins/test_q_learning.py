@@ -17,7 +17,7 @@ from dcsim_plugins.path_planners.tabular_q import (
     train,
 )
 
-from dcsim.api import NoPath, Trajectory
+from dcsim.api import NoPath, PluginError, Trajectory
 from dcsim.bench.cell_optimum import optimal_values, reachable_cells, working_cells
 from dcsim.testing.problems import reach_problem
 
@@ -253,3 +253,25 @@ def test_simplified_keeps_every_point_within_the_tolerance():
     assert len(kept) < len(steps)
     np.testing.assert_array_equal(kept[[0, -1]], steps[[0, -1]])
     assert len(simplified(steps, 0.0)) == len(steps)
+
+
+def test_a_target_in_the_start_cell_is_one_short_move():
+    problem = reach_problem(target=(1.41, 0.9, -0.8))  # within the start's 5 cm cell
+    answer = planner().plan(problem)
+    assert isinstance(answer, Trajectory)
+    assert answer.length == pytest.approx(0.01)  # straight there, no detour
+    assert np.isfinite(answer.velocities).all()
+
+
+def test_a_grid_larger_than_max_cells_and_a_foreign_table_are_refused(tmp_path):
+    assert "max_cells" in planner(cell_size=0.001).plan(reach_problem()).reason
+    foreign = tmp_path / "q.npy"
+    np.save(foreign, np.zeros(3))
+    with pytest.raises(PluginError, match="cannot read the Q-table"):
+        planner(q_table_file=str(foreign), margin=0).plan(reach_problem())
+
+
+def test_the_facing_axis_sets_the_sight_constraint():
+    default = planner(margin=0).environment(reach_problem())
+    turned = planner(margin=0, facing_axis=(0.0, 1.0, 0.0)).environment(reach_problem())
+    assert default.sight.max() < np.radians(60.0) < turned.sight.min()
