@@ -55,14 +55,27 @@ def write_plots(
     list of Path
         The files written (none if there is no telemetry).
     """
-    if len(telemetry["time"]) == 0:
+    folder = plots_folder(out_dir, telemetry)
+    if folder is None:
         return []
-    folder = out_dir / "plots"
-    folder.mkdir(parents=True, exist_ok=True)
     paths = [folder / "trajectory.png", folder / "timeline.png"]
     _trajectory(paths[0], scenario, telemetry, events)
     _timeline(paths[1], telemetry, tuple(modes), safety_distance)
     return paths
+
+
+def plots_folder(out_dir: Path, telemetry: Mapping[str, np.ndarray]) -> Path | None:
+    """``out_dir/plots``, created; None when the telemetry has no row to draw."""
+    if len(telemetry["time"]) == 0:
+        return None
+    folder = out_dir / "plots"
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder
+
+
+def stacked(telemetry: Mapping[str, np.ndarray], names: Sequence[str]) -> np.ndarray:
+    """Telemetry columns ``names`` side by side as floats, (rows, len(names))."""
+    return np.column_stack([np.asarray(telemetry[name], dtype=float) for name in names])
 
 
 def _object_paths(scenario: Scenario, times: np.ndarray, events: Sequence[Mapping[str, Any]]):
@@ -81,8 +94,8 @@ def _trajectory(path: Path, scenario: Scenario, telemetry, events) -> None:
     times = telemetry["time"]
     step = max(1, len(times) // 400)
     sample = times[::step]
-    true = np.column_stack([telemetry[c] for c in ("x", "y", "z")])
-    estimate = np.column_stack([telemetry[c] for c in ("est_x", "est_y", "est_z")])
+    true = stacked(telemetry, ("x", "y", "z"))
+    estimate = stacked(telemetry, ("est_x", "est_y", "est_z"))
     drop = scenario.drop_point.build(scenario.mean_motion).state_at(sample)[0]
     grabs = [e["t"] for e in events if e["event"] == "grab" and e["success"]]
     grab_points = true[np.searchsorted(times, grabs)] if grabs else np.zeros((0, 3))

@@ -29,6 +29,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
 import numpy as np  # noqa: E402
 
+from dcsim.plots import plots_folder, stacked  # noqa: E402
 from dcsim.scenario.model import Scenario  # noqa: E402
 
 SIGHT_LIMIT_DEG = 60.0
@@ -68,10 +69,9 @@ def write_reach_plots(
     list of Path
         The files written (none if there is no telemetry).
     """
-    if len(telemetry["time"]) == 0:
+    folder = plots_folder(out_dir, telemetry)
+    if folder is None:
         return []
-    folder = out_dir / "plots"
-    folder.mkdir(parents=True, exist_ok=True)
     path_end = _path_end(events)
     title = f"{scenario.name} ({scenario.controller.plugin})"
     paths = [folder / "path.png", folder / "timeline.png", folder / "joints.png"]
@@ -89,10 +89,6 @@ def _path_end(events: Sequence[Mapping[str, Any]]) -> float | None:
     return None
 
 
-def _stack(telemetry: Mapping[str, np.ndarray], names: Sequence[str]) -> np.ndarray:
-    return np.column_stack([np.asarray(telemetry[name], dtype=float) for name in names])
-
-
 def _mark_end(axis, path_end: float | None) -> None:
     if path_end is not None:
         axis.axvline(path_end, color="0.4", ls=":", lw=1.0)
@@ -106,9 +102,9 @@ def _path_figure(
     title: str,
 ) -> None:
     times = telemetry["time"]
-    flown = _stack(telemetry, ("ee_x", "ee_y", "ee_z"))
-    reference = _stack(telemetry, ("ref_ee_x", "ref_ee_y", "ref_ee_z"))
-    base = _stack(telemetry, ("x", "y", "z"))
+    flown = stacked(telemetry, ("ee_x", "ee_y", "ee_z"))
+    reference = stacked(telemetry, ("ref_ee_x", "ref_ee_y", "ref_ee_z"))
+    base = stacked(telemetry, ("x", "y", "z"))
     target = np.asarray(scenario.mission.target, dtype=float)
     figure = plt.figure(figsize=(13, 6))
     axis = figure.add_subplot(1, 2, 1, projection="3d")
@@ -177,11 +173,11 @@ def _timeline_figure(
 
 def _torques(axis, telemetry: Mapping[str, np.ndarray]) -> None:
     times = telemetry["time"]
-    base = np.linalg.norm(_stack(telemetry, ("tx", "ty", "tz")), axis=1)
+    base = np.linalg.norm(stacked(telemetry, ("tx", "ty", "tz")), axis=1)
     axis.plot(times, base, color="k", lw=1.4, label="base |τ|")
     for i, name in enumerate(_numbered(telemetry, "joint_torque_"), 1):
         axis.plot(times, telemetry[name], lw=0.9, label=f"joint {i}")
-    thrust = np.linalg.norm(_stack(telemetry, ("fx", "fy", "fz")), axis=1)
+    thrust = np.linalg.norm(stacked(telemetry, ("fx", "fy", "fz")), axis=1)
     axis.plot(times, thrust, color="0.5", ls="--", lw=1.0, label="base thrust |F| [N]")
     axis.set(ylabel="torque [N·m]", title="Commands")
     axis.legend(fontsize=7, ncol=3)
@@ -193,7 +189,7 @@ def _momentum(linear_axis, angular_axis, telemetry: Mapping[str, np.ndarray]) ->
         (linear_axis, ("px", "py", "pz"), "kg·m/s", "linear"),
         (angular_axis, ("hx", "hy", "hz"), "kg·m²/s", "angular (about the origin)"),
     ):
-        values = _stack(telemetry, names)
+        values = stacked(telemetry, names)
         change = np.linalg.norm(values - values[0], axis=1)
         axis.plot(times, change, color=_FLOWN)
         axis.set(ylabel=f"change [{unit}]", title=f"Total {what} momentum: change from the start")

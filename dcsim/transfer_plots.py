@@ -30,7 +30,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
 from dcsim.messages import ObjectKind, Shape, ShapeKind  # noqa: E402
-from dcsim.plots import obstacle_panel  # noqa: E402
+from dcsim.plots import obstacle_panel, plots_folder, stacked  # noqa: E402
 from dcsim.scenario.model import Scenario  # noqa: E402
 from dcsim.shape_outlines import outline, wireframe  # noqa: E402
 from dcsim.world.objects import build_objects  # noqa: E402
@@ -145,10 +145,9 @@ def write_transfer_plots(
     list of Path
         The files written (none if there is no telemetry).
     """
-    if len(telemetry["time"]) == 0:
+    folder = plots_folder(out_dir, telemetry)
+    if folder is None:
         return []
-    folder = out_dir / "plots"
-    folder.mkdir(parents=True, exist_ok=True)
     paths = [folder / "path.png", folder / "timeline.png"]
     scene = build_scene(scenario, telemetry, read_planned(out_dir / "trajectory.csv"))
     _path_figure(paths[0], scene, f"{scenario.name}: path (frame {scenario.world.frame})")
@@ -182,8 +181,8 @@ def build_scene(
         Positions of the planned trajectory, m.
     """
     times = telemetry["time"]
-    flown = _stack(telemetry, ("x", "y", "z"))
-    reference = _stack(telemetry, ("ref_x", "ref_y", "ref_z"))
+    flown = stacked(telemetry, ("x", "y", "z"))
+    reference = stacked(telemetry, ("ref_x", "ref_y", "ref_z"))
     goal = _goal(scenario)
     bounds = _bounds(scenario)
     core = np.vstack([flown, reference, planned, *_corners(goal)])
@@ -203,10 +202,6 @@ def _extent(points: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     """Lowest and highest coordinates of arrays of points (each (K, 3))."""
     stacked = np.vstack(points)
     return stacked.min(axis=0), stacked.max(axis=0)
-
-
-def _stack(telemetry: Mapping[str, np.ndarray], names: Sequence[str]) -> np.ndarray:
-    return np.column_stack([telemetry[name] for name in names])
 
 
 def _goal(scenario: Scenario) -> Placed:
@@ -376,8 +371,8 @@ def _timeline_figure(
     safety_distance: float,
 ) -> None:
     times = telemetry["time"]
-    speed = np.linalg.norm(_stack(telemetry, ("vx", "vy", "vz")), axis=1)
-    thrust = np.linalg.norm(_stack(telemetry, ("fx", "fy", "fz")), axis=1)
+    speed = np.linalg.norm(stacked(telemetry, ("vx", "vy", "vz")), axis=1)
+    thrust = np.linalg.norm(stacked(telemetry, ("fx", "fy", "fz")), axis=1)
     robot = scenario.robot
     figure, axes = plt.subplots(5, 1, figsize=(11, 12), sharex=True)
     _limited(axes[0], times, speed, robot.max_speed, "speed [m/s]", "Speed", "max_speed")

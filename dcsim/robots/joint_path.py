@@ -165,10 +165,10 @@ class JointPath:
 
     def _rates(self, t: float, theta: Array) -> Array:
         """``θ̇`` of the module's equation."""
-        q = self._state(theta)
-        jac = self.model.jacobian(q)[:3, 6:]
+        kin = self.model.kinematics(self._state(theta))
+        jac = kin.jacobian[:3, 6:]
         position, velocity, _ = self._path_at(t)
-        drift = position - self.model.forward_kinematics(q).end_effector
+        drift = position - kin.end_effector
         wanted = velocity + self.gain * drift
         return jac.T @ np.linalg.solve(jac @ jac.T, wanted)
 

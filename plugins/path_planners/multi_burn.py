@@ -78,6 +78,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+from dcsim_plugins.path_planners.deadline import OutOfTime, check
 from dcsim_plugins.path_planners.obstacle_field import ObstacleField, endpoint_refusal
 from dcsim_plugins.path_planners.relative_motion import (
     BurnPlan,
@@ -191,10 +192,6 @@ class MultiBurnParams(PluginParams):
     sample_step: float = quantity(
         5.0, unit="s", gt=0, description="Time between samples of the returned trajectory."
     )
-
-
-class OutOfTime(Exception):
-    """The planning budget ran out."""
 
 
 @dataclass
@@ -468,8 +465,7 @@ class BurnSearch:
         )
 
     def _check_time(self) -> None:
-        if time.monotonic() > self.deadline:
-            raise OutOfTime
+        check(self.deadline, f"{self.statistics.plans_tried} plans tried")
 
     # ------------------------------------------------------------------ two burns
     def two_burn(self) -> Candidate:
@@ -753,7 +749,7 @@ class MultiBurnPlanner(PathPlanner):
 
     def plan(self, problem: PathProblem) -> Trajectory | NoPath:
         """Search plans of more and more burns; the cheapest clear one, or why there is none."""
-        deadline = time.monotonic() + problem.time_budget
+        deadline = time.perf_counter() + problem.time_budget
         search = BurnSearch(problem, self.params)
         refusal = endpoint_refusal(problem, search.obstacles)
         if refusal is not None:
