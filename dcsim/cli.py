@@ -19,10 +19,11 @@ from typing import TYPE_CHECKING
 import click
 
 from dcsim import __version__
+from dcsim.cli_campaign import campaign_group
 from dcsim.errors import DcsimError, PluginLoadWarning
 from dcsim.interfaces import PLUGIN_KINDS
 from dcsim.registry import PluginRegistry
-from dcsim.rundir import prepare_run_directory
+from dcsim.rundir import file_name_part, prepare_run_directory
 from dcsim.runsetup import prepare_run
 from dcsim.scenario import load_scenario
 from dcsim.scenario.model import MAX_SEED
@@ -171,7 +172,7 @@ def run_command(
     setup = prepare_run(scenario, overrides, seed, registry=_registry())
     if out is None:
         stamp = f"{datetime.now():%Y%m%d-%H%M%S}"
-        out = Path("runs") / f"{_file_name_part(setup.scenario.name)}-{stamp}"
+        out = Path("runs") / f"{file_name_part(setup.scenario.name)}-{stamp}"
     prepare_run_directory(out, force)
     summary = Runner(setup, out, progress=terminal_progress()).run()
     if sys.stderr.isatty():
@@ -181,11 +182,6 @@ def run_command(
         sys.exit(130)
     if summary["status"] == "failed":
         sys.exit(1)
-
-
-def _file_name_part(name: str) -> str:
-    """``name`` made safe inside a file name: no separators or control characters, short."""
-    return re.sub(r"[\x00-\x1f\x7f/\\]", "_", name)[:50]
 
 
 def _print_summary(summary: dict, out: Path) -> None:
@@ -1251,6 +1247,9 @@ def _start_values(settings: tuple[str, ...]) -> dict[str, dict[str, float]]:
                 f"{setting!r}: {text!r} is not a number", param_hint="--set"
             ) from None
     return values
+
+
+cli.add_command(campaign_group)
 
 
 def main() -> None:

@@ -62,14 +62,22 @@ class ScenarioError(DcsimError):
         Every problem found, in document order.
     """
 
+    document = "scenario"
+    """What kind of document the file is, for the message's first line."""
+
     def __init__(self, filename: str, problems: list[Problem]) -> None:
         self.filename = filename
         self.problems = list(problems)
         lines = [p.describe(filename) for p in self.problems]
-        head = (
-            f"{filename}: invalid scenario ({len(lines)} problem{'s' if len(lines) != 1 else ''})"
-        )
+        count = f"{len(lines)} problem{'s' if len(lines) != 1 else ''}"
+        head = f"{filename}: invalid {self.document} ({count})"
         super().__init__("\n".join([head, *("  " + line for line in lines)]))
+
+
+class CampaignError(ScenarioError):
+    """A campaign file does not describe a valid campaign (same form as a scenario's)."""
+
+    document = "campaign"
 
 
 class RobotTypeError(DcsimError):

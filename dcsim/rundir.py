@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import shutil
 import tempfile
 from pathlib import Path
@@ -56,6 +57,11 @@ def prepare_run_directory(path: Path, force: bool = False) -> Path:
             f"cannot write the run directory {path}: {_reason(error)}"
         ) from None
     return path
+
+
+def file_name_part(name: str) -> str:
+    """``name`` made safe inside a file name: no separators or control characters, short."""
+    return re.sub(r"[\x00-\x1f\x7f/\\]", "_", name)[:50]
 
 
 def _empty(path: Path) -> None:

@@ -45,6 +45,18 @@ from dcsim.world import World, WorldInputs
 PLOT_POINTS = 2000
 """Telemetry rows the end-of-run plots draw at most (evenly spaced)."""
 
+SUMMARY_FIGURES = (
+    "sim_time_s",
+    "wall_time_s",
+    "real_time_factor",
+    "collisions",
+    "fuel_used_kg",
+    "delta_v_mps",
+    "localisation_rmse_m",
+    "min_obstacle_distance_m",
+)
+"""The numeric fields of every run's summary; a mission adds its ``summary_names``."""
+
 Progress = Callable[[float, float, str, str], None]
 """``progress(sim_time, duration, mode, mission_progress)``: times in s."""
 
@@ -111,6 +123,9 @@ class Runner:
         Keep every telemetry row in memory (``recorder.rows``); by default only when
         there is no run directory. A long run that needs only its summary (an FMU)
         passes False, so memory stays flat.
+    plots : bool, optional
+        Draw the mission's plots into ``plots/`` of the run directory at the end
+        (default); a campaign's cases usually skip them.
 
     Attributes
     ----------
@@ -135,8 +150,10 @@ class Runner:
         out_dir: Path | None = None,
         progress: Progress | None = None,
         keep_rows: bool | None = None,
+        plots: bool = True,
     ) -> None:
         self.setup = setup
+        self.plots = plots
         self.scenario = setup.scenario
         self.plugins = setup.plugins
         self.mission_class = mission_class(self.scenario.mission.type)
@@ -254,7 +271,7 @@ class Runner:
 
     def _plot(self) -> None:
         """Draw the run's pictures from its telemetry file."""
-        if self.info.out_dir is None:
+        if self.info.out_dir is None or not self.plots:
             return
         try:
             self.mission.plot(

@@ -65,6 +65,9 @@ class Mission(ABC):
     robots : tuple of str
         The robot types (``robot.type``) it can fly; a scenario pairing it with another
         is refused before the run.
+    summary_names : tuple of str
+        The keys of :meth:`summary_fields`, known before a run (a campaign checks the
+        metrics it collects against them).
     """
 
     type: ClassVar[str]
@@ -74,6 +77,7 @@ class Mission(ABC):
     modes: ClassVar[tuple[str, ...]]
     columns: ClassVar[tuple[str, ...]] = ()
     robots: ClassVar[tuple[str, ...]] = ("free-flyer",)
+    summary_names: ClassVar[tuple[str, ...]] = ()
 
     def __init__(
         self, scenario: Scenario, world: World, plugins: Mapping[str, Plugin], emit: Emit

@@ -83,6 +83,7 @@ class DebrisMission(Mission):
     summary = "collect drifting targets and deliver them to a drop point (the source thesis)"
     Settings = DebrisMissionSection
     roles = ("localiser", "task_planner", "path_planner", "controller")
+    summary_names = ("targets", "captured", "delivered")
     modes = tuple(mode.name for mode in Mode)
     columns = ("carried", "delivered")
     settings: DebrisMissionSection

@@ -73,6 +73,19 @@ class ReachMission(Mission):
     summary = "move a space manipulator's end effector to a target"
     Settings = ReachMissionSection
     roles = ("path_planner", "controller")
+    summary_names = (
+        "reached",
+        "time_to_target_s",
+        "path_duration_s",
+        "planning_time_s",
+        "final_target_distance_m",
+        "max_ee_tracking_error_m",
+        "max_joint_tracking_error_deg",
+        "min_det_jjt",
+        "max_target_angle_deg",
+        "max_base_displacement_m",
+        "ee_displacement_m",
+    )
     modes = ("PLAN", "HOLD", "REACH", "ARRIVED")
     robots = ("manipulator",)
     settings: ReachMissionSection

@@ -71,6 +71,16 @@ class TransferMission(Mission):
     summary = "fly from the initial state to a goal region among obstacles"
     Settings = TransferMissionSection
     roles = ("path_planner", "controller")
+    summary_names = (
+        "reached",
+        "time_to_goal_s",
+        "planned_delta_v_mps",
+        "planning_time_s",
+        "replans",
+        "nodes_expanded",
+        "min_clearance_m",
+        "max_tracking_error_m",
+    )
     modes = ("PLAN", "HOLD", "FLY", "ARRIVED")
     columns = ("ref_x", "ref_y", "ref_z", "tracking_error", "goal_distance")
     settings: TransferMissionSection

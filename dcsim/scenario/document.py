@@ -58,6 +58,31 @@ def parse_key_path(text: str) -> KeyPath:
     return tuple(path)
 
 
+def read_document_text(path: str | Path) -> str:
+    """The text of the YAML file at ``path``.
+
+    Raises
+    ------
+    ScenarioError
+        If the file cannot be read, is larger than
+        :data:`~dcsim.scenario.yamltext.MAX_FILE_BYTES`, or is not UTF-8 text.
+    """
+    try:
+        with Path(path).open("rb") as file:
+            raw = file.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise ScenarioError(
+            str(path), [Problem("", f"cannot read the file: {exc.strerror}")]
+        ) from None
+    if len(raw) > MAX_FILE_BYTES:
+        message = f"the file is larger than {MAX_FILE_BYTES:,} bytes; a scenario needs far less"
+        raise ScenarioError(str(path), [Problem("", message)])
+    try:
+        return decode(raw)
+    except YamlInputError as exc:
+        raise ScenarioError(str(path), [Problem("", str(exc), exc.line, exc.column)]) from None
+
+
 @dataclass
 class ScenarioDocument:
     """A scenario's raw data with source positions.
@@ -115,25 +140,9 @@ class ScenarioDocument:
         Raises
         ------
         ScenarioError
-            If the file cannot be read, is larger than
-            :data:`~dcsim.scenario.yamltext.MAX_FILE_BYTES`, is not UTF-8 text, or cannot
-            be parsed.
+            If the file cannot be read (see :func:`read_document_text`) or parsed.
         """
-        try:
-            with Path(path).open("rb") as file:
-                raw = file.read(MAX_FILE_BYTES + 1)
-        except OSError as exc:
-            raise ScenarioError(
-                str(path), [Problem("", f"cannot read the file: {exc.strerror}")]
-            ) from None
-        if len(raw) > MAX_FILE_BYTES:
-            message = f"the file is larger than {MAX_FILE_BYTES:,} bytes; a scenario needs far less"
-            raise ScenarioError(str(path), [Problem("", message)])
-        try:
-            text = decode(raw)
-        except YamlInputError as exc:
-            raise ScenarioError(str(path), [Problem("", str(exc), exc.line, exc.column)]) from None
-        return cls.from_text(text, str(path))
+        return cls.from_text(read_document_text(path), str(path))
 
     def _collect_marks(self, node: yaml.Node, path: KeyPath, duplicates: list[Problem]) -> None:
         if isinstance(node, yaml.MappingNode):

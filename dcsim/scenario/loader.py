@@ -96,7 +96,7 @@ def validate(doc: ScenarioDocument) -> Scenario:
     try:
         scenario = model.model_validate(doc.data)
     except ValidationError as exc:
-        problems = _schema_problems(doc, exc, model)
+        problems = schema_problems(doc, exc, model)
     else:
         problems = []
     violations = _rule_violations(doc.data, model)
@@ -435,10 +435,10 @@ def _scenario_model(doc: ScenarioDocument) -> type[Scenario]:
     return scenario_model(missions[mission_type].Settings)
 
 
-def _schema_problems(
-    doc: ScenarioDocument, exc: ValidationError, model: type[Scenario]
+def schema_problems(
+    doc: ScenarioDocument, exc: ValidationError, model: type[BaseModel]
 ) -> list[Problem]:
-    """Turn pydantic errors into problems located at their keys in the document."""
+    """Turn pydantic errors of ``model`` into problems located at their keys in ``doc``."""
     messages: dict[KeyPath, list[str]] = {}
     for err in exc.errors():
         path, owner, field = _locate(doc.data, err["loc"], model)

@@ -1,0 +1,177 @@
+"""``dcsim campaign``: run, resume and replay campaigns from the command line."""
+
+from __future__ import annotations
+
+import sys
+from datetime import datetime
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import click
+
+from dcsim.rundir import file_name_part
+
+if TYPE_CHECKING:
+    from dcsim.campaign import CampaignRun, ClusterOptions
+
+EXIT_INTERRUPTED = 130
+
+
+@click.group("campaign")
+def campaign_group() -> None:
+    """Many cases of one scenario on Dask: Monte Carlo draws and sweeps (docs/campaigns.md)."""
+
+
+def _cluster_options(command: click.Command) -> click.Command:
+    """The options that choose where cases run."""
+    options = [
+        click.option(
+            "--scheduler",
+            metavar="tcp://HOST:PORT",
+            help="Run on this existing Dask scheduler (its workers need dcsim and the "
+            "campaign's plugins installed, and the campaign directory at the same path). "
+            "Default: a local cluster.",
+        ),
+        click.option(
+            "--workers",
+            type=click.IntRange(min=1, max=1024),
+            help="Worker processes of the local cluster. Default: one per core.",
+        ),
+        click.option(
+            "--worker-deaths",
+            type=click.IntRange(min=1, max=100),
+            default=3,
+            show_default=True,
+            help="Workers that may die running one case (killed, out of memory) before "
+            "it is a failed case. Local cluster only.",
+        ),
+    ]
+    for option in reversed(options):
+        command = option(command)
+    return command
+
+
+@campaign_group.command("run")
+@click.argument("campaign", type=click.Path(dir_okay=False, path_type=Path))
+@click.option(
+    "--out",
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Campaign directory to write. Default: runs/campaigns/NAME-YYYYmmdd-HHMMSS.",
+)
+@click.option("--force", is_flag=True, help="Replace the campaign directory if it holds anything.")
+@click.option(
+    "--cases",
+    type=click.IntRange(min=1),
+    help="Run only the first N cases (the same N cases every time).",
+)
+@_cluster_options
+def run_command(
+    campaign: Path,
+    out: Path | None,
+    force: bool,
+    cases: int | None,
+    scheduler: str | None,
+    workers: int | None,
+    worker_deaths: int,
+) -> None:
+    """Run the cases of CAMPAIGN (a campaign file) and collect their results.
+
+    Every case is generated and checked before anything runs. Each case writes its run
+    directory under DIR/cases/; as cases end their results are appended to
+    DIR/results.jsonl, and at the end DIR/results.csv, results.parquet,
+    statistics.csv and plots/ are written. Ctrl-C keeps the finished cases; `dcsim
+    campaign resume DIR` runs the rest. A failed case is a row with its reason (exit
+    status 0); exit status 130 when interrupted.
+    """
+    from dcsim.campaign import load_campaign, run_campaign
+
+    loaded = load_campaign(campaign)
+    if out is None:
+        stamp = f"{datetime.now():%Y%m%d-%H%M%S}"
+        out = Path("runs") / "campaigns" / f"{file_name_part(loaded.spec.name)}-{stamp}"
+    options = _options(scheduler, workers, worker_deaths)
+    count = loaded.spec.total_cases if cases is None else min(cases, loaded.spec.total_cases)
+    click.echo(f"campaign {loaded.spec.name}: {count} cases {_where(options)} → {out}", err=True)
+    _report(run_campaign(loaded, out, options, cases, force))
+
+
+@campaign_group.command("resume")
+@click.argument("directory", type=click.Path(file_okay=False, exists=True, path_type=Path))
+@_cluster_options
+def resume_command(
+    directory: Path, scheduler: str | None, workers: int | None, worker_deaths: int
+) -> None:
+    """Run the cases of campaign DIRECTORY that have no result yet (after Ctrl-C or a crash)."""
+    from dcsim.campaign import resume_campaign
+
+    options = _options(scheduler, workers, worker_deaths)
+    click.echo(f"resuming {directory} {_where(options)}", err=True)
+    _report(resume_campaign(directory, options))
+
+
+@campaign_group.command("rerun")
+@click.argument("directory", type=click.Path(file_okay=False, exists=True, path_type=Path))
+@click.option("--case", "index", type=click.IntRange(min=0), required=True, help="Case index.")
+@click.option(
+    "--out",
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Run directory of the replay. Default: DIRECTORY/reruns/case-NNNNNN.",
+)
+def rerun_command(directory: Path, index: int, out: Path | None) -> None:
+    """Run one case of campaign DIRECTORY again here and compare it with its recorded run.
+
+    Exit status 1 when its telemetry or events differ from the recorded run's.
+    """
+    from dcsim.campaign import replay_case
+
+    replay = replay_case(directory, index, out)
+    summary = replay.summary
+    click.echo(f"case {index} (seed {replay.case.seed}): {summary['status']} ({summary['reason']})")
+    for name, same in replay.identical.items():
+        click.echo(f"  {name}: {'identical to' if same else 'DIFFERS from'} the recorded run")
+    click.echo(f"  replay in {replay.out}")
+    if not all(replay.identical.values()):
+        sys.exit(1)
+
+
+def _options(scheduler: str | None, workers: int | None, worker_deaths: int) -> ClusterOptions:
+    from dcsim.campaign import ClusterOptions
+
+    if scheduler is not None and workers is not None:
+        raise click.BadParameter(
+            "--workers sizes the local cluster; an existing scheduler has its own workers",
+            param_hint="--workers",
+        )
+    return ClusterOptions(scheduler, workers, worker_deaths)
+
+
+def _where(options: ClusterOptions) -> str:
+    from dcsim.campaign.engine import local_worker_count
+
+    if options.scheduler is not None:
+        return f"on the cluster at {options.scheduler}"
+    count = options.workers or local_worker_count()
+    return f"on a local cluster of {count} worker{'s' if count != 1 else ''}"
+
+
+def _report(run: CampaignRun) -> None:
+    """Print the outcome counts and the statistics; exit 130 if interrupted."""
+    table = run.table
+    counts = table["status"].value_counts()
+    click.echo(", ".join(f"{count} {status}" for status, count in counts.items()))
+    failed = table[table["status"] == "failed"]
+    for row in failed.head(5).itertuples():
+        click.echo(f"  case {row.case} failed: {row.reason}")
+    if len(failed) > 5:
+        click.echo(f"  and {len(failed) - 5} more failed cases (results.csv has every reason)")
+    if len(run.statistics):
+        shown = run.statistics.drop(columns=["std", "p5", "p95"], errors="ignore")
+        click.echo(shown.to_string(index=False, float_format=lambda x: f"{x:.4g}"))
+    click.echo(f"results in {run.directory}")
+    if run.interrupted:
+        click.echo(
+            f"interrupted: the finished cases are kept; dcsim campaign resume {run.directory} "
+            "runs the rest",
+            err=True,
+        )
+        sys.exit(EXIT_INTERRUPTED)
