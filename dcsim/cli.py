@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 import click
 
 from dcsim import __version__
-from dcsim.cli_campaign import campaign_group
+from dcsim.cli_campaign import campaign_group, cluster_choice, cluster_options
 from dcsim.errors import DcsimError, PluginLoadWarning
 from dcsim.interfaces import PLUGIN_KINDS
 from dcsim.registry import PluginRegistry
@@ -497,13 +497,7 @@ def bench_task_planners_command(
     show_default=True,
     help="Comma-separated controller plugins (default parameters).",
 )
-@click.option(
-    "--workers",
-    type=click.IntRange(min=1),
-    default=2,
-    show_default=True,
-    help="Runs flown at once (processes).",
-)
+@cluster_options
 @click.option(
     "--set",
     "overrides",
@@ -521,7 +515,9 @@ def bench_controllers_command(
     seeds: int,
     first_seed: int,
     controllers: str,
-    workers: int,
+    scheduler: str | None,
+    workers: int | None,
+    worker_deaths: int,
     overrides: tuple[str, ...],
     plot_path: Path | None,
 ) -> None:
@@ -529,6 +525,7 @@ def bench_controllers_command(
 
     Reports per controller the runs with a collision, the closest approach to any
     obstacle, delta-v and mission time as a Markdown table for docs/benchmarks.md.
+    The runs are campaign cases on Dask (a local cluster unless --scheduler).
     """
     from dcsim.bench.controllers import bench_controllers, markdown_table, plot
     from dcsim.scenario import packaged_scenario_path
@@ -546,7 +543,7 @@ def bench_controllers_command(
         names,
         range(first_seed, first_seed + seeds),
         overrides,
-        workers,
+        cluster_choice(scheduler, workers, worker_deaths),
         progress=lambda line: click.echo(line, err=True),
     )
     click.echo(markdown_table(runs))

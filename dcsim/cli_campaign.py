@@ -22,8 +22,9 @@ def campaign_group() -> None:
     """Many cases of one scenario on Dask: Monte Carlo draws and sweeps (docs/campaigns.md)."""
 
 
-def _cluster_options(command: click.Command) -> click.Command:
-    """The options that choose where cases run."""
+def cluster_options(command: click.Command) -> click.Command:
+    """Add the options that choose where cases run (``--scheduler``, ``--workers``,
+    ``--worker-deaths``) to a command."""
     options = [
         click.option(
             "--scheduler",
@@ -64,7 +65,7 @@ def _cluster_options(command: click.Command) -> click.Command:
     type=click.IntRange(min=1),
     help="Run only the first N cases (the same N cases every time).",
 )
-@_cluster_options
+@cluster_options
 def run_command(
     campaign: Path,
     out: Path | None,
@@ -89,7 +90,7 @@ def run_command(
     if out is None:
         stamp = f"{datetime.now():%Y%m%d-%H%M%S}"
         out = Path("runs") / "campaigns" / f"{file_name_part(loaded.spec.name)}-{stamp}"
-    options = _options(scheduler, workers, worker_deaths)
+    options = cluster_choice(scheduler, workers, worker_deaths)
     count = loaded.spec.total_cases if cases is None else min(cases, loaded.spec.total_cases)
     click.echo(f"campaign {loaded.spec.name}: {count} cases {_where(options)} → {out}", err=True)
     _report(run_campaign(loaded, out, options, cases, force))
@@ -97,14 +98,14 @@ def run_command(
 
 @campaign_group.command("resume")
 @click.argument("directory", type=click.Path(file_okay=False, exists=True, path_type=Path))
-@_cluster_options
+@cluster_options
 def resume_command(
     directory: Path, scheduler: str | None, workers: int | None, worker_deaths: int
 ) -> None:
     """Run the cases of campaign DIRECTORY that have no result yet (after Ctrl-C or a crash)."""
     from dcsim.campaign import resume_campaign
 
-    options = _options(scheduler, workers, worker_deaths)
+    options = cluster_choice(scheduler, workers, worker_deaths)
     click.echo(f"resuming {directory} {_where(options)}", err=True)
     _report(resume_campaign(directory, options))
 
@@ -134,7 +135,10 @@ def rerun_command(directory: Path, index: int, out: Path | None) -> None:
         sys.exit(1)
 
 
-def _options(scheduler: str | None, workers: int | None, worker_deaths: int) -> ClusterOptions:
+def cluster_choice(
+    scheduler: str | None, workers: int | None, worker_deaths: int
+) -> ClusterOptions:
+    """The cluster the options chose; ``--workers`` with ``--scheduler`` is an error."""
     from dcsim.campaign import ClusterOptions
 
     if scheduler is not None and workers is not None:

@@ -5,13 +5,13 @@ the one written in ``scenarios/crowded_field.yaml``) and flies the crowded-field
 with each controller; the world's seed is the same number, so both controllers meet
 the same field and the same sensor noise. A run records its collisions (the scenario
 does not stop at the first), the least surface gap to any obstacle, the delta-v and
-the mission time.
+the mission time. The runs are cases on the campaign engine (:mod:`dcsim.campaign`):
+a local Dask cluster, or an existing one by address.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,6 +19,8 @@ import numpy as np
 import yaml
 
 from dcsim.bench.figures import pyplot, save
+from dcsim.campaign.engine import ClusterOptions, TaskOutcome, dask_client, run_tasks
+from dcsim.errors import DcsimError
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
 
@@ -72,10 +74,18 @@ class ControllerRun:
     targets: int
 
 
-def fly(scenario: Path, controller: str, seed: int, overrides: Sequence[str] = ()) -> ControllerRun:
-    """Fly ``scenario`` with ``controller`` on seed ``seed``'s field (nothing written).
+@dataclass(frozen=True)
+class ControllerCase:
+    """One controller on one seed's field of a scenario, with extra overrides."""
 
-    ``overrides`` (``key.path=value``) apply after the field and the controller's choice.
+    scenario: Path
+    controller: str
+    seed: int
+    overrides: tuple[str, ...] = ()
+
+
+def fly(case: ControllerCase) -> ControllerRun:
+    """Fly ``case`` (nothing written); its overrides apply after the field and the controller.
 
     Raises
     ------
@@ -83,13 +93,20 @@ def fly(scenario: Path, controller: str, seed: int, overrides: Sequence[str] = (
         If the run did not complete (a plugin failed, or a stop rule other than a
         collision ended it): its figures would not be comparable.
     """
-    chosen = [field_override(seed), f"controller.plugin={controller}", "controller.params={}"]
-    summary = Runner(prepare_run(scenario, [*chosen, *overrides], seed), None).run()
+    chosen = [
+        field_override(case.seed),
+        f"controller.plugin={case.controller}",
+        "controller.params={}",
+    ]
+    setup = prepare_run(case.scenario, [*chosen, *case.overrides], case.seed)
+    summary = Runner(setup, None).run()
     if summary["status"] != "completed":
-        raise RuntimeError(f"{controller} on seed {seed}: {summary['status']}, {summary['reason']}")
+        raise RuntimeError(
+            f"{case.controller} on seed {case.seed}: {summary['status']}, {summary['reason']}"
+        )
     return ControllerRun(
-        controller,
-        seed,
+        case.controller,
+        case.seed,
         summary["collisions"],
         summary["min_obstacle_distance_m"],
         summary["delta_v_mps"],
@@ -104,25 +121,40 @@ def bench_controllers(
     controllers: Sequence[str],
     seeds: Iterable[int],
     overrides: Sequence[str] = (),
-    workers: int = 2,
+    cluster: ClusterOptions | None = None,
     progress: Callable[[str], None] = print,
 ) -> list[ControllerRun]:
-    """Fly every controller on the fields of ``seeds``, ``workers`` runs at a time."""
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        jobs = [
-            pool.submit(fly, scenario, controller, seed, tuple(overrides))
-            for seed in seeds
-            for controller in controllers
-        ]
-        runs = []
-        for job in jobs:
-            runs.append(job.result())
-            run = runs[-1]
-            progress(
-                f"{run.controller} seed {run.seed}: {run.collisions} collisions, "
-                f"closest {run.min_distance:.2f} m, delta-v {run.delta_v:.2f} m/s"
-            )
-    return runs
+    """Fly every controller on the fields of ``seeds`` as cases on a Dask cluster.
+
+    Returns
+    -------
+    list of ControllerRun
+        Seed by seed, the controllers in the order given.
+
+    Raises
+    ------
+    DcsimError
+        At the first run that did not complete (the others are cancelled).
+    """
+    cases = [
+        ControllerCase(scenario, controller, seed, tuple(overrides))
+        for seed in seeds
+        for controller in controllers
+    ]
+    runs: dict[int, ControllerRun] = {}
+
+    def record(outcome: TaskOutcome) -> None:
+        if outcome.error is not None:
+            raise DcsimError(f"bench controllers: {outcome.error}")
+        run = runs[outcome.index] = outcome.value
+        progress(
+            f"{run.controller} seed {run.seed}: {run.collisions} collisions, "
+            f"closest {run.min_distance:.2f} m, delta-v {run.delta_v:.2f} m/s"
+        )
+
+    with dask_client(cluster or ClusterOptions()) as client:
+        run_tasks(client, fly, dict(enumerate(cases)), record, name="dcsim-bench-controllers")
+    return [runs[index] for index in range(len(cases))]
 
 
 def markdown_table(runs: list[ControllerRun]) -> str:

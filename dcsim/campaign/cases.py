@@ -92,7 +92,7 @@ def draw_seed(campaign_seed: int, draw: int) -> int:
 
 def override_text(path: str, value: Any) -> str:
     """The ``--set`` text assigning ``value`` (plain data) to ``path``; it reads back equal."""
-    text = yaml.safe_dump(value, default_flow_style=True, width=2**31, allow_unicode=True)
+    text = yaml.safe_dump(value, default_flow_style=True, width=2**31)
     end_of_document = "\n...\n"  # PyYAML ends a lone scalar with it
     return f"{path}={text.removesuffix(end_of_document).strip()}"
 

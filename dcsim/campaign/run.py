@@ -21,7 +21,8 @@ import json
 import os
 import shutil
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any, TextIO
@@ -125,20 +126,25 @@ def run_campaign(
     registry = PluginRegistry.discover()
     selected = campaign_cases(campaign, registry, cases)
     metrics = metric_names(campaign, validate(campaign.base).mission.type)
-    prepare_run_directory(out, force)
-    (out / CAMPAIGN_FILE).write_text(campaign.text, encoding="utf-8")
-    (out / BASE_FILE).write_text(campaign.base_text, encoding="utf-8")
-    manifest = {
-        "name": campaign.spec.name,
-        "campaign_file": campaign.filename,
-        "base_scenario": campaign.base.filename,
-        "cases": len(selected),
-        "total_cases": campaign.spec.total_cases,
-        "dcsim_version": __version__,
-        "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-    }
-    (out / MANIFEST_FILE).write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
-    return _execute(out, campaign, selected, metrics, cluster, {}, stream)
+    if not force and out.is_dir() and any(out.iterdir()):
+        prepare_run_directory(out)  # refused now, before a cluster starts
+
+    def prepare() -> None:
+        prepare_run_directory(out, force)
+        (out / CAMPAIGN_FILE).write_text(campaign.text, encoding="utf-8")
+        (out / BASE_FILE).write_text(campaign.base_text, encoding="utf-8")
+        manifest = {
+            "name": campaign.spec.name,
+            "campaign_file": campaign.filename,
+            "base_scenario": campaign.base.filename,
+            "cases": len(selected),
+            "total_cases": campaign.spec.total_cases,
+            "dcsim_version": __version__,
+            "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+        }
+        (out / MANIFEST_FILE).write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
+
+    return _execute(out, campaign, selected, metrics, cluster, {}, stream, prepare)
 
 
 def resume_campaign(
@@ -237,27 +243,34 @@ def _execute(
     cluster: ClusterOptions | None,
     finished: Mapping[int, dict[str, Any]],
     stream: TextIO | None,
+    prepare: Callable[[], None] | None = None,
 ) -> CampaignRun:
-    """Run the cases without a result; write the table whatever happens."""
-    cases_dir = directory / CASES_DIR
-    cases_dir.mkdir(exist_ok=True)
-    _remove_attempts(cases_dir)
+    """Run the cases without a result; write the table whatever happens.
+
+    ``prepare`` (making the directory) is called once the cluster is reached, so that
+    a cluster that cannot be reached leaves nothing behind.
+    """
     results = dict(finished)
-    tasks = {
-        case.index: CaseTask(
-            cases_dir, campaign.spec.name, campaign.base, case, campaign.spec.case_plots
-        )
-        for case in cases
-        if case.index not in results
-    }
-    progress = CampaignProgress(len(tasks), stream)
+    pending = [case for case in cases if case.index not in results]
+    progress = CampaignProgress(len(pending), stream)
     interrupted = False
-    with (directory / JOURNAL_FILE).open("a", encoding="utf-8") as journal:
+    with ExitStack() as stack:
+        client = stack.enter_context(dask_client(cluster or ClusterOptions())) if pending else None
+        if prepare is not None:
+            prepare()
+        cases_dir = directory / CASES_DIR
+        cases_dir.mkdir(exist_ok=True)
+        _remove_attempts(cases_dir)
+        tasks = {
+            case.index: CaseTask(
+                cases_dir, campaign.spec.name, campaign.base, case, campaign.spec.case_plots
+            )
+            for case in pending
+        }
+        journal = stack.enter_context((directory / JOURNAL_FILE).open("a", encoding="utf-8"))
         try:
             if tasks:
-                with dask_client(cluster or ClusterOptions()) as client:
-                    record = _Recorder(journal, results, progress, client)
-                    run_tasks(client, run_case, tasks, record)
+                run_tasks(client, run_case, tasks, _Recorder(journal, results, progress, client))
         except KeyboardInterrupt:
             interrupted = True
         finally:

@@ -3,8 +3,18 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
-from dcsim.bench.controllers import FIELD_BOX, crowded_obstacles, field_override
+from dcsim.bench.controllers import (
+    FIELD_BOX,
+    ControllerCase,
+    bench_controllers,
+    crowded_obstacles,
+    field_override,
+    fly,
+)
+from dcsim.campaign import ClusterOptions
+from dcsim.errors import DcsimError
 from dcsim.scenario import load_scenario, packaged_scenario_path
 from tests.conftest import REPO
 
@@ -28,3 +38,20 @@ def test_every_seed_draws_another_field_inside_the_slab():
     # The field travels as a scenario override that validates.
     scenario = load_scenario(packaged_scenario_path("crowded_field.yaml"), [field_override(3)])
     assert [o.id for o in scenario.obstacles] == [o["id"] for o in crowded_obstacles(3)]
+
+
+@pytest.mark.xdist_group("dask")
+def test_the_bench_flies_its_cases_on_the_campaign_engine_as_in_process():
+    scenario = packaged_scenario_path("crowded_field.yaml")
+    short = ("world.duration=6.0",)
+    lines = []
+    runs = bench_controllers(
+        scenario, ["pd", "elastic"], [3], short, ClusterOptions(workers=2), lines.append
+    )
+    assert [(r.controller, r.seed) for r in runs] == [("pd", 3), ("elastic", 3)]
+    assert runs == [fly(ControllerCase(scenario, r.controller, 3, short)) for r in runs]
+    assert len(lines) == 2
+    with pytest.raises(DcsimError, match="bench controllers: RuntimeError: pd on seed 3: stopped"):
+        bench_controllers(
+            scenario, ["pd"], [3], (*short, "stop.max_wall_time=0.001"), ClusterOptions(workers=1)
+        )
