@@ -49,11 +49,18 @@ Geometry
 FMUs (FMI 2.0 co-simulation, through fmpy)
     :class:`FmuDescription`, :class:`FmuInstance`, :class:`FmuError`,
     :class:`FmuCallError`.
+Campaigns (many cases of a scenario on Dask; docs/campaigns.md)
+    :func:`run_campaign`.
 Registry and hooks
     :data:`hookimpl`, :class:`PluginRegistry`.
 Errors
     :class:`DcsimError` and its subclasses.
 """
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 from dcsim.clearance import (
     Clearance,
@@ -145,7 +152,11 @@ from dcsim.robots.manipulator import (
 )
 from dcsim.robots.urdf import urdf_text as manipulator_urdf
 
+if TYPE_CHECKING:
+    import pandas
+
 __all__ = [
+    "run_campaign",
     "array_field",
     "BeaconRange",
     "body_surface_distance",
@@ -243,3 +254,45 @@ __all__ = [
     "Trajectory",
     "unit",
 ]
+
+
+def run_campaign(
+    campaign: str | Path,
+    out: str | Path,
+    *,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    cases: int | None = None,
+    force: bool = False,
+) -> pandas.DataFrame:
+    """Run a campaign file's cases on Dask and return their results table.
+
+    The same as ``dcsim campaign run`` (docs/campaigns.md): each case's run directory
+    and the results files are written under ``out``.
+
+    Parameters
+    ----------
+    campaign : str or Path
+        The campaign file.
+    out : str or Path
+        The campaign directory to write.
+    scheduler : str, optional
+        Address of an existing Dask scheduler (``tcp://host:port``); a local cluster
+        when None.
+    workers : int, optional
+        Worker processes of the local cluster (one per core when None).
+    cases : int, optional
+        Run only the first ``cases`` cases.
+    force : bool
+        Replace ``out`` if it holds anything.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per case: index, seed, dispersed values, status, reason, metrics.
+    """
+    from dcsim.campaign import ClusterOptions
+    from dcsim.campaign import run_campaign as run
+
+    options = ClusterOptions(scheduler, workers)
+    return run(Path(campaign), Path(out), options, cases, force).table

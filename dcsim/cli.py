@@ -552,6 +552,59 @@ def bench_controllers_command(
         click.echo(f"plot: {plot_path}")
 
 
+@bench_group.command("campaign")
+@click.argument(
+    "campaign",
+    required=False,
+    type=click.Path(dir_okay=False, exists=True, path_type=Path),
+)
+@click.option(
+    "--cases", type=click.IntRange(min=1), default=40, show_default=True, help="Cases run."
+)
+@click.option(
+    "--workers",
+    default="1,2",
+    show_default=True,
+    help="Comma-separated local cluster sizes (1 is always run: the reference).",
+)
+@click.option(
+    "--duration",
+    type=click.FloatRange(min=0, min_open=True),
+    default=300.0,
+    show_default=True,
+    help="world.duration of every case, s.",
+)
+@click.option(
+    "--out",
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Folder for the run directories. Default: a temporary folder, removed after.",
+)
+def bench_campaign_command(
+    campaign: Path | None, cases: int, workers: str, duration: float, out: Path | None
+) -> None:
+    """The campaign engine against direct runs: overhead per case and speed-up per worker.
+
+    CAMPAIGN defaults to scenarios/campaigns/default_dispersed.yaml of this checkout.
+    """
+    import tempfile
+
+    from dcsim.bench.campaign import bench_campaign, markdown_table
+
+    if campaign is None:
+        campaign = (
+            Path(__file__).resolve().parents[1] / "scenarios/campaigns/default_dispersed.yaml"
+        )
+        if not campaign.exists():
+            raise click.BadParameter("name a campaign file", param_hint="CAMPAIGN")
+    counts = [int(n) for n in _numbers(workers, "--workers") if n >= 1]
+    with tempfile.TemporaryDirectory() as scratch:
+        folder = out if out is not None else Path(scratch)
+        bench = bench_campaign(
+            campaign, folder, cases, counts, duration, lambda line: click.echo(line, err=True)
+        )
+    click.echo(markdown_table(bench))
+
+
 @bench_group.command("fmu")
 @click.argument("scenario", required=False, type=click.Path(dir_okay=False, path_type=Path))
 @click.option(

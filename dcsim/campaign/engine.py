@@ -9,7 +9,9 @@ have died running it, then it is an outcome with that reason. Ctrl-C cancels wha
 left and is raised again for the caller to keep what finished.
 
 Workers hold one case at a time (``worker-saturation`` 1): a worker that dies takes
-only the case it was running with it.
+only the case it was running with it. A local cluster's workers run without Dask's
+statistical profiler, which samples the running case's stack every 10 ms and cost
+about a quarter of a case's wall time here (docs/benchmarks.md, "Campaigns on Dask").
 """
 
 from __future__ import annotations
@@ -108,6 +110,7 @@ def dask_client(options: ClusterOptions) -> Iterator[Client]:
     settings = {
         "distributed.scheduler.allowed-failures": options.worker_deaths - 1,
         "distributed.scheduler.worker-saturation": 1.0,
+        "distributed.worker.profile.enabled": False,
     }
     try:
         with dask.config.set(settings):

@@ -67,14 +67,14 @@ def results_table(
     rows = []
     for case in cases:
         result = results.get(case.index)
-        summary = result.get("summary") or {} if result else {}
+        summary = (result.get("summary") or {}) if result else {}
         row: dict[str, Any] = {"case": case.index, "draw": case.draw, "seed": case.seed}
         row.update(_value_columns(campaign, case.values))
         row["status"] = result["status"] if result else "not run"
         row["reason"] = result["reason"] if result else ""
         row.update({name: _number(summary.get(name)) for name in metrics})
         row["case_wall_time_s"] = _number(result.get("wall_time_s")) if result else np.nan
-        row["run_dir"] = f"cases/{case.name}" if result and summary.get("sim_time_s") else ""
+        row["run_dir"] = f"cases/{case.name}" if "sim_time_s" in summary else ""
         rows.append(row)
     return pandas.DataFrame(rows)
 

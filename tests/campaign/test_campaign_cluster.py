@@ -16,6 +16,7 @@ from pathlib import Path
 import pandas
 import pytest
 
+import dcsim.api
 from dcsim.campaign import ClusterOptions, load_campaign, replay_case, run_campaign
 from dcsim.campaign.cases import campaign_cases
 from dcsim.campaign.run import read_journal
@@ -81,11 +82,12 @@ def campaign_file(folder: Path, text: str) -> Path:
 
 @pytest.fixture(scope="module")
 def twelve(tmp_path_factory) -> tuple[Path, pandas.DataFrame]:
-    """The twelve-case campaign run on a local cluster of two workers."""
+    """The twelve-case campaign run from Python on a local cluster of two workers."""
     root = tmp_path_factory.mktemp("twelve")
     path = campaign_file(root, TWELVE_CASES)
-    run = run_campaign(path, root / "out", ClusterOptions(workers=2))
-    return root / "out", run.table
+    table = dcsim.api.run_campaign(path, root / "out", workers=2)
+    assert isinstance(table, pandas.DataFrame)
+    return root / "out", table
 
 
 @ON_DASK
@@ -289,3 +291,15 @@ def test_an_unreachable_scheduler_is_an_error_not_a_traceback(tmp_path, dcsim_cl
     assert "\nerror: cannot reach the Dask scheduler at tcp://127.0.0.1:" in done.stderr
     assert "Traceback" not in done.stderr
     assert not (tmp_path / "runs").exists()  # nothing written
+
+
+@ON_DASK
+def test_the_campaign_bench_compares_direct_runs_with_the_engine(tmp_path):
+    from dcsim.bench.campaign import bench_campaign, markdown_table
+
+    path = campaign_file(tmp_path / "campaign", TWELVE_CASES)
+    bench = bench_campaign(path, tmp_path / "bench", 2, [1], 2.0, progress=lambda line: None)
+    assert bench.cases == 2 and set(bench.campaign_s) == {1}
+    assert bench.same_results and bench.direct_s > 0
+    assert "| campaign, 1 worker |" in markdown_table(bench)
+    assert len(list((tmp_path / "bench" / "direct").iterdir())) == 2
