@@ -179,6 +179,16 @@ def test_a_dying_worker_loses_no_case_and_a_raising_plugin_is_a_failed_case(tmp_
     assert cases == ["case-000000", "case-000002", "case-000003", "case-000004", "case-000005"]
 
 
+def as_from_a_terminal() -> None:
+    """SIGINT delivered and handled by default in the child, as under a terminal.
+
+    An ignored or blocked SIGINT is inherited across exec; this test process may have
+    either from what ran in it before.
+    """
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 @ON_DASK
 def test_ctrl_c_keeps_the_finished_cases_and_resume_completes_them(tmp_path):
     path = campaign_file(
@@ -203,7 +213,13 @@ def test_ctrl_c_keeps_the_finished_cases_and_resume_completes_them(tmp_path):
         "--workers",
         "2",
     ]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    process = subprocess.Popen(
+        command,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=as_from_a_terminal,
+    )
     journal = out / "results.jsonl"
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and len(read_journal(journal)) < 2:
