@@ -20,11 +20,9 @@ from pathlib import Path
 import yaml
 
 from dcsim.campaign import ClusterOptions, campaign_cases, load_campaign, run_campaign
-from dcsim.campaign.cases import case_document
+from dcsim.campaign.cases import case_setup
 from dcsim.registry import PluginRegistry
 from dcsim.runner import Runner
-from dcsim.runsetup import build_run
-from dcsim.scenario import resolve_plugins, validate
 
 TIMING_COLUMNS = ("case_wall_time_s", "wall_time_s", "real_time_factor")
 """Columns that hold wall times, left out when tables are compared."""
@@ -78,8 +76,7 @@ def bench_campaign(
     selected = campaign_cases(campaign, registry, cases)
     began = time.perf_counter()
     for case in selected:
-        document = case_document(campaign.base, case)
-        setup = build_run(resolve_plugins(document, validate(document), registry), registry)
+        setup = case_setup(campaign.base, case, registry)
         Runner(setup, out / "direct" / case.name, plots=False).run()
     direct = time.perf_counter() - began
     progress(f"direct: {len(selected)} cases in {direct:.1f} s")

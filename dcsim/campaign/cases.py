@@ -37,6 +37,7 @@ from dcsim.campaign.spec import (
 )
 from dcsim.errors import CampaignError, Problem, ScenarioError
 from dcsim.registry import PluginRegistry
+from dcsim.runsetup import RunSetup, build_run
 from dcsim.scenario import ScenarioDocument, dump_scenario, parse_key_path, resolve_plugins
 from dcsim.scenario import validate as validate_scenario
 from dcsim.scenario.model import MAX_SEED
@@ -135,6 +136,18 @@ def case_document(base: ScenarioDocument, case: Case) -> ScenarioDocument:
     for assignment in case.overrides:
         document.apply_override(assignment)
     return document
+
+
+def case_setup(base: ScenarioDocument, case: Case, registry: PluginRegistry) -> RunSetup:
+    """The resolved scenario and constructed plugins of ``case``: what its run flies.
+
+    Raises
+    ------
+    ScenarioError
+        If the case is not a valid scenario (or names a plugin not installed here).
+    """
+    document = case_document(base, case)
+    return build_run(resolve_plugins(document, validate_scenario(document), registry), registry)
 
 
 def draw_value(

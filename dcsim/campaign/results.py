@@ -134,7 +134,7 @@ def plot_results(
         axis.grid(alpha=0.3)
     for axis in axes.flat[len(shown) :]:
         axis.set_visible(False)
-    _legend(figure, axes.flat[0], groups)
+    _legend(axes.flat[0], groups)
     figure.suptitle(f"{campaign.spec.name}: {len(ran)} cases")
     save(figure, folder / "metrics.png")
     dispersed = _dispersed_columns(campaign, ran)[:MAX_SCATTER_COLUMNS]
@@ -169,7 +169,7 @@ def _scatter(
                 axis.set_ylabel(name)
             if row == len(metrics) - 1:
                 axis.set_xlabel(value)
-    _legend(figure, axes[0, 0], groups)
+    _legend(axes[0, 0], groups)
     figure.suptitle(f"{campaign.spec.name}: metrics against the dispersed values")
     save(figure, path)
 
@@ -185,7 +185,8 @@ def _grid_groups(table: Any, grid: list[str]) -> list[tuple[str, Any]]:
     ]
 
 
-def _legend(figure: Any, axis: Any, groups: list[tuple[str, Any]]) -> None:
+def _legend(axis: Any, groups: list[tuple[str, Any]]) -> None:
+    """A legend of the grid points, when there is more than one."""
     if len(groups) > 1:
         axis.legend(fontsize="small")
 

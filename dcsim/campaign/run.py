@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any, TextIO
 
 from dcsim import __version__
-from dcsim.campaign.cases import Case, campaign_cases, case_document
+from dcsim.campaign.cases import Case, campaign_cases, case_setup
 from dcsim.campaign.engine import ClusterOptions, TaskOutcome, dask_client, run_tasks, running_count
 from dcsim.campaign.progress import CampaignProgress
 from dcsim.campaign.results import metric_names, results_table, write_results
@@ -37,7 +37,7 @@ from dcsim.campaign.worker import CaseTask, run_case
 from dcsim.errors import DcsimError
 from dcsim.registry import PluginRegistry
 from dcsim.rundir import prepare_run_directory
-from dcsim.scenario import ScenarioDocument, resolve_plugins, validate
+from dcsim.scenario import ScenarioDocument, validate
 
 if TYPE_CHECKING:
     import pandas
@@ -123,9 +123,7 @@ def run_campaign(
     """
     if not isinstance(campaign, Campaign):
         campaign = load_campaign(campaign)
-    registry = PluginRegistry.discover()
-    selected = campaign_cases(campaign, registry, cases)
-    metrics = metric_names(campaign, validate(campaign.base).mission.type)
+    selected, metrics = _checked(campaign, cases)
     if not force and out.is_dir() and any(out.iterdir()):
         prepare_run_directory(out)  # refused now, before a cluster starts
 
@@ -158,8 +156,7 @@ def resume_campaign(
         If ``directory`` is not a campaign directory.
     """
     campaign, count = load_campaign_directory(directory)
-    selected = campaign_cases(campaign, PluginRegistry.discover(), count)
-    metrics = metric_names(campaign, validate(campaign.base).mission.type)
+    selected, metrics = _checked(campaign, count)
     finished = read_journal(directory / JOURNAL_FILE)
     return _execute(directory, campaign, selected, metrics, cluster, finished, stream)
 
@@ -177,7 +174,6 @@ def replay_case(directory: Path, index: int, out: Path | None = None) -> Replay:
         If ``directory`` is not a campaign directory, or has no case ``index``.
     """
     from dcsim.runner import Runner  # the world engine loads PyBullet
-    from dcsim.runsetup import build_run
 
     campaign, count = load_campaign_directory(directory)
     if not 0 <= index < count:
@@ -186,8 +182,7 @@ def replay_case(directory: Path, index: int, out: Path | None = None) -> Replay:
     case = campaign_cases(campaign, registry, index + 1)[index]
     out = out if out is not None else directory / "reruns" / case.name
     prepare_run_directory(out, force=True)
-    document = case_document(campaign.base, case)
-    setup = build_run(resolve_plugins(document, validate(document), registry), registry)
+    setup = case_setup(campaign.base, case, registry)
     summary = Runner(setup, out, plots=campaign.spec.case_plots).run()
     recorded = directory / CASES_DIR / case.name
     identical = {
@@ -233,6 +228,12 @@ def read_journal(path: Path) -> dict[int, dict[str, Any]]:
         except (ValueError, KeyError, TypeError):
             continue
     return results
+
+
+def _checked(campaign: Campaign, count: int | None) -> tuple[list[Case], list[str]]:
+    """The campaign's first ``count`` cases and its metrics, all checked."""
+    cases = campaign_cases(campaign, PluginRegistry.discover(), count)
+    return cases, metric_names(campaign, validate(campaign.base).mission.type)
 
 
 def _execute(

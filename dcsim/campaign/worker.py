@@ -20,11 +20,11 @@ from pathlib import Path
 from typing import Any
 
 from dcsim import __version__
-from dcsim.campaign.cases import Case, case_document
+from dcsim.campaign.cases import Case, case_setup
 from dcsim.errors import DcsimError
 from dcsim.recording import to_json
 from dcsim.registry import PluginRegistry
-from dcsim.scenario import ScenarioDocument, resolve_plugins, validate
+from dcsim.scenario import ScenarioDocument
 
 CASE_FILE = "case.json"
 """The manifest in each case's run directory: index, seed, values, overrides, version."""
@@ -117,13 +117,9 @@ def read_case_result(directory: Path) -> dict[str, Any] | None:
 def _run(task: CaseTask, out: Path) -> dict[str, Any]:
     """Run the case into ``out``; its summary (one saying why, if it could not start)."""
     from dcsim.runner import Runner  # the world engine loads PyBullet
-    from dcsim.runsetup import build_run
 
     try:
-        document = case_document(task.base, task.case)
-        registry = _registry()
-        setup = build_run(resolve_plugins(document, validate(document), registry), registry)
-        runner = Runner(setup, out, plots=task.plots)
+        runner = Runner(case_setup(task.base, task.case, _registry()), out, plots=task.plots)
     except DcsimError as error:  # e.g. a plugin not installed on this worker
         return {"status": "failed", "reason": str(error)}
     try:

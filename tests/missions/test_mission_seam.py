@@ -13,9 +13,10 @@ from pydantic import Field
 from dcsim.api import Controller, Reference, ScenarioError
 from dcsim.missions import Mission, mission_class, register_mission
 from dcsim.registry import PluginOrigin, PluginRegistry
-from dcsim.runner import Runner
+from dcsim.runner import SUMMARY_FIGURES, Runner
 from dcsim.runsetup import prepare_run
 from dcsim.scenario.model import MissionSettings
+from tests.conftest import REPO
 
 TEST_ORIGIN = PluginOrigin("tests", "0", "test module")
 
@@ -152,3 +153,16 @@ def test_a_plugin_that_does_not_support_the_robot_is_refused(tmp_path):
         "controller.plugin: controller plugin 'arm-only' does not support robot type "
         "'free-flyer' (it supports: manipulator)"
     ) in str(error.value)
+
+
+@pytest.mark.parametrize(
+    "scenario",
+    ["default.yaml", "station_inspection.yaml", "space_manipulator_reach.yaml"],
+)
+def test_a_mission_declares_the_fields_of_its_summary(scenario):
+    runner = Runner(prepare_run(REPO / "scenarios" / scenario, ["world.duration=1"]))
+    runner.open()
+    mission = runner.mission
+    assert tuple(mission.summary_fields()) == type(mission).summary_names
+    summary = runner.close()
+    assert set(SUMMARY_FIGURES) | set(type(mission).summary_names) <= set(summary)
