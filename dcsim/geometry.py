@@ -50,6 +50,12 @@ def length(vector: ArrayLike) -> float:
     return math.sqrt(float(flat.dot(flat)))
 
 
+def row_lengths(vectors: np.ndarray) -> np.ndarray:
+    """Euclidean norms along the last axis of a float array: ``np.linalg.norm(vectors,
+    axis=-1)`` to the bit, without its dispatch."""
+    return np.sqrt(np.add.reduce(vectors * vectors, axis=-1))
+
+
 def unit(v: ArrayLike, fallback: ArrayLike = (1.0, 0.0, 0.0)) -> Vector:
     """Return ``v`` scaled to unit length, or ``fallback`` when ``v`` is (near) zero."""
     v = np.asarray(v, dtype=float)

@@ -296,7 +296,7 @@ class ClohessyWiltshireMotion(MotionModel):
 
     def state_at(self, t: ArrayLike) -> tuple[Vector, Vector]:
         """Return the exact relative position and velocity at time(s) ``t``."""
-        tau = np.asarray(t, dtype=float) - self.epoch
+        tau = float(t) - self.epoch if np.ndim(t) == 0 else np.asarray(t, dtype=float) - self.epoch
         return _cw_state(self.position, self.velocity, self.mean_motion, tau)
 
     @classmethod
@@ -317,9 +317,13 @@ class ClohessyWiltshireMotion(MotionModel):
 
 
 def _cw_state(p0: ArrayLike, v0: ArrayLike, n: ArrayLike, tau: np.ndarray) -> tuple[Vector, Vector]:
-    """The Clohessy–Wiltshire closed form; components of ``p0``, ``v0`` broadcast with τ."""
-    nt = np.multiply(n, tau)
-    s, c = np.sin(nt), np.cos(nt)
+    """The Clohessy–Wiltshire closed form; components of ``p0``, ``v0`` broadcast with τ.
+
+    With floats for ``n`` and ``τ`` (one model at one time) the arithmetic stays in
+    Python floats, the same IEEE operations without numpy's per-scalar overhead.
+    """
+    nt = n * tau
+    s, c = _sin_cos(nt)
     x0, y0, z0 = p0
     u0, v0, w0 = v0
     x = (4 - 3 * c) * x0 + s / n * u0 + 2 / n * (1 - c) * v0
@@ -331,8 +335,17 @@ def _cw_state(p0: ArrayLike, v0: ArrayLike, n: ArrayLike, tau: np.ndarray) -> tu
     return _columns(x, y, z), _columns(vx, vy, vz)
 
 
+def _sin_cos(angle: ArrayLike) -> tuple[Any, Any]:
+    """``sin`` and ``cos`` of ``angle`` (rad): floats for a float, arrays otherwise."""
+    if isinstance(angle, float):
+        return float(np.sin(angle)), float(np.cos(angle))
+    return np.sin(angle), np.cos(angle)
+
+
 def _columns(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> Vector:
     """``x``, ``y`` and ``z`` (broadcast together) as the last axis of one array."""
+    if isinstance(x, float) and isinstance(y, float) and isinstance(z, float):
+        return np.array((x, y, z))
     out = np.empty(np.broadcast_shapes(np.shape(x), np.shape(y), np.shape(z)) + (3,))
     out[..., 0], out[..., 1], out[..., 2] = x, y, z
     return out

@@ -73,6 +73,20 @@ def _shape_fits(shape: tuple[int, ...], wanted: tuple[int, ...]) -> bool:
     return all(w in (-1, s) for w, s in zip(wanted, shape, strict=True))
 
 
+def _is_frozen_float(value: object) -> bool:
+    """Whether ``value`` is a float array that no one can write: read-only, owning its
+    data (or viewing a read-only array that does), as message fields are."""
+    if type(value) is not np.ndarray or value.dtype != _FLOAT or value.flags.writeable:
+        return False
+    base = value.base
+    return base is None or (
+        type(base) is np.ndarray and not base.flags.writeable and base.base is None
+    )
+
+
+_FLOAT = np.dtype(float)
+
+
 class Message:
     """Base of every message: converts array fields and compares by value."""
 
@@ -81,6 +95,10 @@ class Message:
             raw = getattr(self, name)
             if raw is default or (raw is None and optional):
                 continue  # a default is shared, read-only and of the right shape
+            if _is_frozen_float(raw) and (
+                raw.shape == shape or (not fixed and _shape_fits(raw.shape, shape))
+            ):
+                continue  # another message's field (or alike): nobody can change it
             value = np.array(raw, dtype=float)
             if value.shape != shape and (fixed or not _shape_fits(value.shape, shape)):
                 raise ValueError(

@@ -10,6 +10,7 @@ import dataclasses
 import enum
 from collections.abc import Mapping
 from dataclasses import field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -271,13 +272,29 @@ class Trajectory(Message):
         position, velocity : ndarray, shape (..., 3)
             Linear between samples, m and m/s.
         """
-        position = np.stack(
-            [np.interp(t, self.times, self.positions[:, k]) for k in range(3)], axis=-1
-        )
-        velocity = np.stack(
-            [np.interp(t, self.times, self.velocities[:, k]) for k in range(3)], axis=-1
-        )
+        times = self.times
+        if np.ndim(t) == 0 and times[0] < t < times[-1]:
+            row = self._interpolate_inside(float(t))
+            return row[:3], row[3:]
+        table = self._sample_table
+        position = np.stack([np.interp(t, times, table[:, k]) for k in range(3)], axis=-1)
+        velocity = np.stack([np.interp(t, times, table[:, k]) for k in range(3, 6)], axis=-1)
         return position, velocity
+
+    def _interpolate_inside(self, t: float) -> Vector:
+        """Position and velocity (6,) at a time strictly inside the trajectory, s: the
+        arithmetic of :func:`numpy.interp`, all six components at once."""
+        times, table = self.times, self._sample_table
+        j = int(np.searchsorted(times, t, side="right")) - 1
+        if times[j] == t:
+            return table[j].copy()
+        slope = (table[j + 1] - table[j]) / (times[j + 1] - times[j])
+        return slope * (t - times[j]) + table[j]
+
+    @cached_property
+    def _sample_table(self) -> Vector:
+        """Positions and velocities side by side, (N, 6), made once per trajectory."""
+        return np.hstack([self.positions, self.velocities])
 
     def state_at(self, t: float) -> RobotState:
         """The full reference state at time ``t`` (s), held at the ends."""

@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from dcsim.geometry import unit
+from dcsim.geometry import length, unit
 from dcsim.interfaces import Plugin
 from dcsim.messages import (
     DropVisit,
@@ -333,11 +333,7 @@ class DebrisMission(Mission):
                 self._go(Mode.DEVISE_PLAN, "pickup missed")
             return self._holding()
         target_position = track.predict(self.time)[0]
-        gap = (
-            np.linalg.norm(self.estimate.position - target_position)
-            - self.robot.radius
-            - track.radius
-        )
+        gap = length(self.estimate.position - target_position) - self.robot.radius - track.radius
         if gap <= min(self._standoff_gap() + 0.5 * self.settings.reach, self.robot.grab_distance):
             self._go(Mode.GRAB, f"target {task.target_id} in reach")
         elif self.time > task.pickup_time + self.settings.pickup_slack:
@@ -385,7 +381,7 @@ class DebrisMission(Mission):
         reference = dataclasses.replace(
             self._follow(lambda: drop.state_at(self.time)), max_speed=self._drop_speed()
         )
-        distance = np.linalg.norm(self.estimate.position - drop.state_at(self.time)[0])
+        distance = length(self.estimate.position - drop.state_at(self.time)[0])
         if distance <= self.settings.release_fraction * drop.tolerance:
             result = self.world.release()
             if result.delivered or not self.world.carried_ids():

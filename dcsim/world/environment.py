@@ -131,12 +131,18 @@ class Propellant:
         steps, dt = self._steps, self._dt
         magnitude = length(force)
         per_step = magnitude * dt / (self._specific_impulse * STANDARD_GRAVITY)
-        fractions = np.zeros(steps)
-        if per_step > 0:
+        if per_step == 0 or (self.remaining - per_step * (steps - 1)) / per_step >= 1.0:
+            # the whole period at one fraction, 0 or 1: the general case's numbers, exactly
+            fraction = 0.0 if per_step == 0 else 1.0
+            burnt, mean = fraction * steps, fraction
+            thrusts = [tuple(fraction * f for f in force.tolist())] * steps
+        else:
             fractions = np.clip((self.remaining - per_step * np.arange(steps)) / per_step, 0.0, 1.0)
-        used = per_step * float(fractions.sum())
+            burnt, mean = float(fractions.sum()), float(fractions.mean())
+            thrusts = [tuple(thrust) for thrust in np.outer(fractions, force).tolist()]
+        used = per_step * burnt
         self.remaining = max(self.remaining - used, 0.0)
         self.used += used
-        self.delta_v += magnitude * dt * float(fractions.sum()) / mass
-        self.last_acceleration = force * (fractions.mean() / mass)
-        return [tuple(thrust) for thrust in np.outer(fractions, force).tolist()]
+        self.delta_v += magnitude * dt * burnt / mass
+        self.last_acceleration = force * (mean / mass)
+        return thrusts

@@ -82,7 +82,7 @@ class ObjectField:
     is_sphere : ndarray (N,) of bool
         Which objects are spheres (their bounding sphere is their shape).
     status : ndarray (N,) of int
-        :class:`ObjectStatus` of each object.
+        :class:`ObjectStatus` of each object (read-only: change it with :meth:`set_status`).
     """
 
     def __init__(self, objects: Sequence[SpaceObject]) -> None:
@@ -92,7 +92,9 @@ class ObjectField:
         self.is_sphere = np.array(
             [o.shape.kind is ShapeKind.SPHERE for o in self.objects], dtype=bool
         )
-        self.status = np.full(len(self.objects), ObjectStatus.FREE, dtype=int)
+        self._status = np.full(len(self.objects), ObjectStatus.FREE, dtype=int)
+        self.status = _read_only(self._status.view())
+        self._derived: dict[object, object] = {}
         self.index = {o.id: i for i, o in enumerate(self.objects)}
         self._motions = MotionSet([o.motion for o in self.objects])
         self._cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
@@ -101,7 +103,8 @@ class ObjectField:
         return len(self.objects)
 
     def free_states(self, t: float) -> tuple[np.ndarray, np.ndarray]:
-        """Positions and velocities (N, 3) of every object as its motion model gives them.
+        """Positions and velocities (N, 3) of every object as its motion model gives them
+        (read-only arrays).
 
         Only the rows of free objects describe where the objects are; carried objects
         move with the collector. The two latest times are cached (the world asks for
@@ -110,14 +113,44 @@ class ObjectField:
         if t not in self._cache:
             if len(self._cache) >= 2:
                 self._cache.pop(min(self._cache))
-            self._cache[t] = self._motions.state_at(t)
+            self._cache[t] = tuple(_read_only(a) for a in self._motions.state_at(t))
         return self._cache[t]
 
+    def set_status(self, index: int, status: ObjectStatus) -> None:
+        """Make object ``index`` free, carried or delivered (a grab or a delivery)."""
+        self._status[index] = status
+        self._derived.clear()
+
     def free_mask(self) -> np.ndarray:
-        """Boolean mask of the objects that are free."""
-        return self.status == _FREE
+        """Boolean mask of the objects that are free (read-only)."""
+        mask = self._derived.get("free")
+        if mask is None:
+            mask = self._derived["free"] = _read_only(self.status == _FREE)
+        return mask
+
+    def free_obstacles(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Indices of the free obstacles, their bounding radii (m) and whether each is a
+        sphere (read-only arrays, kept until a status changes)."""
+        found = self._derived.get("obstacles")
+        if found is None:
+            indices = np.flatnonzero(self.free_mask() & ~self.is_target)
+            found = self._derived["obstacles"] = tuple(
+                _read_only(a) for a in (indices, self.radii[indices], self.is_sphere[indices])
+            )
+        return found  # type: ignore[return-value]
 
     def count(self, status: ObjectStatus, targets_only: bool = True) -> int:
         """Number of objects (targets only, by default) with ``status``."""
-        mask = self.status == int(status)  # a plain int: numpy probes an enum at length
-        return int(np.count_nonzero(mask & self.is_target if targets_only else mask))
+        key = (int(status), targets_only)  # a plain int: numpy probes an enum at length
+        found = self._derived.get(key)
+        if found is None:
+            mask = self.status == key[0]
+            found = self._derived[key] = int(
+                np.count_nonzero(mask & self.is_target if targets_only else mask)
+            )
+        return found
+
+
+def _read_only(array: np.ndarray) -> np.ndarray:
+    array.setflags(write=False)
+    return array

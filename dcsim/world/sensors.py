@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from dcsim.geometry import row_lengths
 from dcsim.messages import BeaconRange, ObjectTrack, Observations
 from dcsim.scenario.model import Scenario, point_to_cartesian
 from dcsim.world.objects import ObjectField
@@ -46,7 +47,7 @@ class Sensors:
         if len(self.beacons) == 0:
             return []
         settings = self._settings
-        distances = np.linalg.norm(self.beacons - position, axis=1)
+        distances = row_lengths(self.beacons - position)
         order = np.argsort(distances, kind="stable")
         if settings.max_range is not None:
             order = order[distances[order] <= settings.max_range]
@@ -68,7 +69,7 @@ class Sensors:
         positions, velocities = self._field.free_states(time)
         if len(positions) == 0:
             return []
-        distances = np.linalg.norm(positions - position, axis=1)
+        distances = row_lengths(positions - position)
         visible = np.flatnonzero(self._field.free_mask() & (distances <= self._sensor_range))
         return [
             ObjectTrack(

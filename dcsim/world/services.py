@@ -178,7 +178,7 @@ class Cargo:
         for index, (body, constraint) in self.held.items():
             pb.removeConstraint(constraint, physicsClientId=self._client)
             pb.removeBody(body, physicsClientId=self._client)
-            self._field.status[index] = ObjectStatus.DELIVERED
+            self._field.set_status(index, ObjectStatus.DELIVERED)
             delivered.append(self._field.objects[index].id)
         self.held.clear()
         self.protrusion = 0.0
@@ -210,7 +210,7 @@ class Cargo:
         self.held[index] = (body, constraint)
         self.protrusion = self._measure_protrusion(position)
         self.changes += 1
-        self._field.status[index] = ObjectStatus.CARRIED
+        self._field.set_status(index, ObjectStatus.CARRIED)
 
     def _measure_protrusion(self, centre: np.ndarray) -> float:
         radius = self._robot.radius

@@ -115,14 +115,27 @@ class EKFLocaliser(Localiser):
         """The filter's mean and covariance."""
         state = self.filter.x.ravel()
         covariance = 0.5 * (self.filter.P + self.filter.P.T)
-        spread = float(np.sqrt(np.linalg.eigvalsh(covariance[:3, :3]).max()))
         return StateEstimate(
             time=self.time,
             position=state[:3],
             velocity=state[3:],
             covariance=covariance,
-            converged=self.started and spread <= self.params.convergence_sigma,
+            converged=self.started and self._position_settled(covariance[:3, :3]),
         )
+
+    def _position_settled(self, covariance: np.ndarray) -> bool:
+        """Whether the largest position standard deviation is within ``convergence_sigma``.
+
+        The largest eigenvalue of a covariance (m²) lies between its largest diagonal
+        entry and its trace; the eigenvalues are computed only when those bounds, with a
+        margin for rounding, leave the answer open.
+        """
+        sigma = self.params.convergence_sigma
+        if np.trace(covariance) < 0.999 * sigma**2:
+            return True
+        if covariance.diagonal().max() > 1.001 * sigma**2:
+            return False
+        return float(np.sqrt(np.linalg.eigvalsh(covariance).max())) <= sigma
 
 
 @hookimpl

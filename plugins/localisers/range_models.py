@@ -56,8 +56,9 @@ def predicted_ranges(position: np.ndarray, beacons: np.ndarray) -> np.ndarray:
 def range_jacobian(state: np.ndarray, beacons: np.ndarray) -> np.ndarray:
     """Jacobian (m×6) of the ranges with respect to ``[position, velocity]``."""
     offsets = state[:3] - beacons
-    rows = offsets / np.maximum(np.linalg.norm(offsets, axis=1), 1e-9)[:, None]
-    return np.hstack([rows, np.zeros_like(rows)])
+    jacobian = np.zeros((len(offsets), 6))
+    jacobian[:, :3] = offsets / np.maximum(np.linalg.norm(offsets, axis=1), 1e-9)[:, None]
+    return jacobian
 
 
 def least_squares_fix(
