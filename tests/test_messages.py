@@ -46,6 +46,30 @@ def test_messages_copy_their_inputs_and_compare_by_value():
     assert a != Command(force=[1, 2, 4])
 
 
+def test_messages_keep_arrays_nobody_can_write_and_copy_the_others():
+    owner = np.array([1.0, 2.0, 3.0])
+    owner.setflags(write=False)
+    kept = Command(force=owner)
+    assert kept.force is owner
+    assert Command(torque=kept.force).torque is owner
+    writable = np.array([[1.0, 2.0, 3.0]])
+    view = writable[0]
+    view.setflags(write=False)  # read-only, but its owner can still change it
+    copied = Command(force=view)
+    writable[0, 0] = 9.0
+    assert copied.force[0] == 1.0
+    assert Command(force=np.array([1, 2, 3])).force.dtype == float
+
+
+def test_trusted_messages_equal_checked_ones_and_need_every_field():
+    position = np.array([1.0, 2.0, 3.0])
+    position.setflags(write=False)
+    trusted = BeaconRange.trusted(beacon_id=1, beacon_position=position, range=4.0, sigma=0.5)
+    assert trusted == BeaconRange(1, [1.0, 2.0, 3.0], 4.0, 0.5)
+    with pytest.raises(TypeError, match="needs exactly the fields"):
+        BeaconRange.trusted(beacon_id=1, beacon_position=position, range=4.0)
+
+
 def test_shapes_are_checked():
     with pytest.raises(ValueError, match=r"covariance must have shape \(-1, -1\)"):
         StateEstimate(time=0.0, position=[0, 0, 0], covariance=np.ones(6))
@@ -96,9 +120,25 @@ def test_trajectory_samples_linearly_and_holds_at_the_ends():
     position, velocity = trajectory.sample(20.0)
     np.testing.assert_allclose(position, [10, 0, 0])
     np.testing.assert_allclose(velocity, [0, 0, 0])
+    position, velocity = trajectory.sample(10.0)  # the last sample exactly
+    np.testing.assert_allclose(position, [10, 0, 0])
     positions, velocities = trajectory.sample([-1.0, 2.5, 20.0])
     np.testing.assert_allclose(positions, [[0, 0, 0], [2.5, 0, 0], [10, 0, 0]])
     np.testing.assert_allclose(velocities, [[2, 0, 0], [1.5, 0, 0], [0, 0, 0]])
+
+
+def test_trajectory_samples_inside_as_numpy_interp_does_to_the_bit():
+    rng = np.random.default_rng(3)
+    times = np.cumsum(rng.uniform(0.01, 10.0, 40))
+    trajectory = Trajectory(
+        times=times, positions=rng.normal(0, 1e3, (40, 3)), velocities=rng.normal(0, 1, (40, 3))
+    )
+    for t in [*rng.uniform(times[0], times[-1], 200), *times[1:-1]]:
+        position, velocity = trajectory.sample(t)
+        expected = [np.interp(t, times, trajectory.positions[:, k]) for k in range(3)]
+        assert position.tolist() == expected
+        expected = [np.interp(t, times, trajectory.velocities[:, k]) for k in range(3)]
+        assert velocity.tolist() == expected
 
 
 def test_trajectory_end_state_takes_the_goal_attitude_when_it_leaves_the_attitude_free():

@@ -86,3 +86,23 @@ def test_batch_evaluation_matches_one_by_one():
         expected_position, expected_velocity = model.state_at(123.4)
         np.testing.assert_allclose(position, expected_position, rtol=1e-13, atol=1e-12)
         np.testing.assert_allclose(velocity, expected_velocity, rtol=1e-13, atol=1e-12)
+
+
+def test_one_cw_model_at_one_time_equals_its_array_evaluation_to_the_bit():
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        model = ClohessyWiltshireMotion(
+            tuple(rng.normal(0, 1e4, 3)), tuple(rng.normal(0, 5, 3)), N, epoch=rng.uniform(-50, 50)
+        )
+        t = float(rng.uniform(-1e4, 1e4))
+        position, velocity = model.state_at(t)
+        positions, velocities = model.state_at(np.array([t]))
+        assert position.tolist() == positions[0].tolist()
+        assert velocity.tolist() == velocities[0].tolist()
+
+
+def test_row_lengths_are_numpys_norms_to_the_bit():
+    from dcsim.geometry import row_lengths
+
+    vectors = np.random.default_rng(6).normal(0, 1e3, (500, 3))
+    assert row_lengths(vectors).tolist() == np.linalg.norm(vectors, axis=1).tolist()

@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 T = TypeVar("T", bound=type)
+M = TypeVar("M", bound="Message")
 _NO_SHARED_DEFAULT = object()
 
 
@@ -66,6 +67,17 @@ def _array_fields(cls: type) -> tuple[_ArrayField, ...]:
     return found
 
 
+_FIELD_NAMES: dict[type, frozenset[str]] = {}
+
+
+def _field_names(cls: type) -> frozenset[str]:
+    """Names of every field of a message class (cached per class)."""
+    names = _FIELD_NAMES.get(cls)
+    if names is None:
+        names = _FIELD_NAMES[cls] = frozenset(f.name for f in fields(cls))
+    return names
+
+
 def _shape_fits(shape: tuple[int, ...], wanted: tuple[int, ...]) -> bool:
     """Whether ``shape`` is ``wanted`` where ``-1`` in ``wanted`` accepts any length."""
     if len(shape) != len(wanted):
@@ -73,10 +85,10 @@ def _shape_fits(shape: tuple[int, ...], wanted: tuple[int, ...]) -> bool:
     return all(w in (-1, s) for w, s in zip(wanted, shape, strict=True))
 
 
-def _is_frozen_float(value: object) -> bool:
-    """Whether ``value`` is a float array that no one can write: read-only, owning its
-    data (or viewing a read-only array that does), as message fields are."""
-    if type(value) is not np.ndarray or value.dtype != _FLOAT or value.flags.writeable:
+def _owned_read_only(value: np.ndarray) -> bool:
+    """Whether no one can write ``value``'s data: it is read-only and owns its data, or
+    views a read-only array that does (as message fields and cached states are)."""
+    if value.flags.writeable:
         return False
     base = value.base
     return base is None or (
@@ -91,21 +103,45 @@ class Message:
     """Base of every message: converts array fields and compares by value."""
 
     def __post_init__(self) -> None:
+        values = self.__dict__
         for name, shape, optional, fixed, default in _array_fields(type(self)):
-            raw = getattr(self, name)
+            raw = values[name]
             if raw is default or (raw is None and optional):
                 continue  # a default is shared, read-only and of the right shape
-            if _is_frozen_float(raw) and (
-                raw.shape == shape or (not fixed and _shape_fits(raw.shape, shape))
+            if (
+                type(raw) is np.ndarray
+                and raw.dtype == _FLOAT
+                and (raw.shape == shape or not fixed and _shape_fits(raw.shape, shape))
+                and _owned_read_only(raw)
             ):
-                continue  # another message's field (or alike): nobody can change it
+                continue  # another message's field (or alike): kept, not copied
             value = np.array(raw, dtype=float)
             if value.shape != shape and (fixed or not _shape_fits(value.shape, shape)):
                 raise ValueError(
                     f"{type(self).__name__}.{name} must have shape {shape}, got {value.shape}"
                 )
             value.setflags(write=False)
-            object.__setattr__(self, name, value)
+            values[name] = value
+
+    @classmethod
+    def trusted(cls: type[M], **values: Any) -> M:
+        """Build a message from values already in the form it keeps, without checks.
+
+        For the framework's hot paths (a sensor's tracks, every tick): each field is
+        given, arrays are read-only floats of the declared shapes that no one can
+        write, and the class's own rules already hold. Anyone else calls the class.
+
+        Raises
+        ------
+        TypeError
+            If a field is missing or unknown.
+        """
+        names = _field_names(cls)
+        if values.keys() != names:
+            raise TypeError(f"{cls.__name__}.trusted needs exactly the fields {sorted(names)}")
+        message = object.__new__(cls)
+        message.__dict__.update(values)
+        return message
 
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):

@@ -30,13 +30,14 @@ class Sensors:
     Attributes
     ----------
     beacons : ndarray (B, 3)
-        Beacon positions, world frame, m.
+        Beacon positions, world frame, m (read-only).
     """
 
     def __init__(self, scenario: Scenario, field: ObjectField, rng: np.random.Generator) -> None:
         self.beacons = np.array(
             [point_to_cartesian(p) for p in scenario.beacons.positions]
         ).reshape(-1, 3)
+        self.beacons.setflags(write=False)  # shared by every range message, not copied
         self._settings = scenario.beacons
         self._sensor_range = scenario.robot.sensor_range
         self._field = field
@@ -56,9 +57,10 @@ class Sensors:
             self._rng.normal(0.0, settings.noise_sigma, len(order)) if settings.noise_sigma else 0.0
         )
         measured = distances[order] + noise
+        sigma = float(settings.noise_sigma)
         return [
-            BeaconRange(int(i), self.beacons[i], float(r), settings.noise_sigma)
-            for i, r in zip(order, np.atleast_1d(measured), strict=True)
+            BeaconRange.trusted(beacon_id=i, beacon_position=self.beacons[i], range=r, sigma=sigma)
+            for i, r in zip(order.tolist(), np.atleast_1d(measured).tolist(), strict=True)
         ]
 
     def object_tracks(self, time: float, position: np.ndarray) -> list[ObjectTrack]:
@@ -72,7 +74,7 @@ class Sensors:
         distances = row_lengths(positions - position)
         visible = np.flatnonzero(self._field.free_mask() & (distances <= self._sensor_range))
         return [
-            ObjectTrack(
+            ObjectTrack.trusted(
                 id=obj.id,
                 kind=obj.kind,
                 time=time,
