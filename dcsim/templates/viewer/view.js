@@ -206,6 +206,7 @@
 
   // Drawing a frame: one plotly.react at a time, the latest frame asked for wins.
   let frame = 0;
+  let drawn = -1;
   let drawing = null;
   let wanted = null;
 
@@ -226,7 +227,9 @@
       wanted = frame;
       return drawing;
     }
-    drawing = draw(frame).then(function () {
+    const asked = frame;
+    drawing = draw(asked).then(function () {
+      drawn = asked;
       drawing = null;
       if (wanted !== null) {
         const next = wanted;
@@ -306,11 +309,12 @@
     }
   });
 
-  // For scripts driving the page (tests): the frame count, the frame shown, a way to show one.
+  // For scripts driving the page (tests): the frame count, the frame drawn last, a way to
+  // show one (its promise resolves once it is drawn).
   window.dcsimView = {
     frames: times.length,
     ready: false,
-    frame: function () { return frame; },
+    frame: function () { return drawn; },
     setFrame: setFrame,
   };
   Plotly.newPlot(plot, data, layout, { responsive: true, displaylogo: false })
