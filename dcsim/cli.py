@@ -245,10 +245,15 @@ def view_command(run_dir: Path, out: Path | None, max_frames: int) -> None:
 
 
 def _write_view(run_dir: Path) -> None:
-    """Write the run's page after ``dcsim run --view``, saying where."""
-    from dcsim.viewer import write_view
+    """Write the run's page after ``dcsim run --view``, saying where; a run that left
+    nothing to show (no telemetry row) gets a warning, and keeps its exit status."""
+    from dcsim.viewer import ViewError, write_view
 
-    page = write_view(run_dir)
+    try:
+        page = write_view(run_dir)
+    except ViewError as error:
+        click.echo(f"warning: no view written: {error}", err=True)
+        return
     click.echo(f"  view in {page} ({_megabytes(page)})")
 
 

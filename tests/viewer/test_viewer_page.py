@@ -10,6 +10,7 @@ from __future__ import annotations
 import io
 import re
 import shutil
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -210,3 +211,11 @@ def test_play_runs_the_frames_and_pause_stops_them(visit):
     visit.tab.wait_for_timeout(1000)
     assert visit.tab.evaluate("window.dcsimView.frame()") == stopped < 200
     assert visit.errors == []
+
+
+def test_without_plotly_the_page_is_refused_saying_how_to_install_it(monkeypatch, run_dir):
+    from dcsim.viewer import ViewError, write_view
+
+    monkeypatch.setitem(sys.modules, "plotly.offline", None)  # import fails
+    with pytest.raises(ViewError, match="needs the plotly package: pip install plotly"):
+        write_view(run_dir)
