@@ -42,15 +42,15 @@ MAX_FRAMES = 600
 PLAYBACK_SECONDS = 30.0
 """Wall time the default playback speed takes to play the whole run, s."""
 
-ROBOT = "#1f77b4"
-TARGET = "#2ca02c"
-OBSTACLE = "#d62728"
-PLAN = "#ff7f0e"
-GOAL = "#2ca02c"
-DROP = "#555555"
-BEACON = "#9467bd"
-AXIS_COLOURS = ("#e41a1c", "#4daf4a", "#377eb8")
-"""Colours of the body x, y and z axes."""
+# Colours (CSS), matplotlib's defaults as the run's plots use them.
+_ROBOT = "#1f77b4"
+_TARGET = "#2ca02c"
+_OBSTACLE = "#d62728"
+_PLAN = "#ff7f0e"
+_GOAL = "#2ca02c"
+_DROP = "#555555"
+_BEACON = "#9467bd"
+_AXIS_COLOURS = ("#e41a1c", "#4daf4a", "#377eb8")  # body x, y and z axes
 
 _SPEEDS = (0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000)
 
@@ -85,6 +85,7 @@ def build_scene(records: RunRecords, max_frames: int = MAX_FRAMES) -> dict[str, 
     arm = arm_polylines(records.scenario, telemetry, path, rows)
     context = _Context(records, path, rows, times, tracks, arm)
     bodies = [_robot_body(context), *_object_bodies(tracks), *_drop_body(context)]
+    stages = _plans(context)
     return {
         "title": title(records.scenario),
         "subtitle": subtitle(records.summary),
@@ -93,10 +94,10 @@ def build_scene(records: RunRecords, max_frames: int = MAX_FRAMES) -> dict[str, 
         "bodies": bodies,
         "polylines": _robot_lines(context),
         "trails": _trails(context),
-        "stages": _plans(context),
+        "stages": stages,
         "readouts": readouts(records.scenario, telemetry, rows, handling),
         "events": event_log(records.events),
-        "extent": _extent(context, bodies),
+        "extent": _extent(context, bodies, stages),
         "playback": _playback(times),
     }
 
@@ -187,7 +188,7 @@ def _robot_body(context: _Context) -> dict[str, Any]:
         context.path.positions[context.rows],
         context.path.attitudes[context.rows],
     )
-    trace = _mesh_trace("robot", ROBOT, 0.85, flat=shape.kind is not ShapeKind.SPHERE)
+    trace = _mesh_trace("robot", _ROBOT, 0.85, flat=shape.kind is not ShapeKind.SPHERE)
     return {"trace": trace, "labels": False, "members": [member]}
 
 
@@ -195,8 +196,8 @@ def _object_bodies(tracks: Sequence[ObjectTrack]) -> list[dict[str, Any]]:
     """One group of targets and one of obstacles, each member labelled by its id."""
     groups = []
     for kind, name, colour, prefix in (
-        (ObjectKind.TARGET, "targets", TARGET, "T"),
-        (ObjectKind.OBSTACLE, "obstacles", OBSTACLE, "O"),
+        (ObjectKind.TARGET, "targets", _TARGET, "T"),
+        (ObjectKind.OBSTACLE, "obstacles", _OBSTACLE, "O"),
     ):
         chosen = [t for t in tracks if t.object.kind is kind]
         if not chosen:
@@ -224,7 +225,7 @@ def _drop_body(context: _Context) -> list[dict[str, Any]]:
     drop = context.scenario.drop_point
     positions = drop.build(context.scenario.mean_motion).state_at(context.times)[0]
     mesh = shape_mesh(Shape(ShapeKind.SPHERE, radius=drop.tolerance))
-    trace = _mesh_trace("drop point (tolerance)", DROP, 0.25, flat=False)
+    trace = _mesh_trace("drop point (tolerance)", _DROP, 0.25, flat=False)
     return [{"trace": trace, "labels": True, "members": [_member("drop", mesh, positions)]}]
 
 
@@ -265,10 +266,10 @@ def _robot_lines(context: _Context) -> list[dict[str, Any]]:
             "trace": _line_trace(f"body {name} axis", colour, 5, group="robot axes"),
             "frames": segment,
         }
-        for name, colour, segment in zip("xyz", AXIS_COLOURS, axes, strict=True)
+        for name, colour, segment in zip("xyz", _AXIS_COLOURS, axes, strict=True)
     ]
-    marker = _line_trace("robot", ROBOT, mode="markers", legend=False, group="robot")
-    marker["marker"] = {"color": ROBOT, "size": 5, "symbol": "circle"}
+    marker = _line_trace("robot centre", _ROBOT, mode="markers", legend=False, group="robot")
+    marker["marker"] = {"color": _ROBOT, "size": 5, "symbol": "circle"}
     lines.append({"trace": marker, "frames": context.path.positions[context.rows][:, None]})
     if context.arm is not None:
         arm = _line_trace("arm links", "#444444", 9, mode="lines+markers")
@@ -281,7 +282,7 @@ def _trails(context: _Context) -> list[dict[str, Any]]:
     """The robot's path (and a manipulator's end effector's) up to the current frame."""
     trails = [
         {
-            "trace": _line_trace("robot path", ROBOT, 4, group="robot"),
+            "trace": _line_trace("robot path", _ROBOT, 4, group="robot"),
             "points": context.path.positions[context.rows],
         }
     ]
@@ -301,7 +302,7 @@ def _static_traces(context: _Context) -> list[dict[str, Any]]:
     beacons, the goal region and bounds, a reach target."""
     traces = [
         _polyline(
-            _line_trace("flown path (whole run)", ROBOT, 1.5, legend=True),
+            _line_trace("flown path (whole run)", _ROBOT, 1.5, legend=True),
             context.path.positions[context.rows],
         )
         | {"opacity": 0.35}
@@ -309,6 +310,7 @@ def _static_traces(context: _Context) -> list[dict[str, Any]]:
     traces += _references(context)
     traces += _beacons(context)
     traces += _goal(context)
+    traces += _bounds(context)
     return traces
 
 
@@ -329,7 +331,7 @@ def _references(context: _Context) -> list[dict[str, Any]]:
             traces.append(_polyline(trace, reference[context.rows]))
     planned = context.records.planned
     if len(planned):
-        traces.append(_polyline(_line_trace("planned trajectory", PLAN, 4), planned))
+        traces.append(_polyline(_line_trace("planned trajectory", _PLAN, 4), planned))
     return traces
 
 
@@ -338,15 +340,25 @@ def _beacons(context: _Context) -> list[dict[str, Any]]:
     if not positions:
         return []
     points = np.array(positions, dtype=float)
-    trace = _line_trace("beacons", BEACON, mode="markers+text")
-    trace["marker"] = {"color": BEACON, "size": 6, "symbol": "diamond"}
+    trace = _line_trace("beacons", _BEACON, mode="markers+text")
+    trace["marker"] = {"color": _BEACON, "size": 6, "symbol": "diamond"}
     trace["text"] = [f"B{i}" for i in range(1, len(points) + 1)]
     trace["textposition"] = "top center"
     return [_polyline(trace, points)]
 
 
+def _bounds(context: _Context) -> list[dict[str, Any]]:
+    """The box a transfer's path must stay in, as a dotted wireframe (none without one)."""
+    bounds = getattr(context.scenario.mission, "bounds", None)
+    if bounds is None:
+        return []
+    lower, upper = np.asarray(bounds.lower), np.asarray(bounds.upper)
+    box = Shape(ShapeKind.BOX, half_extents=0.5 * (upper - lower))
+    return [_wireframe_trace(box, 0.5 * (lower + upper), "bounds", "#7f7f7f")]
+
+
 def _goal(context: _Context) -> list[dict[str, Any]]:
-    """A transfer's goal region and bounds; a reach's target."""
+    """A transfer's goal region; a reach's target."""
     settings = context.scenario.mission
     traces = []
     goal = getattr(settings, "goal", None)
@@ -355,16 +367,11 @@ def _goal(context: _Context) -> list[dict[str, Any]]:
             shape = Shape(ShapeKind.BOX, half_extents=goal.half_extents)
         else:
             shape = Shape(ShapeKind.SPHERE, radius=goal.radius)
-        traces.append(_placed_mesh(shape, np.asarray(goal.position), "goal region", GOAL, 0.25))
-    bounds = getattr(settings, "bounds", None)
-    if bounds is not None:
-        lower, upper = np.asarray(bounds.lower), np.asarray(bounds.upper)
-        box = Shape(ShapeKind.BOX, half_extents=0.5 * (upper - lower))
-        traces.append(_wireframe_trace(box, 0.5 * (lower + upper), "bounds", "#7f7f7f"))
+        traces.append(_placed_mesh(shape, np.asarray(goal.position), "goal region", _GOAL, 0.25))
     target = getattr(settings, "target", None)
     if target is not None:
-        trace = _line_trace("reach target", GOAL, mode="markers")
-        trace["marker"] = {"color": GOAL, "size": 7, "symbol": "x"}
+        trace = _line_trace("reach target", _GOAL, mode="markers")
+        trace["marker"] = {"color": _GOAL, "size": 7, "symbol": "x"}
         traces.append(_polyline(trace, np.asarray(target, dtype=float)[None]))
     return traces
 
@@ -409,8 +416,8 @@ def _plans(context: _Context) -> list[dict[str, Any]]:
             elif key in motions:
                 points.append(motions[key].position_at(time))
         stages.append({"t": float(plan["t"]), "points": np.array(points, dtype=float)})
-    trace = _line_trace("plan", PLAN, 3, dash="dash", mode="lines+markers")
-    trace["marker"] = {"color": PLAN, "size": 4}
+    trace = _line_trace("plan", _PLAN, 3, dash="dash", mode="lines+markers")
+    trace["marker"] = {"color": _PLAN, "size": 4}
     return [{"trace": trace, "stages": stages}]
 
 
@@ -429,24 +436,21 @@ def _plan_steps(plan: Mapping[str, Any]) -> list[tuple[str, int, float]]:
 # ---------------------------------------------------------------- views
 
 
-def _extent(context: _Context, bodies: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
-    """The boxes the views show: the work area (robot, objects, drop, plans, goal), the
-    whole scene (beacons and bounds too), and the half width of the close-up."""
-    points = [context.path.positions[context.rows]]
+def _extent(
+    context: _Context, bodies: Sequence[Mapping[str, Any]], stages: Sequence[Mapping[str, Any]]
+) -> dict[str, Any]:
+    """The boxes the views show: the work area (robot, objects, drop point, plans, goal),
+    the whole scene (beacons and bounds too), and the half width of the close-up, m."""
+    points = [context.path.positions[context.rows], context.records.planned]
     for group in bodies:
         for member in group["members"]:
-            reach = float(np.max(np.linalg.norm(member["vertices"], axis=1)))
-            points += [member["positions"] - reach, member["positions"] + reach]
+            points += [member["positions"] - member["lift"], member["positions"] + member["lift"]]
     if context.arm is not None:
         points.append(context.arm.reshape(-1, 3))
-    points.append(context.records.planned)
-    for trace in _goal(context):
-        points.append(np.column_stack([trace["x"], trace["y"], trace["z"]]))
+    points += [stage["points"] for staged in stages for stage in staged["stages"]]
+    points += [_trace_points(trace) for trace in _goal(context)]
     work = _box(points)
-    whole = [work, *(_trace_points(t) for t in _beacons(context))]
-    bounds = getattr(context.scenario.mission, "bounds", None)
-    if bounds is not None:
-        whole.append(np.array([bounds.lower, bounds.upper], dtype=float))
+    whole = [work, *(_trace_points(t) for t in [*_beacons(context), *_bounds(context)])]
     return {
         "work": work,
         "scene": _box(whole),
