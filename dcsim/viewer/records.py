@@ -86,6 +86,11 @@ def read_table(path: Path) -> dict[str, np.ndarray]:
     dict of str to ndarray
         One array per column, named by :func:`plain_name`: floats (empty cells NaN),
         except ``mode`` (text).
+
+    Raises
+    ------
+    ViewError
+        If the file cannot be read or parsed as CSV.
     """
     try:
         frame = pd.read_csv(path, dtype={name: str for name in _TEXT_COLUMNS})
