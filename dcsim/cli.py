@@ -147,12 +147,18 @@ def validate_command(files: tuple[Path, ...]) -> None:
     help="Override one scenario value, e.g. --set robot.max_force=20 or "
     "--set targets[0].motion.r=150000; the value is read as YAML. Repeatable.",
 )
+@click.option(
+    "--view",
+    is_flag=True,
+    help="Also write view.html, the run replayed in 3-D in a browser (see `dcsim view`).",
+)
 def run_command(
     scenario: Path | None,
     out: Path | None,
     force: bool,
     seed: int | None,
     overrides: tuple[str, ...],
+    view: bool,
 ) -> None:
     """Run SCENARIO (default: the scenario shipped with dcsim) and record it.
 
@@ -165,7 +171,8 @@ def run_command(
     directory that cannot be written, or that already holds a run (unless --force), is
     refused before anything runs. Exit status: 0 when the run completed or was stopped
     by a stop rule, 1 when a plugin failed or the records could not be written, 130
-    when interrupted with Ctrl-C.
+    when interrupted with Ctrl-C. With --view the run directory also receives
+    view.html, written after the run however it ended.
     """
     from dcsim.runner import Runner, terminal_progress  # the world engine loads PyBullet
 
@@ -178,6 +185,8 @@ def run_command(
     if sys.stderr.isatty():
         click.echo("", err=True)
     _print_summary(summary, out)
+    if view:
+        _write_view(out)
     if summary["reason"] == "interrupted":
         sys.exit(130)
     if summary["status"] == "failed":
@@ -203,6 +212,53 @@ def _print_summary(summary: dict, out: Path) -> None:
         f"(x{summary['real_time_factor']:.0f} real time)"
     )
     click.echo(f"  results in {out}")
+
+
+@cli.command("view")
+@click.argument("run_dir", type=click.Path(path_type=Path))
+@click.option(
+    "--out",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Page to write. Default: RUN_DIR/view.html.",
+)
+@click.option(
+    "--max-frames",
+    type=click.IntRange(min=2),
+    default=600,
+    show_default=True,
+    help="Frames the page holds at most (telemetry rows evenly spread over the run).",
+)
+def view_command(run_dir: Path, out: Path | None, max_frames: int) -> None:
+    """Write a page that replays the run in RUN_DIR in 3-D in a browser.
+
+    The page (RUN_DIR/view.html) is one self-contained HTML file, with plotly.js and
+    the run's data inside: open it in any browser, no server or network needed. It
+    shows the robot with its attitude (a manipulator's arm too), every target and
+    obstacle in its true shape as it moves (grabbed targets ride along, delivered ones
+    disappear), the plans, beacons, drop point or goal, a time slider with play and
+    pause, and the mission's mode and key numbers at the time shown.
+    """
+    from dcsim.viewer import write_view
+
+    page = write_view(run_dir, out, max_frames)
+    click.echo(f"wrote {page} ({_megabytes(page)})")
+
+
+def _write_view(run_dir: Path) -> None:
+    """Write the run's page after ``dcsim run --view``, saying where; a run that left
+    nothing to show (no telemetry row) gets a warning, and keeps its exit status."""
+    from dcsim.viewer import ViewError, write_view
+
+    try:
+        page = write_view(run_dir)
+    except ViewError as error:
+        click.echo(f"warning: no view written: {error}", err=True)
+        return
+    click.echo(f"  view in {page} ({_megabytes(page)})")
+
+
+def _megabytes(path: Path) -> str:
+    return f"{path.stat().st_size / 1e6:.1f} MB"
 
 
 @cli.command("new-plugin")

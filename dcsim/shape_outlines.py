@@ -90,3 +90,24 @@ def _sphere_wireframe(radius: float) -> list[np.ndarray]:
 def _unit_circle() -> np.ndarray:
     angles = np.linspace(0.0, 2.0 * np.pi, CIRCLE_POINTS, endpoint=False)
     return np.column_stack([np.cos(angles), np.sin(angles)])
+
+
+SPHERE_POINTS = 162
+"""Points spread over a sphere by :func:`surface_points` (a golden-angle spiral)."""
+
+
+def surface_points(shape: Shape) -> np.ndarray:
+    """Points on the shape's surface whose convex hull is the shape (K, 3), m.
+
+    A box's 8 corners, a cylinder's two end circles (bottom then top), or
+    :data:`SPHERE_POINTS` points spread evenly over a sphere; about the shape's centre,
+    in world axes (the shape's orientation applied). Solid pictures triangulate their
+    hull.
+    """
+    if shape.kind is not ShapeKind.SPHERE:
+        return _hull_points(shape)
+    index = np.arange(SPHERE_POINTS) + 0.5
+    height = 1.0 - 2.0 * index / SPHERE_POINTS
+    azimuth = np.pi * (3.0 - np.sqrt(5.0)) * index
+    ring = np.sqrt(1.0 - height**2)
+    return shape.radius * np.column_stack([ring * np.cos(azimuth), ring * np.sin(azimuth), height])

@@ -20,7 +20,7 @@ def test_version(dcsim_cli):
 def test_help_lists_commands(dcsim_cli):
     result = dcsim_cli("--help")
     assert result.returncode == 0
-    for command in ("plugins", "validate", "run"):
+    for command in ("plugins", "validate", "run", "view"):
         assert command in result.stdout
 
 
@@ -29,7 +29,8 @@ def test_help_lists_commands(dcsim_cli):
     [
         ("plugins", ["--kind", "--json"]),
         ("validate", ["FILES"]),
-        ("run", ["--out", "--force", "--seed", "--set", "SCENARIO"]),
+        ("run", ["--out", "--force", "--seed", "--set", "--view", "SCENARIO"]),
+        ("view", ["RUN_DIR", "--out", "--max-frames"]),
     ],
 )
 def test_command_help_explains_every_option(dcsim_cli, command, options):
