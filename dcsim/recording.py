@@ -356,7 +356,7 @@ def read_telemetry(path: Path, max_points: int | None = None) -> dict[str, np.nd
         One array per column, by its row name (the header's name without its unit
         suffix, :func:`column_name`): floats, except ``mode`` (text).
     """
-    step = 1 if max_points is None else _stride(_count_lines(path) - 1, max_points)
+    step = 1 if max_points is None else _stride(count_lines(path) - 1, max_points)
     kept: list[list[str]] = []
     last: list[str] | None = None
     with path.open(encoding="utf-8") as stream:
@@ -377,8 +377,8 @@ def read_telemetry(path: Path, max_points: int | None = None) -> dict[str, np.nd
     return _parse(header, kept)
 
 
-def _count_lines(path: Path) -> int:
-    """Number of line ends in a file, read in blocks."""
+def count_lines(path: Path) -> int:
+    """Number of line ends in a file, read in blocks (the file is not held in memory)."""
     count = 0
     with path.open("rb") as stream:
         while block := stream.read(1 << 20):
