@@ -6,12 +6,14 @@ no traceback; ``dcsim --debug ...`` shows the traceback instead.
 
 from __future__ import annotations
 
+import difflib
 import json
 import re
 import sys
 import time
 import warnings
 from collections.abc import Sequence
+from dataclasses import asdict
 from datetime import datetime
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -20,9 +22,10 @@ import click
 
 from dcsim import __version__
 from dcsim.cli_campaign import campaign_group, cluster_choice, cluster_options
-from dcsim.errors import DcsimError, PluginLoadWarning
+from dcsim.errors import DcsimError, PluginLoadWarning, PluginNotFoundError
 from dcsim.interfaces import PLUGIN_KINDS
-from dcsim.registry import PluginRegistry
+from dcsim.params import ParameterInfo, parameter_infos
+from dcsim.registry import PluginRegistry, RegisteredPlugin
 from dcsim.rundir import file_name_part, prepare_run_directory
 from dcsim.runsetup import prepare_run
 from dcsim.scenario import load_scenario
@@ -71,20 +74,27 @@ def cli(ctx: click.Context, debug: bool) -> None:
 
 
 @cli.command("plugins")
+@click.argument("name", required=False)
 @click.option(
     "--kind",
     type=click.Choice(list(PLUGIN_KINDS)),
     help="Only list plugins of this kind.",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print a JSON list instead of a table.")
-def plugins_command(kind: str | None, as_json: bool) -> None:
-    """List registered plugins: kind, name, summary and origin.
+def plugins_command(name: str | None, kind: str | None, as_json: bool) -> None:
+    """List registered plugins: kind, name, summary and origin; or NAME's parameters.
 
     The origin is the installed distribution (and version) that provides the plugin.
-    Set DCSIM_LOAD_PLUGINS to a comma-separated list of distributions to restrict
-    which external plugins load.
+    With NAME, prints that plugin's robots and parameters (name, default, unit, bounds
+    or allowed values, description), the keys of its scenario section's params; --kind
+    picks one of two plugins of that name. Set DCSIM_LOAD_PLUGINS to a comma-separated
+    list of distributions to restrict which external plugins load.
     """
-    entries = [p.as_dict() for p in _registry().plugins(kind)]
+    registry = _registry()
+    if name is not None:
+        _print_parameters(_plugins_named(registry, name, kind), as_json)
+        return
+    entries = [p.as_dict() for p in registry.plugins(kind)]
     if as_json:
         click.echo(json.dumps(entries, indent=2))
         return
@@ -92,6 +102,62 @@ def plugins_command(kind: str | None, as_json: bool) -> None:
         (e["kind"], e["name"], e["summary"], f"{e['distribution']} {e['version']}") for e in entries
     ]
     _print_table(("KIND", "NAME", "SUMMARY", "ORIGIN"), rows)
+
+
+def _plugins_named(registry: PluginRegistry, name: str, kind: str | None) -> list[RegisteredPlugin]:
+    """The registered plugins called ``name`` (of ``kind``, if given).
+
+    Raises
+    ------
+    PluginNotFoundError
+        Naming the closest names when there is none.
+    """
+    found = [p for p in registry.plugins(kind) if p.name == name]
+    if found:
+        return found
+    if kind is not None:
+        registry.get(kind, name)  # raises, with the names of that kind
+    names = sorted({p.name for p in registry.plugins()})
+    close = difflib.get_close_matches(name, names, n=1)
+    hint = f"; did you mean '{close[0]}'?" if close else ""
+    raise PluginNotFoundError(f"no plugin named '{name}' (see dcsim plugins){hint}")
+
+
+def _print_parameters(plugins: list[RegisteredPlugin], as_json: bool) -> None:
+    """Each plugin's origin, robots and parameter table (or all of it as JSON)."""
+    if as_json:
+        entries = [
+            {
+                **plugin.as_dict(),
+                "robots": list(plugin.cls.robots),
+                "parameters": [asdict(info) for info in parameter_infos(plugin.cls.Params)],
+            }
+            for plugin in plugins
+        ]
+        click.echo(json.dumps(entries, indent=2, ensure_ascii=False))
+        return
+    for index, plugin in enumerate(plugins):
+        click.echo(("\n" if index else "") + f"{plugin.kind} {plugin.name}: {plugin.cls.summary}")
+        click.echo(f"origin: {plugin.origin}")
+        click.echo(f"robots: {', '.join(plugin.cls.robots)}")
+        rows = [
+            (i.name, _default_text(i), i.unit, i.bounds, i.description)
+            for i in parameter_infos(plugin.cls.Params)
+        ]
+        if not rows:
+            click.echo("parameters: none")
+            continue
+        click.echo("")
+        _print_table(("PARAMETER", "DEFAULT", "UNIT", "BOUNDS", "DESCRIPTION"), rows)
+
+
+def _default_text(info: ParameterInfo) -> str:
+    """A parameter's default as a scenario file would write it."""
+    if info.required:
+        return "required"
+    if isinstance(info.default, str):
+        return info.default
+    return json.dumps(info.default, ensure_ascii=False)
 
 
 def _print_table(header: tuple[str, ...], rows: list[tuple[str, ...]]) -> None:
@@ -202,7 +268,16 @@ def _print_summary(summary: dict, out: Path) -> None:
         f"  simulated {summary['sim_time_s']:.1f} s in {summary['wall_time_s']:.1f} s of wall time "
         f"(x{summary['real_time_factor']:.0f} real time)"
     )
+    click.echo(f"  plugins: {_plugins_flown(summary['plugins'])}")
     click.echo(f"  results in {out}")
+
+
+def _plugins_flown(plugins: dict[str, dict[str, str]]) -> str:
+    """``localiser ekf (dcsim 0.1.0), ...``: each role's plugin and where it came from."""
+    return ", ".join(
+        f"{role} {entry['name']} ({entry['distribution']} {entry['version']})"
+        for role, entry in plugins.items()
+    )
 
 
 @cli.command("new-plugin")
@@ -222,11 +297,12 @@ def new_plugin_command(kind: str, name: str, directory: Path) -> None:
     The package (DIR/dcsim-NAME) has a pyproject.toml with the dcsim entry point, the
     plugin class with its parameter model and a simple working algorithm, a test file
     that runs the conformance suite, and a README. Install it with
-    `pip install -e DIR/dcsim-NAME` and run `pytest` inside it.
+    `pip install -e DIR/dcsim-NAME` and run `pytest` inside it. A NAME an installed
+    plugin of KIND already has is refused.
     """
     from dcsim.scaffold import new_plugin
 
-    root = new_plugin(kind, name, directory)
+    root = new_plugin(kind, name, directory, _registry())
     click.echo(f"wrote {root}")
     click.echo(f"next: pip install -e '{root}[test]' && (cd {root} && pytest)")
 
