@@ -312,12 +312,14 @@ def bench_group() -> None:
     """Measure dcsim and its plugins; results go into docs/benchmarks.md."""
 
 
-@bench_group.command("world")
+@bench_group.command(
+    "world", short_help="Closed-loop wall time per simulated second against PyBullet."
+)
 @click.option(
     "--objects",
     default="10,100,1000",
     show_default=True,
-    help="Comma-separated field sizes (targets and obstacles in all).",
+    help="Comma-separated field sizes (targets and obstacles in all), each >= 0.",
 )
 @click.option(
     "--duration",
@@ -337,10 +339,12 @@ def bench_world_command(objects: str, duration: float) -> None:
     from dcsim.bench.world import bench_world, markdown_table
     from dcsim.runner import Runner
 
-    try:
-        sizes = [int(n) for n in objects.split(",")]
-    except ValueError:
-        raise click.BadParameter(f"expected integers like 10,100,1000, got {objects!r}") from None
+    words = [word.strip() for word in objects.split(",")]
+    if not all(word.isdigit() for word in words):
+        raise click.BadParameter(
+            f"expected integers >= 0 like 10,100,1000, got {objects!r}", param_hint="--objects"
+        )
+    sizes = [int(word) for word in words]
     rows = bench_world(sizes, duration, progress=lambda line: click.echo(line, err=True))
     click.echo(markdown_table(rows))
     summary = Runner(prepare_run(registry=_registry())).run()
@@ -351,7 +355,7 @@ def bench_world_command(objects: str, duration: float) -> None:
     )
 
 
-@bench_group.command("soak")
+@bench_group.command("soak", short_help="A long run's memory and time per tick; FMU lifetimes.")
 @click.option(
     "--ticks",
     type=click.IntRange(min=100),
@@ -420,7 +424,9 @@ def bench_soak_command(
         )
 
 
-@bench_group.command("localisers")
+@bench_group.command(
+    "localisers", short_help="Localisers' RMSE against the Cramér–Rao bound; latency."
+)
 @click.option(
     "--runs", type=click.IntRange(min=1), default=10, show_default=True, help="Monte Carlo runs."
 )
@@ -471,7 +477,9 @@ def bench_localisers_command(
         click.echo(f"plot: {plot_path}")
 
 
-@bench_group.command("task-planners")
+@bench_group.command(
+    "task-planners", short_help="ga's time strategies; task planners' gaps to the optimum."
+)
 @click.option(
     "--instances",
     type=click.IntRange(min=1),
@@ -552,7 +560,9 @@ def bench_task_planners_command(
         click.echo(f"plots: {plot_dir}")
 
 
-@bench_group.command("controllers")
+@bench_group.command(
+    "controllers", short_help="Controllers across crowded fields of drifting obstacles."
+)
 @click.option(
     "--seeds",
     type=click.IntRange(min=1),
@@ -628,7 +638,9 @@ def bench_controllers_command(
         click.echo(f"plot: {plot_path}")
 
 
-@bench_group.command("campaign")
+@bench_group.command(
+    "campaign", short_help="The campaign engine's overhead and speed-up per worker."
+)
 @click.argument(
     "campaign",
     required=False,
@@ -681,7 +693,7 @@ def bench_campaign_command(
     click.echo(markdown_table(bench))
 
 
-@bench_group.command("fmu")
+@bench_group.command("fmu", short_help="The closed-loop FMU in fmpy against dcsim run, per tick.")
 @click.argument("scenario", required=False, type=click.Path(dir_okay=False, path_type=Path))
 @click.option(
     "--duration",
@@ -708,7 +720,9 @@ def bench_fmu_command(scenario: Path | None, duration: float, repeats: int) -> N
     click.echo(markdown_table(result))
 
 
-@bench_group.command("manipulator")
+@bench_group.command(
+    "manipulator", short_help="The manipulator model's time per call against Pinocchio."
+)
 @click.option(
     "--states",
     type=click.IntRange(min=1),
@@ -757,7 +771,9 @@ def bench_manipulator_command(
         click.echo(f"\n{bench.scenario_line(speed)}")
 
 
-@bench_group.command("grid-search")
+@bench_group.command(
+    "grid-search", short_help="The Boeing paper's Tables 3-4: grid-astar and multi-burn."
+)
 @click.option(
     "--scenario",
     type=click.Path(exists=True, dir_okay=False, path_type=Path),
@@ -799,7 +815,9 @@ def bench_grid_search_command(
     click.echo(tables(cells))
 
 
-@bench_group.command("ant-colony")
+@bench_group.command(
+    "ant-colony", short_help="The ant-colony planner against its graph's exact optimum."
+)
 @click.option(
     "--layouts",
     type=int,
@@ -962,7 +980,7 @@ def bench_ant_colony_command(
         click.echo(f"plot: {plot_path}")
 
 
-@bench_group.command("q-learning")
+@bench_group.command("q-learning", short_help="The q-learning planner against value iteration.")
 @click.option(
     "--scenario",
     default="scenarios/space_manipulator_reach.yaml",
@@ -1063,7 +1081,9 @@ def _span(specs: Sequence[str]) -> str:
     return ", ".join(specs)
 
 
-@bench_group.command("path-planners")
+@bench_group.command(
+    "path-planners", short_help="Path planners side by side on seeded fields and scenarios."
+)
 @click.option(
     "--planners",
     default=None,

@@ -231,29 +231,44 @@ def test_debug_shows_the_traceback(dcsim_cli):
     assert "ScenarioError" in result.stderr
 
 
+def test_bench_help_lists_every_bench_with_its_whole_one_line_description(dcsim_cli):
+    from dcsim.cli import bench_group
+
+    lines = dcsim_cli("bench", "--help").stdout.split("Commands:\n")[1].splitlines()
+    assert len(lines) == len(bench_group.commands)  # one line each, none wrapped
+    for name, command in bench_group.commands.items():
+        assert command.short_help and command.short_help.endswith(".")
+        assert f"  {name}  " in next(line for line in lines if line.split()[0] == name)
+        assert next(line for line in lines if line.split()[0] == name).endswith(command.short_help)
+
+
+# The least values the options of `bench world`, `manipulator` and `localisers` allow
+# (tests/bench/test_smallest_options.py runs the other benches at theirs).
 def test_bench_world_prints_a_table_for_each_size(dcsim_cli):
-    result = dcsim_cli("bench", "world", "--objects", "5,20", "--duration", "2")
+    result = dcsim_cli("bench", "world", "--objects", "0,5", "--duration", "1")
     assert result.returncode == 0, result.stderr
     rows = [
         line for line in result.stdout.splitlines() if line.startswith("| ") and line[2].isdigit()
     ]
-    assert [row.split("|")[1].strip() for row in rows] == ["5", "20"]
+    assert [row.split("|")[1].strip() for row in rows] == ["0", "5"]
     assert "default scenario: completed (all targets delivered)" in result.stdout
     assert "5 objects: bare stepping" in result.stderr
+    negative = dcsim_cli("bench", "world", "--objects", "5,-1")
+    assert negative.returncode == 2 and "expected integers >= 0" in negative.stderr
 
 
 def test_bench_manipulator_prints_the_table_and_the_verdict(dcsim_cli):
-    result = dcsim_cli("bench", "manipulator", "--states", "2", "--repeats", "1", "--number", "1")
+    result = dcsim_cli("bench", "manipulator", "--states", "1", "--repeats", "1", "--number", "1")
     assert result.returncode == 0, result.stderr
     assert "| M + C, two calls |" in result.stdout
     assert "M + C within 10× of Pinocchio: " in result.stdout
-    assert "agreement with dcsim over the 2 states" in result.stdout
-    assert "dcsim: timed 6 quantities at 2 states" in result.stderr
+    assert "agreement with dcsim over the 1 states" in result.stdout
+    assert "dcsim: timed 6 quantities at 1 states" in result.stderr
 
 
 def test_bench_localisers_prints_the_bound_and_every_localiser(dcsim_cli, tmp_path):
     plot = tmp_path / "localisers.png"
-    result = dcsim_cli("bench", "localisers", "--runs", "1", "--steps", "20", "--plot", str(plot))
+    result = dcsim_cli("bench", "localisers", "--runs", "1", "--steps", "10", "--plot", str(plot))
     assert result.returncode == 0, result.stderr
     labels = [
         line.split("|")[1].strip() for line in result.stdout.splitlines() if line.startswith("| ")
