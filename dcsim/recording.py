@@ -114,14 +114,18 @@ def header_name(column: str, unit: str = "") -> str:
 
 def column_name(header: str) -> str:
     """A telemetry column's row name from its header name: ``vx_mps`` → ``vx``."""
-    stem, _, suffix = header.rpartition("_")
-    return stem if stem and suffix in UNITS else header
+    return _split_unit(header)[0]
 
 
 def column_unit(header: str) -> str:
     """The unit of a header name (``vx_mps`` → ``m/s``); empty when it has none."""
+    return UNITS.get(_split_unit(header)[1], "")
+
+
+def _split_unit(header: str) -> tuple[str, str]:
+    """A header name's row name and unit suffix (empty when it has none)."""
     stem, _, suffix = header.rpartition("_")
-    return UNITS[suffix] if stem and suffix in UNITS else ""
+    return (stem, suffix) if stem and suffix in UNITS else (header, "")
 
 
 def _json_value(value: Any) -> Any:
