@@ -3,9 +3,16 @@
 Import from here, not from dcsim's internal modules::
 
     from dcsim.api import Controller, Command, PluginParams, quantity, hookimpl
+    from dcsim.api import run
 
 Contents
 --------
+Runs (docs/python.md)
+    :func:`run` (a scenario flown to its end, in memory or into a run directory),
+    :func:`load_scenario`, :func:`open_run` and :func:`close_run` (a run stepped one
+    control period at a time), :func:`read_run` (a run directory read back); each
+    gives a :class:`RunResult`: summary, telemetry (a pandas DataFrame, units in the
+    column names), events, plugins.
 Plugin kinds
     :class:`Localiser`, :class:`TaskPlanner`, :class:`PathPlanner`, :class:`Controller`
     (and their common base :class:`Plugin`).
@@ -151,12 +158,19 @@ from dcsim.robots.manipulator import (
     manipulator_model,
 )
 from dcsim.robots.urdf import urdf_text as manipulator_urdf
+from dcsim.runs import RunResult, close_run, load_scenario, open_run, read_run, run
 
 if TYPE_CHECKING:
     import pandas
 
 __all__ = [
+    "close_run",
+    "load_scenario",
+    "open_run",
+    "read_run",
+    "run",
     "run_campaign",
+    "RunResult",
     "array_field",
     "BeaconRange",
     "body_surface_distance",

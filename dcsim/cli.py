@@ -6,12 +6,14 @@ no traceback; ``dcsim --debug ...`` shows the traceback instead.
 
 from __future__ import annotations
 
+import difflib
 import json
 import re
 import sys
 import time
 import warnings
 from collections.abc import Sequence
+from dataclasses import asdict
 from datetime import datetime
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -20,9 +22,10 @@ import click
 
 from dcsim import __version__
 from dcsim.cli_campaign import campaign_group, cluster_choice, cluster_options
-from dcsim.errors import DcsimError, PluginLoadWarning
+from dcsim.errors import DcsimError, PluginLoadWarning, PluginNotFoundError
 from dcsim.interfaces import PLUGIN_KINDS
-from dcsim.registry import PluginRegistry
+from dcsim.params import ParameterInfo, parameter_infos
+from dcsim.registry import PluginRegistry, RegisteredPlugin
 from dcsim.rundir import file_name_part, prepare_run_directory
 from dcsim.runsetup import prepare_run
 from dcsim.scenario import load_scenario
@@ -71,20 +74,27 @@ def cli(ctx: click.Context, debug: bool) -> None:
 
 
 @cli.command("plugins")
+@click.argument("name", required=False)
 @click.option(
     "--kind",
     type=click.Choice(list(PLUGIN_KINDS)),
     help="Only list plugins of this kind.",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print a JSON list instead of a table.")
-def plugins_command(kind: str | None, as_json: bool) -> None:
-    """List registered plugins: kind, name, summary and origin.
+def plugins_command(name: str | None, kind: str | None, as_json: bool) -> None:
+    """List registered plugins: kind, name, summary and origin; or NAME's parameters.
 
     The origin is the installed distribution (and version) that provides the plugin.
-    Set DCSIM_LOAD_PLUGINS to a comma-separated list of distributions to restrict
-    which external plugins load.
+    With NAME, prints that plugin's robots and parameters (name, default, unit, bounds
+    or allowed values, description), the keys of its scenario section's params; --kind
+    picks one of two plugins of that name. Set DCSIM_LOAD_PLUGINS to a comma-separated
+    list of distributions to restrict which external plugins load.
     """
-    entries = [p.as_dict() for p in _registry().plugins(kind)]
+    registry = _registry()
+    if name is not None:
+        _print_parameters(_plugins_named(registry, name, kind), as_json)
+        return
+    entries = [p.as_dict() for p in registry.plugins(kind)]
     if as_json:
         click.echo(json.dumps(entries, indent=2))
         return
@@ -92,6 +102,62 @@ def plugins_command(kind: str | None, as_json: bool) -> None:
         (e["kind"], e["name"], e["summary"], f"{e['distribution']} {e['version']}") for e in entries
     ]
     _print_table(("KIND", "NAME", "SUMMARY", "ORIGIN"), rows)
+
+
+def _plugins_named(registry: PluginRegistry, name: str, kind: str | None) -> list[RegisteredPlugin]:
+    """The registered plugins called ``name`` (of ``kind``, if given).
+
+    Raises
+    ------
+    PluginNotFoundError
+        Naming the closest names when there is none.
+    """
+    found = [p for p in registry.plugins(kind) if p.name == name]
+    if found:
+        return found
+    if kind is not None:
+        registry.get(kind, name)  # raises, with the names of that kind
+    names = sorted({p.name for p in registry.plugins()})
+    close = difflib.get_close_matches(name, names, n=1)
+    hint = f"; did you mean '{close[0]}'?" if close else ""
+    raise PluginNotFoundError(f"no plugin named '{name}' (see dcsim plugins){hint}")
+
+
+def _print_parameters(plugins: list[RegisteredPlugin], as_json: bool) -> None:
+    """Each plugin's origin, robots and parameter table (or all of it as JSON)."""
+    if as_json:
+        entries = [
+            {
+                **plugin.as_dict(),
+                "robots": list(plugin.cls.robots),
+                "parameters": [asdict(info) for info in parameter_infos(plugin.cls.Params)],
+            }
+            for plugin in plugins
+        ]
+        click.echo(json.dumps(entries, indent=2, ensure_ascii=False))
+        return
+    for index, plugin in enumerate(plugins):
+        click.echo(("\n" if index else "") + f"{plugin.kind} {plugin.name}: {plugin.cls.summary}")
+        click.echo(f"origin: {plugin.origin}")
+        click.echo(f"robots: {', '.join(plugin.cls.robots)}")
+        rows = [
+            (i.name, _default_text(i), i.unit, i.bounds, i.description)
+            for i in parameter_infos(plugin.cls.Params)
+        ]
+        if not rows:
+            click.echo("parameters: none")
+            continue
+        click.echo("")
+        _print_table(("PARAMETER", "DEFAULT", "UNIT", "BOUNDS", "DESCRIPTION"), rows)
+
+
+def _default_text(info: ParameterInfo) -> str:
+    """A parameter's default as a scenario file would write it."""
+    if info.required:
+        return "required"
+    if isinstance(info.default, str):
+        return info.default
+    return json.dumps(info.default, ensure_ascii=False)
 
 
 def _print_table(header: tuple[str, ...], rows: list[tuple[str, ...]]) -> None:
@@ -211,6 +277,7 @@ def _print_summary(summary: dict, out: Path) -> None:
         f"  simulated {summary['sim_time_s']:.1f} s in {summary['wall_time_s']:.1f} s of wall time "
         f"(x{summary['real_time_factor']:.0f} real time)"
     )
+    click.echo(f"  plugins: {_plugins_flown(summary['plugins'])}")
     click.echo(f"  results in {out}")
 
 
@@ -261,6 +328,14 @@ def _megabytes(path: Path) -> str:
     return f"{path.stat().st_size / 1e6:.1f} MB"
 
 
+def _plugins_flown(plugins: dict[str, dict[str, str]]) -> str:
+    """``localiser ekf (dcsim 0.1.0), ...``: each role's plugin and where it came from."""
+    return ", ".join(
+        f"{role} {entry['name']} ({entry['distribution']} {entry['version']})"
+        for role, entry in plugins.items()
+    )
+
+
 @cli.command("new-plugin")
 @click.argument("kind", type=click.Choice(list(PLUGIN_KINDS)))
 @click.argument("name")
@@ -278,11 +353,12 @@ def new_plugin_command(kind: str, name: str, directory: Path) -> None:
     The package (DIR/dcsim-NAME) has a pyproject.toml with the dcsim entry point, the
     plugin class with its parameter model and a simple working algorithm, a test file
     that runs the conformance suite, and a README. Install it with
-    `pip install -e DIR/dcsim-NAME` and run `pytest` inside it.
+    `pip install -e DIR/dcsim-NAME` and run `pytest` inside it. A NAME an installed
+    plugin of KIND already has is refused.
     """
     from dcsim.scaffold import new_plugin
 
-    root = new_plugin(kind, name, directory)
+    root = new_plugin(kind, name, directory, _registry())
     click.echo(f"wrote {root}")
     click.echo(f"next: pip install -e '{root}[test]' && (cd {root} && pytest)")
 
@@ -292,12 +368,14 @@ def bench_group() -> None:
     """Measure dcsim and its plugins; results go into docs/benchmarks.md."""
 
 
-@bench_group.command("world")
+@bench_group.command(
+    "world", short_help="Closed-loop wall time per simulated second against PyBullet."
+)
 @click.option(
     "--objects",
     default="10,100,1000",
     show_default=True,
-    help="Comma-separated field sizes (targets and obstacles in all).",
+    help="Comma-separated field sizes (targets and obstacles in all), each >= 0.",
 )
 @click.option(
     "--duration",
@@ -317,10 +395,12 @@ def bench_world_command(objects: str, duration: float) -> None:
     from dcsim.bench.world import bench_world, markdown_table
     from dcsim.runner import Runner
 
-    try:
-        sizes = [int(n) for n in objects.split(",")]
-    except ValueError:
-        raise click.BadParameter(f"expected integers like 10,100,1000, got {objects!r}") from None
+    words = [word.strip() for word in objects.split(",")]
+    if not all(word.isdigit() for word in words):
+        raise click.BadParameter(
+            f"expected integers >= 0 like 10,100,1000, got {objects!r}", param_hint="--objects"
+        )
+    sizes = [int(word) for word in words]
     rows = bench_world(sizes, duration, progress=lambda line: click.echo(line, err=True))
     click.echo(markdown_table(rows))
     summary = Runner(prepare_run(registry=_registry())).run()
@@ -331,7 +411,7 @@ def bench_world_command(objects: str, duration: float) -> None:
     )
 
 
-@bench_group.command("soak")
+@bench_group.command("soak", short_help="A long run's memory and time per tick; FMU lifetimes.")
 @click.option(
     "--ticks",
     type=click.IntRange(min=100),
@@ -400,7 +480,9 @@ def bench_soak_command(
         )
 
 
-@bench_group.command("localisers")
+@bench_group.command(
+    "localisers", short_help="Localisers' RMSE against the Cramér–Rao bound; latency."
+)
 @click.option(
     "--runs", type=click.IntRange(min=1), default=10, show_default=True, help="Monte Carlo runs."
 )
@@ -451,7 +533,9 @@ def bench_localisers_command(
         click.echo(f"plot: {plot_path}")
 
 
-@bench_group.command("task-planners")
+@bench_group.command(
+    "task-planners", short_help="ga's time strategies; task planners' gaps to the optimum."
+)
 @click.option(
     "--instances",
     type=click.IntRange(min=1),
@@ -532,7 +616,9 @@ def bench_task_planners_command(
         click.echo(f"plots: {plot_dir}")
 
 
-@bench_group.command("controllers")
+@bench_group.command(
+    "controllers", short_help="Controllers across crowded fields of drifting obstacles."
+)
 @click.option(
     "--seeds",
     type=click.IntRange(min=1),
@@ -608,7 +694,9 @@ def bench_controllers_command(
         click.echo(f"plot: {plot_path}")
 
 
-@bench_group.command("campaign")
+@bench_group.command(
+    "campaign", short_help="The campaign engine's overhead and speed-up per worker."
+)
 @click.argument(
     "campaign",
     required=False,
@@ -661,7 +749,7 @@ def bench_campaign_command(
     click.echo(markdown_table(bench))
 
 
-@bench_group.command("fmu")
+@bench_group.command("fmu", short_help="The closed-loop FMU in fmpy against dcsim run, per tick.")
 @click.argument("scenario", required=False, type=click.Path(dir_okay=False, path_type=Path))
 @click.option(
     "--duration",
@@ -688,7 +776,9 @@ def bench_fmu_command(scenario: Path | None, duration: float, repeats: int) -> N
     click.echo(markdown_table(result))
 
 
-@bench_group.command("manipulator")
+@bench_group.command(
+    "manipulator", short_help="The manipulator model's time per call against Pinocchio."
+)
 @click.option(
     "--states",
     type=click.IntRange(min=1),
@@ -737,7 +827,9 @@ def bench_manipulator_command(
         click.echo(f"\n{bench.scenario_line(speed)}")
 
 
-@bench_group.command("grid-search")
+@bench_group.command(
+    "grid-search", short_help="The Boeing paper's Tables 3-4: grid-astar and multi-burn."
+)
 @click.option(
     "--scenario",
     type=click.Path(exists=True, dir_okay=False, path_type=Path),
@@ -779,7 +871,9 @@ def bench_grid_search_command(
     click.echo(tables(cells))
 
 
-@bench_group.command("ant-colony")
+@bench_group.command(
+    "ant-colony", short_help="The ant-colony planner against its graph's exact optimum."
+)
 @click.option(
     "--layouts",
     type=int,
@@ -942,7 +1036,7 @@ def bench_ant_colony_command(
         click.echo(f"plot: {plot_path}")
 
 
-@bench_group.command("q-learning")
+@bench_group.command("q-learning", short_help="The q-learning planner against value iteration.")
 @click.option(
     "--scenario",
     default="scenarios/space_manipulator_reach.yaml",
@@ -1043,7 +1137,9 @@ def _span(specs: Sequence[str]) -> str:
     return ", ".join(specs)
 
 
-@bench_group.command("path-planners")
+@bench_group.command(
+    "path-planners", short_help="Path planners side by side on seeded fields and scenarios."
+)
 @click.option(
     "--planners",
     default=None,

@@ -92,7 +92,8 @@ def dcsim_run_step(run: RunInfo, row: Mapping[str, Any]) -> None:
         The run.
     row : mapping
         Column name to value, as written to ``telemetry.csv`` (true and estimated
-        state, mode, fuel, delta-v, nearest-obstacle distance, command).
+        state, mode, fuel, delta-v, nearest-obstacle distance, command), the names
+        without the header's unit suffix (``x`` for ``x_m``); SI units.
     """
 
 

@@ -17,10 +17,12 @@ Examples
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from dataclasses import dataclass
+from types import UnionType
+from typing import Any, Literal, Union, get_args, get_origin
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
-from pydantic_core import ErrorDetails
+from pydantic_core import ErrorDetails, to_jsonable_python
 
 from dcsim.errors import PluginParameterError, Problem
 
@@ -92,6 +94,66 @@ def field_bounds(model: type[BaseModel], name: str) -> str:
             if value is not None:
                 parts.append(f"{symbol} {value if isinstance(value, int) else f'{value:g}'}")
     return ", ".join(parts)
+
+
+def field_choices(model: type[BaseModel], name: str) -> tuple[Any, ...]:
+    """The values a field of ``Literal`` type allows (``None`` too when it is optional);
+    empty for any other field."""
+    annotation = model.model_fields[name].annotation
+    options = get_args(annotation) if get_origin(annotation) in (Union, UnionType) else ()
+    literals = [a for a in (annotation, *options) if get_origin(a) is Literal]
+    if not literals:
+        return ()
+    return (*get_args(literals[0]), *((None,) if type(None) in options else ()))
+
+
+@dataclass(frozen=True)
+class ParameterInfo:
+    """What one field of a parameter model declares (``dcsim plugins NAME`` prints it).
+
+    Attributes
+    ----------
+    name : str
+        The field's name.
+    default : Any
+        Its default value, JSON-compatible (None also when there is none).
+    required : bool
+        Whether a value must be given (there is no default).
+    unit : str
+        Its SI unit, empty for a dimensionless value.
+    bounds : str
+        Its bounds (``"> 0, <= 5"``), or the values it allows (``"one of: fix, prior"``);
+        empty when any value of its type goes.
+    description : str
+        One sentence saying what it means.
+    """
+
+    name: str
+    default: Any
+    required: bool
+    unit: str
+    bounds: str
+    description: str
+
+
+def parameter_infos(model: type[BaseModel]) -> list[ParameterInfo]:
+    """What each field of ``model`` declares, in the model's order."""
+    infos = []
+    for name, info in model.model_fields.items():
+        choices = field_choices(model, name)
+        listed = ", ".join("null" if c is None else str(c) for c in choices)
+        default = None if info.is_required() else info.get_default(call_default_factory=True)
+        infos.append(
+            ParameterInfo(
+                name=name,
+                default=to_jsonable_python(default),
+                required=info.is_required(),
+                unit=field_unit(model, name),
+                bounds=f"one of: {listed}" if choices else field_bounds(model, name),
+                description=info.description or "",
+            )
+        )
+    return infos
 
 
 class PluginParams(BaseModel):

@@ -41,6 +41,30 @@ _LEADING_COLUMNS = (
 _TRAILING_COLUMNS = ("fuel_used", "delta_v", "nearest_obstacle", "fx", "fy", "fz")
 _TEXT_COLUMNS = frozenset({"mode"})
 
+UNITS = {
+    "s": "s",
+    "m": "m",
+    "m6": "m⁶",
+    "mps": "m/s",
+    "rad": "rad",
+    "radps": "rad/s",
+    "kg": "kg",
+    "N": "N",
+    "Nm": "N·m",
+    "Ns": "N·s",
+    "Nms": "N·m·s",
+}
+"""The unit suffixes of ``telemetry.csv``'s header (``x_m``, ``vx_mps``), each with its unit."""
+
+COLUMN_UNITS = {
+    "time": "s",
+    **dict.fromkeys(("x", "y", "z", "est_x", "est_y", "est_z", "nearest_obstacle"), "m"),
+    **dict.fromkeys(("vx", "vy", "vz", "est_vx", "est_vy", "est_vz", "delta_v"), "mps"),
+    "fuel_used": "kg",
+    **dict.fromkeys(("fx", "fy", "fz"), "N"),
+}
+"""Unit suffix of each column every run records (a column absent has no unit)."""
+
 
 class RecordingError(DcsimError):
     """The run directory could not be written (disk full, permissions, a vanished folder)."""
@@ -56,6 +80,52 @@ def telemetry_columns(mission_columns: Sequence[str]) -> tuple[str, ...]:
     and the commanded thrust (N).
     """
     return (*_LEADING_COLUMNS, *mission_columns, *_TRAILING_COLUMNS)
+
+
+def telemetry_units(mission_units: Mapping[str, str]) -> dict[str, str]:
+    """Unit suffix of each telemetry column: :data:`COLUMN_UNITS` and the mission's own."""
+    return {**COLUMN_UNITS, **mission_units}
+
+
+def header_name(column: str, unit: str = "") -> str:
+    """A column's name in ``telemetry.csv``'s header: ``column_unit``, or ``column`` alone.
+
+    Parameters
+    ----------
+    column : str
+        The column's name in a telemetry row (``x``, ``delta_v``).
+    unit : str
+        Its unit suffix, a key of :data:`UNITS` (``m``, ``mps``); empty for a count, a
+        flag, a text or a dimensionless number.
+
+    Raises
+    ------
+    ValueError
+        For an unknown unit, or a column without one whose name ends like a unit suffix
+        (the header could not be read back).
+    """
+    if unit and unit not in UNITS:
+        raise ValueError(f"unknown unit {unit!r} of telemetry column {column!r}: use {list(UNITS)}")
+    name = f"{column}_{unit}" if unit else column
+    if column_name(name) != column:
+        raise ValueError(f"telemetry column {column!r} without a unit ends like a unit suffix")
+    return name
+
+
+def column_name(header: str) -> str:
+    """A telemetry column's row name from its header name: ``vx_mps`` → ``vx``."""
+    return _split_unit(header)[0]
+
+
+def column_unit(header: str) -> str:
+    """The unit of a header name (``vx_mps`` → ``m/s``); empty when it has none."""
+    return UNITS.get(_split_unit(header)[1], "")
+
+
+def _split_unit(header: str) -> tuple[str, str]:
+    """A header name's row name and unit suffix (empty when it has none)."""
+    stem, _, suffix = header.rpartition("_")
+    return (stem, suffix) if stem and suffix in UNITS else (header, "")
 
 
 def _json_value(value: Any) -> Any:
@@ -105,9 +175,14 @@ class Recorder:
     keep_rows : bool, optional
         Keep every row in :attr:`rows` as well; by default only when there is no run
         directory.
+    units : mapping of str to str, optional
+        Unit suffix of each column that has one (:func:`telemetry_units`), written into
+        the header of ``telemetry.csv``; the rows keep the bare column names.
 
     Attributes
     ----------
+    header : tuple of str
+        The columns' names in the header of ``telemetry.csv`` (:func:`header_name`).
     rows : list of dict
         The rows kept in memory (empty unless ``keep_rows``).
     events : list of dict
@@ -119,10 +194,16 @@ class Recorder:
     """
 
     def __init__(
-        self, out_dir: Path | None, columns: Sequence[str], keep_rows: bool | None = None
+        self,
+        out_dir: Path | None,
+        columns: Sequence[str],
+        keep_rows: bool | None = None,
+        units: Mapping[str, str] | None = None,
     ) -> None:
         self.out_dir = out_dir
         self.columns = tuple(columns)
+        units = units or {}
+        self.header = tuple(header_name(c, units.get(c, "")) for c in self.columns)
         self.keep_rows = out_dir is None if keep_rows is None else keep_rows
         self.rows: list[dict[str, Any]] = []
         self.events: list[dict[str, Any]] = []
@@ -143,7 +224,7 @@ class Recorder:
         write_summary(self.out_dir, summary)
         with self._writing("telemetry.csv"):
             self._telemetry_file = (self.out_dir / "telemetry.csv").open("w", encoding="utf-8")
-            self._telemetry_file.write(",".join(self.columns) + "\n")
+            self._telemetry_file.write(",".join(self.header) + "\n")
             self._telemetry_file.flush()
         with self._writing("events.jsonl"):
             self._events_file = (self.out_dir / "events.jsonl").open("w", encoding="utf-8")
@@ -276,13 +357,14 @@ def read_telemetry(path: Path, max_points: int | None = None) -> dict[str, np.nd
     Returns
     -------
     dict of str to ndarray
-        One array per column: floats, except ``mode`` (text).
+        One array per column, by its row name (the header's name without its unit
+        suffix, :func:`column_name`): floats, except ``mode`` (text).
     """
-    step = 1 if max_points is None else _stride(_count_lines(path) - 1, max_points)
+    step = 1 if max_points is None else _stride(count_lines(path) - 1, max_points)
     kept: list[list[str]] = []
     last: list[str] | None = None
     with path.open(encoding="utf-8") as stream:
-        header = stream.readline().rstrip("\n").split(",")
+        header = [column_name(h) for h in stream.readline().rstrip("\n").split(",")]
         mode = header.index("mode") if "mode" in header else None
         for index, text in enumerate(stream):
             fields = text.rstrip("\n").split(",")
@@ -299,8 +381,8 @@ def read_telemetry(path: Path, max_points: int | None = None) -> dict[str, np.nd
     return _parse(header, kept)
 
 
-def _count_lines(path: Path) -> int:
-    """Number of line ends in a file, read in blocks."""
+def count_lines(path: Path) -> int:
+    """Number of line ends in a file, read in blocks (the file is not held in memory)."""
     count = 0
     with path.open("rb") as stream:
         while block := stream.read(1 << 20):

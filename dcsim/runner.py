@@ -35,7 +35,7 @@ from dcsim.hookspecs import RunInfo
 from dcsim.messages import Command, Observations, Prior, StateEstimate
 from dcsim.missions import Mission, mission_class
 from dcsim.plugin_calls import PluginFailure, call_plugin
-from dcsim.recording import Recorder, RecordingError, telemetry_columns
+from dcsim.recording import Recorder, RecordingError, telemetry_columns, telemetry_units
 from dcsim.runsetup import RunSetup
 from dcsim.scenario import dump_scenario
 from dcsim.scenario.model import point_to_cartesian
@@ -158,7 +158,8 @@ class Runner:
         self.plugins = setup.plugins
         self.mission_class = mission_class(self.scenario.mission.type)
         columns = telemetry_columns(self.mission_class.telemetry_columns(self.scenario))
-        self.recorder = Recorder(out_dir, columns, keep_rows)
+        units = telemetry_units(self.mission_class.telemetry_units(self.scenario))
+        self.recorder = Recorder(out_dir, columns, keep_rows, units)
         self.info = RunInfo(self.scenario, self.scenario.world.seed, out_dir)
         self.progress = progress
         self.world: World | None = None

@@ -4,11 +4,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 
 from dcsim.interfaces import Plugin
 from dcsim.registry import PluginRegistry, RegisteredPlugin
-from dcsim.scenario import Scenario, load_scenario
+from dcsim.scenario import Scenario, ScenarioSource, load_scenario
 from dcsim.seeding import component_rng
 
 
@@ -48,7 +47,7 @@ class RunSetup:
 
 
 def prepare_run(
-    path: str | Path | None = None,
+    path: ScenarioSource = None,
     overrides: Sequence[str] = (),
     seed: int | None = None,
     registry: PluginRegistry | None = None,
@@ -57,8 +56,8 @@ def prepare_run(
 
     Parameters
     ----------
-    path : str or Path, optional
-        Scenario file; the packaged default if None.
+    path : str, Path or mapping, optional
+        Scenario file, or the scenario's data as a mapping; the packaged default if None.
     overrides : sequence of str
         ``key.path=value`` overrides.
     seed : int, optional

@@ -15,6 +15,7 @@ from string import Template
 from dcsim import __version__
 from dcsim.errors import DcsimError
 from dcsim.interfaces import PLUGIN_KINDS
+from dcsim.registry import PluginRegistry
 
 _NAME = re.compile(r"^[a-z][a-z0-9_-]*$")
 _SUMMARIES = {
@@ -46,8 +47,20 @@ def _template(name: str) -> Template:
     return Template(text)
 
 
-def new_plugin(kind: str, name: str, directory: Path) -> Path:
+def new_plugin(
+    kind: str, name: str, directory: Path, registry: PluginRegistry | None = None
+) -> Path:
     """Write the package of a new ``kind`` plugin called ``name`` under ``directory``.
+
+    Parameters
+    ----------
+    kind, name : str
+        The plugin's kind (``controller``...) and name (``my-controller``).
+    directory : Path
+        The folder the package's folder is made in.
+    registry : PluginRegistry, optional
+        The installed plugins: a name one of them has for ``kind`` is refused, as the
+        two could not be told apart in a scenario.
 
     Returns
     -------
@@ -57,7 +70,8 @@ def new_plugin(kind: str, name: str, directory: Path) -> Path:
     Raises
     ------
     ScaffoldError
-        For an unknown kind, a name that is not a plugin name, or an existing folder.
+        For an unknown kind, a name that is not a plugin name or is taken, or an
+        existing folder.
     """
     if kind not in PLUGIN_KINDS:
         raise ScaffoldError(f"unknown plugin kind '{kind}' (kinds: {', '.join(PLUGIN_KINDS)})")
@@ -65,6 +79,12 @@ def new_plugin(kind: str, name: str, directory: Path) -> Path:
         raise ScaffoldError(
             f"'{name}' is not a plugin name: use lower-case letters, digits, '-' and '_', "
             "starting with a letter (e.g. my-controller)"
+        )
+    taken = [p for p in (registry.plugins(kind) if registry else ()) if p.name == name]
+    if taken:
+        raise ScaffoldError(
+            f"an installed {kind} plugin is already named '{name}' ({taken[0].origin}); "
+            "choose another name"
         )
     module = "dcsim_" + name.replace("-", "_")
     values = {

@@ -27,7 +27,7 @@ def test_help_lists_commands(dcsim_cli):
 @pytest.mark.parametrize(
     "command, options",
     [
-        ("plugins", ["--kind", "--json"]),
+        ("plugins", ["--kind", "--json", "NAME"]),
         ("validate", ["FILES"]),
         ("run", ["--out", "--force", "--seed", "--set", "--view", "SCENARIO"]),
         ("view", ["RUN_DIR", "--out", "--max-frames"]),
@@ -77,6 +77,51 @@ def test_plugins_rejects_unknown_kind(dcsim_cli):
     assert "Traceback" not in result.stderr
 
 
+def test_plugins_name_prints_every_parameter_with_default_unit_and_bounds(dcsim_cli):
+    result = dcsim_cli("plugins", "pd")
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert lines[0].startswith("controller pd: PD tracking")
+    assert lines[1].startswith(f"origin: dcsim {__version__}") and lines[2] == "robots: free-flyer"
+    assert lines[4].split()[:5] == ["PARAMETER", "DEFAULT", "UNIT", "BOUNDS", "DESCRIPTION"]
+    assert lines[5].split()[:4] == ["bandwidth", "0.2", "rad/s", ">"]
+    assert "> 0, <= 5  Damping ratio" in lines[6]
+
+
+def test_plugins_name_as_json_gives_defaults_choices_and_required_values(dcsim_cli):
+    (ekf,) = json.loads(dcsim_cli("plugins", "ekf", "--json").stdout)
+    initialise = next(p for p in ekf["parameters"] if p["name"] == "initialise")
+    assert initialise["bounds"] == "one of: fix, prior" and initialise["default"] == "fix"
+    (fmu,) = json.loads(dcsim_cli("plugins", "fmu", "--kind", "controller", "--json").stdout)
+    path = fmu["parameters"][0]
+    assert (path["name"], path["required"], path["default"]) == ("path", True, None)
+    assert fmu["robots"] == ["free-flyer"] and fmu["distribution"] == "dcsim"
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["ekff"], "error: no plugin named 'ekff' (see dcsim plugins); did you mean 'ekf'?"),
+        (["pd", "--kind", "localiser"], "error: no localiser plugin named 'pd' (available: ekf"),
+    ],
+)
+def test_plugins_name_that_is_not_installed_is_a_user_error(dcsim_cli, args, message):
+    result = dcsim_cli("plugins", *args)
+    assert result.returncode == 2 and result.stderr.startswith(message)
+    assert "Traceback" not in result.stderr
+
+
+def test_new_plugin_refuses_the_name_of_an_installed_plugin_of_its_kind(dcsim_cli, tmp_path):
+    result = dcsim_cli("new-plugin", "controller", "pd", "--dir", str(tmp_path))
+    assert result.returncode == 2
+    assert result.stderr.startswith(
+        "error: an installed controller plugin is already named 'pd' (dcsim "
+    )
+    assert "Traceback" not in result.stderr and not (tmp_path / "dcsim-pd").exists()
+    other_kind = dcsim_cli("new-plugin", "localiser", "pd", "--dir", str(tmp_path))
+    assert other_kind.returncode == 0, other_kind.stderr
+
+
 def test_validate_prints_ok_per_file(dcsim_cli):
     files = [
         str(REPO / "scenarios" / "default.yaml"),
@@ -106,6 +151,10 @@ def test_run_default_writes_a_run_directory_and_prints_a_summary(dcsim_cli, tmp_
     assert result.stdout.startswith("default seed 0: completed (duration reached)")
     (run_dir,) = (tmp_path / "runs").glob("default-*")
     assert f"results in runs/{run_dir.name}" in result.stdout
+    assert (
+        f"  plugins: localiser ekf (dcsim {__version__}), task_planner ga (dcsim {__version__}), "
+        f"path_planner straight-line (dcsim {__version__}), controller pd (dcsim {__version__})\n"
+    ) in result.stdout
     names = {p.name for p in run_dir.iterdir()}
     assert {"scenario.yaml", "telemetry.csv", "events.jsonl", "summary.json", "plots"} <= names
     resolved = yaml.safe_load((run_dir / "scenario.yaml").read_text())
@@ -183,29 +232,44 @@ def test_debug_shows_the_traceback(dcsim_cli):
     assert "ScenarioError" in result.stderr
 
 
+def test_bench_help_lists_every_bench_with_its_whole_one_line_description(dcsim_cli):
+    from dcsim.cli import bench_group
+
+    lines = dcsim_cli("bench", "--help").stdout.split("Commands:\n")[1].splitlines()
+    assert len(lines) == len(bench_group.commands)  # one line each, none wrapped
+    for name, command in bench_group.commands.items():
+        assert command.short_help and command.short_help.endswith(".")
+        assert f"  {name}  " in next(line for line in lines if line.split()[0] == name)
+        assert next(line for line in lines if line.split()[0] == name).endswith(command.short_help)
+
+
+# The least values the options of `bench world`, `manipulator` and `localisers` allow
+# (tests/bench/test_smallest_options.py runs the other benches at theirs).
 def test_bench_world_prints_a_table_for_each_size(dcsim_cli):
-    result = dcsim_cli("bench", "world", "--objects", "5,20", "--duration", "2")
+    result = dcsim_cli("bench", "world", "--objects", "0,5", "--duration", "1")
     assert result.returncode == 0, result.stderr
     rows = [
         line for line in result.stdout.splitlines() if line.startswith("| ") and line[2].isdigit()
     ]
-    assert [row.split("|")[1].strip() for row in rows] == ["5", "20"]
+    assert [row.split("|")[1].strip() for row in rows] == ["0", "5"]
     assert "default scenario: completed (all targets delivered)" in result.stdout
     assert "5 objects: bare stepping" in result.stderr
+    negative = dcsim_cli("bench", "world", "--objects", "5,-1")
+    assert negative.returncode == 2 and "expected integers >= 0" in negative.stderr
 
 
 def test_bench_manipulator_prints_the_table_and_the_verdict(dcsim_cli):
-    result = dcsim_cli("bench", "manipulator", "--states", "2", "--repeats", "1", "--number", "1")
+    result = dcsim_cli("bench", "manipulator", "--states", "1", "--repeats", "1", "--number", "1")
     assert result.returncode == 0, result.stderr
     assert "| M + C, two calls |" in result.stdout
     assert "M + C within 10× of Pinocchio: " in result.stdout
-    assert "agreement with dcsim over the 2 states" in result.stdout
-    assert "dcsim: timed 6 quantities at 2 states" in result.stderr
+    assert "agreement with dcsim over the 1 states" in result.stdout
+    assert "dcsim: timed 6 quantities at 1 states" in result.stderr
 
 
 def test_bench_localisers_prints_the_bound_and_every_localiser(dcsim_cli, tmp_path):
     plot = tmp_path / "localisers.png"
-    result = dcsim_cli("bench", "localisers", "--runs", "1", "--steps", "20", "--plot", str(plot))
+    result = dcsim_cli("bench", "localisers", "--runs", "1", "--steps", "10", "--plot", str(plot))
     assert result.returncode == 0, result.stderr
     labels = [
         line.split("|")[1].strip() for line in result.stdout.splitlines() if line.startswith("| ")

@@ -12,8 +12,9 @@ import time
 import tracemalloc
 
 import numpy as np
+import pytest
 
-from dcsim.recording import read_telemetry
+from dcsim.recording import Recorder, column_unit, header_name, read_telemetry
 from dcsim.registry import PluginRegistry
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
@@ -93,6 +94,26 @@ def test_a_cut_last_line_is_left_out_and_mode_changes_survive_thinning(tmp_path)
     assert len(thin["time"]) < 20
     assert "B" in thin["mode"] and thin["x"][0] == 0 and thin["x"][-1] == 999
     assert {499, 500, 501} <= set(thin["x"].astype(int))
+
+
+def test_the_header_carries_units_and_the_reader_gives_the_row_names(tmp_path):
+    recorder = Recorder(tmp_path, ("time", "mode", "x", "hits"), units={"time": "s", "x": "m"})
+    recorder.start("name: t\n", {"status": "running"})
+    recorder.row({"time": 0.0, "mode": "A", "x": 1.5, "hits": 2})
+    recorder.finish({"status": "completed"})
+    lines = (tmp_path / "telemetry.csv").read_text().splitlines()
+    assert lines == ["time_s,mode,x_m,hits", "0.0,A,1.5,2"]
+    table = read_telemetry(tmp_path / "telemetry.csv")
+    assert list(table) == ["time", "mode", "x", "hits"] and table["x"][0] == 1.5
+    assert [column_unit(name) for name in lines[0].split(",")] == ["s", "", "m", ""]
+    assert column_unit("vx_mps") == "m/s" and column_unit("tx_Nm") == "N·m"
+
+
+def test_a_unit_the_header_could_not_carry_back_is_refused():
+    with pytest.raises(ValueError, match="unknown unit 'furlong'"):
+        header_name("x", "furlong")
+    with pytest.raises(ValueError, match="ends like a unit suffix"):
+        header_name("mass_kg")  # read back, the header would say: mass, in kg
 
 
 def test_bad_output_paths_are_refused_before_the_run(dcsim_cli, tmp_path):

@@ -300,9 +300,15 @@ def gap_table(results: list[GapResult]) -> str:
         lines.append(
             f"| {kind} | {r.n} | {r.label} | {done} | {_percent(r.gaps, np.median)} | "
             f"{_percent(r.gaps, lambda g: np.percentile(g, 95))} | {_percent(r.gaps, np.max)} | "
-            f"{np.median(r.seconds):.3f} | {max(r.seconds):.3f} |"
+            f"{_seconds(r.seconds, np.median)} | {_seconds(r.seconds, np.max)} |"
         )
     return "\n".join(lines)
+
+
+def _seconds(seconds: list[float], statistic: Callable[[np.ndarray], float]) -> str:
+    """``statistic`` of planning times, s, or "–" if no plan was made (no instance, or
+    none the optimum could plan)."""
+    return f"{statistic(np.array(seconds)):.3f}" if seconds else "–"
 
 
 def plot_gaps(results: list[GapResult], path: Path) -> None:

@@ -62,6 +62,10 @@ class Mission(ABC):
     columns : tuple of str
         The mission's own telemetry columns, recorded after ``mode`` and ``converged``
         (:meth:`telemetry_columns` gives them for a scenario).
+    units : mapping of str to str
+        The unit suffix of each of its columns that has a unit (a key of
+        :data:`dcsim.recording.UNITS`: ``m``, ``mps``, ``rad``...), written into the
+        header of ``telemetry.csv`` (:meth:`telemetry_units` gives them for a scenario).
     robots : tuple of str
         The robot types (``robot.type``) it can fly; a scenario pairing it with another
         is refused before the run.
@@ -76,6 +80,7 @@ class Mission(ABC):
     roles: ClassVar[tuple[str, ...]]
     modes: ClassVar[tuple[str, ...]]
     columns: ClassVar[tuple[str, ...]] = ()
+    units: ClassVar[Mapping[str, str]] = {}
     robots: ClassVar[tuple[str, ...]] = ("free-flyer",)
     summary_names: ClassVar[tuple[str, ...]] = ()
 
@@ -117,6 +122,12 @@ class Mission(ABC):
         """The mission's own telemetry columns for ``scenario``: :attr:`columns`, unless
         the mission's columns depend on the robot (one per joint, say)."""
         return cls.columns
+
+    @classmethod
+    def telemetry_units(cls, scenario: Scenario) -> Mapping[str, str]:
+        """The unit suffix of each of the mission's columns for ``scenario`` that has
+        one: :attr:`units`, unless the columns depend on the robot."""
+        return cls.units
 
     def telemetry(self, outputs: Mapping[str, Any]) -> dict[str, Any]:
         """Values of the mission's columns now, given the world's outputs

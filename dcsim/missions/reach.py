@@ -115,15 +115,13 @@ class ReachMission(Mission):
     def telemetry_columns(cls, scenario: Scenario) -> tuple[str, ...]:
         """End effector, joints (one column each), singularity, sight, displacements,
         commanded torques and momentum."""
-        joints = range(1, len(scenario.robot.links) + 1)
-        return (
-            "ee_x", "ee_y", "ee_z", "ref_ee_x", "ref_ee_y", "ref_ee_z",
-            "ee_error", "target_distance",
-            *(f"joint_{i}" for i in joints), *(f"ref_joint_{i}" for i in joints),
-            "joint_error", "det_jjt", "target_angle", "base_displacement", "ee_displacement",
-            "tx", "ty", "tz", *(f"joint_torque_{i}" for i in joints),
-            "px", "py", "pz", "hx", "hy", "hz",
-        )  # fmt: skip
+        return tuple(_column_units(scenario))
+
+    @classmethod
+    def telemetry_units(cls, scenario: Scenario) -> dict[str, str]:
+        """Metres, radians (joints, joint error, sight angle), m⁶ (det(J Jᵀ) of the
+        position rows), N·m (torques), N·s and N·m·s (linear and angular momentum)."""
+        return {name: unit for name, unit in _column_units(scenario).items() if unit}
 
     # ------------------------------------------------------------------ the tick
     @property
@@ -300,6 +298,24 @@ class ReachMission(Mission):
             "max_base_displacement_m": figures.max_base_displacement,
             "ee_displacement_m": figures.ee_displacement,
         }
+
+
+def _column_units(scenario: Scenario) -> dict[str, str]:
+    """The mission's telemetry columns in order, each with its unit suffix."""
+    joints = range(1, len(scenario.robot.links) + 1)
+    return {
+        **dict.fromkeys(("ee_x", "ee_y", "ee_z", "ref_ee_x", "ref_ee_y", "ref_ee_z"), "m"),
+        **dict.fromkeys(("ee_error", "target_distance"), "m"),
+        **dict.fromkeys((f"joint_{i}" for i in joints), "rad"),
+        **dict.fromkeys((f"ref_joint_{i}" for i in joints), "rad"),
+        "joint_error": "rad",
+        "det_jjt": "m6",
+        "target_angle": "rad",
+        **dict.fromkeys(("base_displacement", "ee_displacement"), "m"),
+        **dict.fromkeys(("tx", "ty", "tz", *(f"joint_torque_{i}" for i in joints)), "Nm"),
+        **dict.fromkeys(("px", "py", "pz"), "Ns"),
+        **dict.fromkeys(("hx", "hy", "hz"), "Nms"),
+    }
 
 
 @dataclass(frozen=True)

@@ -83,6 +83,7 @@ class TransferMission(Mission):
     )
     modes = ("PLAN", "HOLD", "FLY", "ARRIVED")
     columns = ("ref_x", "ref_y", "ref_z", "tracking_error", "goal_distance")
+    units = dict.fromkeys(columns, "m")
     settings: TransferMissionSection
 
     def __init__(

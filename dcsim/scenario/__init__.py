@@ -2,11 +2,13 @@
 
 from dcsim.scenario.document import ScenarioDocument, format_key_path, parse_key_path
 from dcsim.scenario.loader import (
+    ScenarioSource,
     default_scenario_path,
     dump_scenario,
     load_scenario,
     packaged_scenario_path,
     resolve_plugins,
+    scenario_document,
     validate,
 )
 from dcsim.scenario.model import Scenario
@@ -14,6 +16,7 @@ from dcsim.scenario.model import Scenario
 __all__ = [
     "Scenario",
     "ScenarioDocument",
+    "ScenarioSource",
     "default_scenario_path",
     "packaged_scenario_path",
     "dump_scenario",
@@ -21,5 +24,6 @@ __all__ = [
     "load_scenario",
     "parse_key_path",
     "resolve_plugins",
+    "scenario_document",
     "validate",
 ]

@@ -16,7 +16,7 @@ gives an equal scenario.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from functools import cache
 from importlib import resources
 from pathlib import Path
@@ -51,8 +51,41 @@ def packaged_scenario_path(name: str) -> Path:
     return Path(str(resources.files("dcsim") / "scenarios" / name))
 
 
+ScenarioSource = str | Path | Mapping[str, Any] | None
+"""A scenario file's path, the scenario's data as a mapping, or None for the packaged one."""
+
+MAPPING_NAME = "scenario mapping"
+"""How errors name a scenario given as a mapping rather than a file."""
+
+
+def scenario_document(source: ScenarioSource = None) -> ScenarioDocument:
+    """Read a scenario file, or take a mapping of the same data, as a document.
+
+    A mapping is held to the same rules as a file: it goes through YAML's safe dumper
+    and parser, so it may hold only plain data (numbers, strings, booleans, None, lists
+    and mappings). Its problems are reported by key path, without lines.
+
+    Raises
+    ------
+    ScenarioError
+        If the file cannot be read or parsed, or the mapping holds other objects.
+    """
+    if source is None:
+        return ScenarioDocument.from_file(default_scenario_path())
+    if not isinstance(source, Mapping):
+        return ScenarioDocument.from_file(source)
+    try:
+        text = yaml.safe_dump(dict(source), sort_keys=False)
+    except yaml.YAMLError as error:
+        message = f"holds a value that is not plain data (numbers, text, lists, mappings): {error}"
+        raise ScenarioError(MAPPING_NAME, [Problem("", message)]) from None
+    doc = ScenarioDocument.from_text(text, MAPPING_NAME)
+    doc.marks.clear()  # lines of a text the user never saw would mislead
+    return doc
+
+
 def load_scenario(
-    path: str | Path | None = None,
+    path: ScenarioSource = None,
     overrides: Sequence[str] = (),
     registry: PluginRegistry | None = None,
 ) -> Scenario:
@@ -60,8 +93,9 @@ def load_scenario(
 
     Parameters
     ----------
-    path : str or Path, optional
-        Scenario file; the packaged default scenario if None.
+    path : str, Path or mapping, optional
+        Scenario file, or the scenario's data as a mapping (:func:`scenario_document`);
+        the packaged default scenario if None.
     overrides : sequence of str
         ``key.path=value`` assignments applied before validation.
     registry : PluginRegistry, optional
@@ -77,7 +111,7 @@ def load_scenario(
     ScenarioError
         Listing every problem with its key path and line, or its override.
     """
-    doc = ScenarioDocument.from_file(path if path is not None else default_scenario_path())
+    doc = scenario_document(path)
     for assignment in overrides:
         doc.apply_override(assignment)
     scenario = validate(doc)

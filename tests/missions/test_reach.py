@@ -3,7 +3,6 @@ the joint references, and the ways a reach is refused."""
 
 from __future__ import annotations
 
-import csv
 import json
 from pathlib import Path
 
@@ -12,6 +11,7 @@ import pytest
 from dcsim_plugins.path_planners.end_effector_line import EndEffectorLinePlanner
 
 from dcsim.api import Trajectory, manipulator_model, thesis_manipulator
+from dcsim.recording import read_telemetry
 from dcsim.robots.joint_path import JointPath, SingularPath
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
@@ -23,13 +23,9 @@ TARGET = np.array([1.5, 0.7, -1.0])
 
 
 def read_run(out: Path) -> tuple[dict, dict[str, np.ndarray]]:
-    """A run directory's summary and telemetry columns."""
+    """A run directory's summary and telemetry columns (by their row names)."""
     summary = json.loads((out / "summary.json").read_text())
-    with open(out / "telemetry.csv", newline="") as handle:
-        rows = list(csv.DictReader(handle))
-    columns = {k: np.array([float(r[k]) for r in rows]) for k in rows[0] if k != "mode"}
-    columns["mode"] = np.array([r["mode"] for r in rows])
-    return summary, columns
+    return summary, read_telemetry(out / "telemetry.csv")
 
 
 def fly(out: Path, *overrides: str) -> tuple[dict, dict[str, np.ndarray]]:

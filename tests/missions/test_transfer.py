@@ -171,7 +171,7 @@ def test_a_trajectory_with_forces_is_flown_as_planned(tmp_path):
     summary, _, out = run_transfer(tmp_path, BangBangPlanner, goal)
     with (out / "telemetry.csv").open() as stream:
         rows = list(csv.DictReader(stream))
-    errors = np.array([float(r["tracking_error"]) for r in rows])
+    errors = np.array([float(r["tracking_error_m"]) for r in rows])
     # The profile ends at x = a·HALF² = 4.5 m at rest; fed forward, the PD loop only
     # mops up the propellant's mass loss and the sampling of the reference.
     assert summary["status"] == "completed", summary["reason"]
@@ -183,5 +183,5 @@ def test_a_trajectory_with_forces_is_flown_as_planned(tmp_path):
     finally:
         BangBangPlanner.feed_forward = True
     with (plain_out / "telemetry.csv").open() as stream:
-        plain_errors = np.array([float(r["tracking_error"]) for r in csv.DictReader(stream)])
+        plain_errors = np.array([float(r["tracking_error_m"]) for r in csv.DictReader(stream)])
     assert plain_errors.max() > 10 * errors.max()

@@ -15,10 +15,10 @@ import numpy as np
 from dcsim.api import (
     Command,
     Controller,
-    StateEstimate,
     PluginParams,
     Reference,
     RobotSpec,
+    StateEstimate,
     Surroundings,
     clip_norm,
     hookimpl,
