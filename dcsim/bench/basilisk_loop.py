@@ -22,7 +22,7 @@ is a PD on the position relative to a chief spacecraft in the chief's Hill frame
 relative-orbit feed-forward. The chief here is the hold point as a constant
 navigation message (at ``HOLD_POINT``, moving at ``CHIEF_SPEED`` along +y so that its
 Hill frame is defined and equal to the inertial axes), with ``μ`` and the chief's
-orbital rate so small that the feed-forward terms vanish (below 1e-15 m/s²) and the
+orbital rate so small that the feed-forward terms vanish (below 1e-12 m/s²) and the
 reference velocity cancelling the chief's: the module's law is then
 ``F = −m (K e + P ė)`` in inertial axes.
 """
@@ -38,17 +38,18 @@ import numpy as np
 
 from dcsim.geometry import rotate
 
-HOLD_POINT = (1.0e7, 0.0, 0.0)
-"""Where the Basilisk spacecraft starts and holds, inertial frame, m (far from the
-origin only so that the chief's Hill frame is defined; no gravity acts)."""
+HOLD_POINT = (1.0e3, 0.0, 0.0)
+"""Where the Basilisk spacecraft starts and holds, inertial frame, m (off the origin
+only so that the chief's Hill frame is defined; no gravity acts; near enough that
+positions keep 1e-13 m of resolution)."""
 
 CHIEF_SPEED = 1.0e-9
-"""Speed of the constant chief message along +y, m/s (its orbital rate, 1e-16 rad/s,
+"""Speed of the constant chief message along +y, m/s (its orbital rate, 1e-12 rad/s,
 only orients the Hill frame)."""
 
 CHIEF_MU = 1.0e-9
 """Gravitational parameter given to ``hillFrameRelativeControl``, m³/s² (it must be
-positive; μ/R³ = 1e-30 s⁻² makes its gravity feed-forward vanish)."""
+positive; μ/R³ = 1e-18 s⁻² makes its gravity feed-forward vanish)."""
 
 _NANO = 1_000_000_000
 
