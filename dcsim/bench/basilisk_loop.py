@@ -106,6 +106,8 @@ class BasiliskFlight:
     ----------
     wall : float
         Wall time from building the simulation to its end, s.
+    cpu : float
+        The process's CPU time over the same span, s.
     times : ndarray (N,)
         Sample times, s.
     attitudes : ndarray (N, 4)
@@ -117,6 +119,7 @@ class BasiliskFlight:
     """
 
     wall: float
+    cpu: float
     times: np.ndarray
     attitudes: np.ndarray
     positions: np.ndarray
@@ -168,14 +171,15 @@ def fly_basilisk(setup: BasiliskSetup) -> BasiliskFlight:
     Basilisk is not in it.
     """
     m = _modules()
-    began = time.perf_counter()
+    began, cpu_began = time.perf_counter(), time.process_time()
     loop = _build(m, setup)
     loop.sim.InitializeSimulation()
     loop.sim.ConfigureStopTime(_nanos(setup.duration))
     loop.sim.ExecuteSimulation()
-    wall = time.perf_counter() - began
+    wall, cpu = time.perf_counter() - began, time.process_time() - cpu_began
     return BasiliskFlight(
         wall=wall,
+        cpu=cpu,
         times=np.asarray(loop.states.times(), dtype=float) / _NANO,
         attitudes=quaternion_from_mrp(np.asarray(loop.states.sigma_BN)),
         positions=np.asarray(loop.states.r_BN_N) - np.asarray(HOLD_POINT),

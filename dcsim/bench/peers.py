@@ -29,7 +29,9 @@ Wall time, both sides, from the case's numbers to the end of the run, imports no
 included (a short warm-up run of each side comes first): for dcsim, scenario
 validation, plugin construction and gain design, world construction (PyBullet) and
 the run; for Basilisk, module construction and wiring, recorders, initialisation and
-the run. Reading the records afterwards is not timed.
+the run. Reading the records afterwards is not timed. Each side's best run counts; the
+process's CPU time over the same spans is reported beside, as a check on a busy
+machine.
 """
 
 from __future__ import annotations
@@ -148,6 +150,8 @@ class Flight:
     ----------
     wall : float
         Wall time of the run, s (see the module's notes for what is included).
+    cpu : float
+        The process's CPU time over the same span, s.
     times : ndarray (N,)
         s.
     pointing_error : ndarray (N,)
@@ -162,6 +166,7 @@ class Flight:
     """
 
     wall: float
+    cpu: float
     times: np.ndarray
     pointing_error: np.ndarray
     position_error: np.ndarray
@@ -268,16 +273,17 @@ def flyer_inertia(case: SlewCase) -> np.ndarray:
 
 def fly_dcsim(case: SlewCase, hold_position: bool, registry: PluginRegistry) -> Flight:
     """Fly ``case`` through dcsim's runner and return its record."""
-    began = time.perf_counter()
+    began, cpu_began = time.perf_counter(), time.process_time()
     runner = Runner(build_run(slew_scenario(case, hold_position), registry), keep_rows=True)
     summary = runner.run()
-    wall = time.perf_counter() - began
+    wall, cpu = time.perf_counter() - began, time.process_time() - cpu_began
     if summary["status"] != "completed":
         raise RuntimeError(f"the dcsim run ended {summary['status']}: {summary['reason']}")
     rows = runner.recorder.rows
     attitudes = np.array([[row[k] for k in ("qx", "qy", "qz", "qw")] for row in rows])
     return Flight(
         wall=wall,
+        cpu=cpu,
         times=np.array([row["time"] for row in rows]),
         pointing_error=pointing_errors(attitudes, case.goal_attitude),
         position_error=np.array([row["position_error"] for row in rows]),
@@ -314,6 +320,7 @@ def fly_peer(setup: BasiliskSetup) -> Flight:
     flight = fly_basilisk(setup)
     return Flight(
         wall=flight.wall,
+        cpu=flight.cpu,
         times=flight.times,
         pointing_error=pointing_errors(flight.attitudes, setup.goal_attitude),
         position_error=np.linalg.norm(flight.positions, axis=1),
@@ -440,6 +447,7 @@ def notes(result: PeersResult) -> str:
         f"P = {big_p:g} N·m·s.",
         _torque_line(result),
         _phase_line(result),
+        _cpu_line(result),
     ]
     hold = result.rows[1]
     line = (
@@ -475,6 +483,21 @@ def _phase_line(result: PeersResult) -> str:
     phases = sorted(best.phases.items(), key=lambda item: -item[1])
     parts = ", ".join(f"{name} {1e3 * seconds / span:.2f}" for name, seconds in phases)
     return f"- dcsim's best attitude-slew run by phase of the run loop (ms / sim s): {parts}."
+
+
+def _cpu_line(result: PeersResult) -> str:
+    """Each side's least process CPU time per simulated second, and their ratio: a
+    check on the wall times that waiting for a busy machine's cores does not inflate."""
+    span = result.case.duration
+    parts = []
+    for row in result.rows:
+        ours = min(f.cpu for f in row.dcsim) / span
+        part = f"{row.name}: dcsim {1e3 * ours:.2f}"
+        if row.basilisk:
+            theirs = min(f.cpu for f in row.basilisk) / span
+            part += f", Basilisk {1e3 * theirs:.2f} (ratio {ours / theirs:.2f})"
+        parts.append(part)
+    return "- by process CPU time (ms / sim s): " + "; ".join(parts) + "."
 
 
 def verdict(result: PeersResult) -> str:
