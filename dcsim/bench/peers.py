@@ -298,8 +298,17 @@ def fly_dcsim(case: SlewCase, hold_position: bool, registry: PluginRegistry) -> 
 def basilisk_setup(
     case: SlewCase, hold_position: bool, inertia: np.ndarray, step: float
 ) -> BasiliskSetup:
-    """The Basilisk loop of ``case``: same body and start, gains matched to ``pd``'s."""
+    """The Basilisk loop of ``case``: same body and start, gains matched to ``pd``'s.
+
+    Raises
+    ------
+    ValueError
+        If ``inertia`` is not the same about every axis: ``mrpFeedback``'s scalar gains
+        match ``pd``'s law on every axis only then.
+    """
     moment = float(np.mean(np.diag(inertia)))
+    if not np.allclose(inertia, moment * np.eye(3), rtol=1e-9, atol=0.0):
+        raise ValueError(f"the gains match on every axis only for an isotropic inertia: {inertia}")
     return BasiliskSetup(
         mass=case.mass,
         inertia=np.asarray(inertia, dtype=float),

@@ -52,6 +52,8 @@ def test_the_case_is_a_real_slew_and_its_gains_are_the_pd_plugins():
 def test_the_free_flyer_is_a_sphere_of_the_cases_mass():
     inertia = peers.flyer_inertia(SHORT)
     assert inertia == pytest.approx(0.4 * SHORT.mass * SHORT.radius**2 * np.eye(3))
+    with pytest.raises(ValueError, match="only for an isotropic inertia"):
+        peers.basilisk_setup(SHORT, False, np.diag([40.0, 40.0, 50.0]), 0.01)
 
 
 def test_dcsim_slews_to_the_goal_without_saturating(dcsim_rows):
