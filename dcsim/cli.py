@@ -777,6 +777,72 @@ def bench_fmu_command(scenario: Path | None, duration: float, repeats: int) -> N
 
 
 @bench_group.command(
+    "peers", short_help="dcsim's attitude loop beside Basilisk's: wall time, pointing error."
+)
+@click.option(
+    "--duration",
+    type=click.FloatRange(min=1.0, max=86_400.0),
+    default=600.0,
+    show_default=True,
+    help="Simulated seconds per run (whole control periods of 0.1 s).",
+)
+@click.option(
+    "--repeats",
+    type=click.IntRange(min=1),
+    default=3,
+    show_default=True,
+    help="Timed runs per side.",
+)
+@click.option(
+    "--basilisk-step",
+    type=click.FloatRange(min=1e-4, max=0.1),
+    default=None,
+    help="Basilisk's dynamics step, s; it must divide the 0.1 s control period "
+    "(default: dcsim's physics step, 0.01 s).",
+)
+@click.option(
+    "--plot",
+    "plot_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Write the pointing error (and the position hold) against time as a PNG.",
+)
+def bench_peers_command(
+    duration: float, repeats: int, basilisk_step: float | None, plot_path: Path | None
+) -> None:
+    """dcsim's attitude loop beside Basilisk's: the same slew, gains and rates.
+
+    A rigid free flyer slews 90° to a fixed inertial attitude under a PD law at 10 Hz,
+    truth-fed, once with translation free and once holding its position; dcsim (the
+    hold mission, pd, PyBullet) and Basilisk (spacecraft hub, extForceTorque, simpleNav,
+    inertial3D, attTrackingError, mrpFeedback, hillFrameRelativeControl) fly it
+    alternately, REPEATS times each. Prints a Markdown table for docs/benchmarks.md.
+    Basilisk is optional (pip install 'dcsim[peers]'); without it the dcsim side runs
+    alone.
+    """
+    from dcsim.bench import peers
+
+    if basilisk_step is not None:
+        periods = peers.SlewCase().control_period / basilisk_step
+        if abs(periods - round(periods)) > 1e-9:
+            raise click.BadParameter(
+                f"{basilisk_step:g} s does not divide the 0.1 s control period",
+                param_hint="'--basilisk-step'",
+            )
+    result = peers.bench_peers(
+        duration, repeats, basilisk_step, progress=lambda line: click.echo(line, err=True)
+    )
+    click.echo(peers.markdown_table(result))
+    click.echo()
+    click.echo(peers.notes(result))
+    click.echo()
+    click.echo(peers.verdict(result))
+    if plot_path is not None:
+        peers.plot(result, plot_path)
+        click.echo(f"\nplot: {plot_path}")
+
+
+@bench_group.command(
     "manipulator", short_help="The manipulator model's time per call against Pinocchio."
 )
 @click.option(

@@ -1,8 +1,9 @@
 """Mission types, selected in a scenario by ``mission.type``.
 
 Built in: ``debris`` (:class:`~dcsim.missions.debris.DebrisMission`), ``transfer``
-(:class:`~dcsim.missions.transfer.TransferMission`) and ``reach``
-(:class:`~dcsim.missions.reach.ReachMission`). A new mission
+(:class:`~dcsim.missions.transfer.TransferMission`), ``reach``
+(:class:`~dcsim.missions.reach.ReachMission`) and ``hold``
+(:class:`~dcsim.missions.hold.HoldMission`). A new mission
 derives from :class:`~dcsim.missions.base.Mission`, declares its ``Settings`` section,
 and is added with :func:`register_mission`.
 """
@@ -12,6 +13,7 @@ from __future__ import annotations
 from dcsim.interfaces import PLUGIN_KINDS
 from dcsim.missions.base import Mission
 from dcsim.missions.debris import DebrisMission
+from dcsim.missions.hold import HoldMission
 from dcsim.missions.reach import ReachMission
 from dcsim.missions.transfer import TransferMission
 from dcsim.scenario.model import Scenario
@@ -20,6 +22,7 @@ _MISSIONS: dict[str, type[Mission]] = {
     DebrisMission.type: DebrisMission,
     TransferMission.type: TransferMission,
     ReachMission.type: ReachMission,
+    HoldMission.type: HoldMission,
 }
 
 
@@ -70,6 +73,7 @@ def mission_class(mission_type: str) -> type[Mission]:
 
 __all__ = [
     "DebrisMission",
+    "HoldMission",
     "Mission",
     "ReachMission",
     "TransferMission",

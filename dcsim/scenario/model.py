@@ -610,7 +610,9 @@ class MissionSettings(Section):
 
     role_defaults: ClassVar[dict[str, PluginChoice | None]] = {}
 
-    type: str = Field("debris", description="The mission type (`debris`, `transfer` or `reach`).")
+    type: str = Field(
+        "debris", description="The mission type (`debris`, `transfer`, `reach` or `hold`)."
+    )
 
 
 class DebrisMissionSection(MissionSettings):
@@ -833,6 +835,29 @@ class ReachMissionSection(MissionSettings):
         if axis is not None and math.hypot(*axis) < 1e-12:
             raise ValueError("the facing axis must not be zero")
         return axis
+
+
+class HoldMissionSection(MissionSettings):
+    """A hold: keep a position and an attitude for the whole run (station keeping)."""
+
+    role_defaults: ClassVar[dict[str, PluginChoice | None]] = {"localiser": None}
+
+    type: Literal["hold"] = Field(
+        "hold", description="The mission type: hold a position and an attitude."
+    )
+    position: Vec3 | None = quantity(
+        None, unit="m", description="Position held, world frame; null: the initial position."
+    )
+    attitude: Quaternion | None = quantity(
+        None,
+        description="Attitude held [x, y, z, w] (normalised; not zero); null: the initial "
+        "attitude.",
+    )
+    hold_position: bool = Field(
+        True,
+        description="Hold the position; false leaves translation free (the reference "
+        "follows the estimate, so no force is asked for) and holds the attitude only.",
+    )
 
 
 class StopSection(Section):

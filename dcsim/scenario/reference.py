@@ -19,6 +19,7 @@ from pydantic_core import PydanticUndefined
 from dcsim.docgen import update_block
 from dcsim.params import field_bounds, field_unit
 from dcsim.scenario.model import (
+    HoldMissionSection,
     MotionSpec,
     PluginChoice,
     ReachMissionSection,
@@ -89,7 +90,7 @@ def _child_path(prefix: str, name: str, annotation: Any) -> str:
 def _sections() -> dict[type[BaseModel], list[str]]:
     """Every model class reachable from Scenario and the mission sections, with the key
     paths it appears at."""
-    missions = (TransferMissionSection, ReachMissionSection)
+    missions = (TransferMissionSection, ReachMissionSection, HoldMissionSection)
     paths: dict[type[BaseModel], list[str]] = {Scenario: [""]}
     paths.update({section: ["mission"] for section in missions})
     queue: list[tuple[str, type[BaseModel]]] = [("", Scenario)]

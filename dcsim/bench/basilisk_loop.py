@@ -1,0 +1,352 @@
+"""The peer side of ``dcsim bench peers``: the same closed loop built from Basilisk modules.
+
+Basilisk (``pip install bsk``, the ``peers`` extra) is optional: :func:`basilisk_missing`
+says why it cannot be used, and nothing here imports it before :func:`fly_basilisk`.
+Its ``unitTestSupport`` module imports pytest and is not used.
+
+The loop, in two tasks of one process:
+
+- **dynamics task** (every ``dynamics_step``, runs first at shared times): the rigid
+  hub (``spacecraft.Spacecraft``: mass, inertia about its centre of mass, no gravity
+  body, Basilisk's default RK4 integrator);
+- **flight-software task** (every control period): ``simpleNav`` (no noise: the true
+  attitude, rate, position and velocity), ``inertial3D`` (the fixed inertial attitude),
+  ``attTrackingError``, ``mrpFeedback`` (no integral term; ``controlLawType = 1``,
+  which compensates ``ω × Iω`` as dcsim's ``pd`` does), optionally
+  ``hillFrameRelativeControl`` (the position hold, see below), then
+  ``extForceTorque``, which reads the commands once per period; the hub applies them
+  over every dynamics step of the period (a zero-order hold, as dcsim's world does).
+
+Position hold: Basilisk's translational feedback module, ``hillFrameRelativeControl``,
+is a PD on the position relative to a chief spacecraft in the chief's Hill frame, with
+relative-orbit feed-forward. The chief here is the hold point as a constant
+navigation message (at ``HOLD_POINT``, moving at ``CHIEF_SPEED`` along +y so that its
+Hill frame is defined and equal to the inertial axes), with ``μ`` and the chief's
+orbital rate so small that the feed-forward terms vanish (below 1e-12 m/s²) and the
+reference velocity cancelling the chief's: the module's law is then
+``F = −m (K e + P ė)`` in inertial axes.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from dcsim.geometry import rotate
+
+HOLD_POINT = (1.0e3, 0.0, 0.0)
+"""Where the Basilisk spacecraft starts and holds, inertial frame, m (off the origin
+only so that the chief's Hill frame is defined; no gravity acts; near enough that
+positions keep 1e-13 m of resolution)."""
+
+CHIEF_SPEED = 1.0e-9
+"""Speed of the constant chief message along +y, m/s (its orbital rate, 1e-12 rad/s,
+only orients the Hill frame)."""
+
+CHIEF_MU = 1.0e-9
+"""Gravitational parameter given to ``hillFrameRelativeControl``, m³/s² (it must be
+positive; μ/R³ = 1e-18 s⁻² makes its gravity feed-forward vanish)."""
+
+_NANO = 1_000_000_000
+
+
+@dataclass(frozen=True)
+class BasiliskSetup:
+    """What the Basilisk loop flies, in SI units.
+
+    Attributes
+    ----------
+    mass : float
+        Hub mass, kg.
+    inertia : ndarray (3, 3)
+        Hub inertia about its centre of mass, body frame, kg·m².
+    attitude : ndarray (4,)
+        Initial attitude ``[x, y, z, w]``, body to inertial.
+    angular_velocity : ndarray (3,)
+        Initial angular velocity, inertial frame, rad/s.
+    velocity : ndarray (3,)
+        Initial velocity, inertial frame, m/s.
+    goal_attitude : ndarray (4,)
+        The inertial attitude to hold ``[x, y, z, w]``.
+    mrp_gains : tuple of float
+        ``mrpFeedback``'s K (N·m) and P (N·m·s).
+    position_gains : tuple of float or None
+        ``hillFrameRelativeControl``'s K (1/s²) and P (1/s), per unit mass, on each
+        axis; None flies without position control.
+    dynamics_step : float
+        Period of the dynamics task, s.
+    control_period : float
+        Period of the flight-software task, s.
+    duration : float
+        Simulated time, s (a whole number of control periods).
+    """
+
+    mass: float
+    inertia: np.ndarray
+    attitude: np.ndarray
+    angular_velocity: np.ndarray
+    velocity: np.ndarray
+    goal_attitude: np.ndarray
+    mrp_gains: tuple[float, float]
+    position_gains: tuple[float, float] | None
+    dynamics_step: float
+    control_period: float
+    duration: float
+
+
+@dataclass(frozen=True)
+class BasiliskFlight:
+    """One Basilisk run: its wall time and its record at the control period.
+
+    Attributes
+    ----------
+    wall : float
+        Wall time from building the simulation to its end, s.
+    cpu : float
+        The process's CPU time over the same span, s.
+    times : ndarray (N,)
+        Sample times, s.
+    attitudes : ndarray (N, 4)
+        True attitude ``[x, y, z, w]``, body to inertial.
+    positions : ndarray (N, 3)
+        True position relative to :data:`HOLD_POINT`, inertial frame, m.
+    torques : ndarray (N, 3)
+        ``mrpFeedback``'s commanded torque, body frame, N·m.
+    """
+
+    wall: float
+    cpu: float
+    times: np.ndarray
+    attitudes: np.ndarray
+    positions: np.ndarray
+    torques: np.ndarray
+
+
+def basilisk_missing() -> str | None:
+    """Why Basilisk cannot be used here, or None when it is importable."""
+    if importlib.util.find_spec("Basilisk") is None:
+        return "Basilisk is not installed (pip install 'dcsim[peers]', or pip install bsk)"
+    try:
+        _modules()
+    except Exception as error:  # a broken or incompatible install
+        return f"Basilisk does not import: {type(error).__name__}: {error}"
+    return None
+
+
+def mrp_from_quaternion(quaternion: np.ndarray) -> np.ndarray:
+    """Modified Rodrigues parameters of the same rotation, the short way round.
+
+    Parameters
+    ----------
+    quaternion : ndarray (..., 4)
+        ``[x, y, z, w]`` (PyBullet's order), body to inertial.
+
+    Returns
+    -------
+    ndarray (..., 3)
+        σ_BN with ``|σ| ≤ 1``.
+    """
+    q = np.asarray(quaternion, dtype=float)
+    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    q = np.where(q[..., 3:] < 0.0, -q, q)
+    return q[..., :3] / (1.0 + q[..., 3:])
+
+
+def quaternion_from_mrp(sigma: np.ndarray) -> np.ndarray:
+    """The unit quaternion ``[x, y, z, w]`` of modified Rodrigues parameters σ_BN (..., 3)."""
+    sigma = np.asarray(sigma, dtype=float)
+    squared = np.sum(sigma * sigma, axis=-1, keepdims=True)
+    return np.concatenate([2.0 * sigma, 1.0 - squared], axis=-1) / (1.0 + squared)
+
+
+def fly_basilisk(setup: BasiliskSetup) -> BasiliskFlight:
+    """Build the Basilisk loop for ``setup``, fly it, and return its record.
+
+    The wall time runs from creating the simulation to the end of its execution (module
+    construction, message wiring, recorders, initialisation and the run); importing
+    Basilisk is not in it.
+    """
+    m = _modules()
+    began, cpu_began = time.perf_counter(), time.process_time()
+    loop = _build(m, setup)
+    loop.sim.InitializeSimulation()
+    loop.sim.ConfigureStopTime(_nanos(setup.duration))
+    loop.sim.ExecuteSimulation()
+    wall, cpu = time.perf_counter() - began, time.process_time() - cpu_began
+    return BasiliskFlight(
+        wall=wall,
+        cpu=cpu,
+        times=np.asarray(loop.states.times(), dtype=float) / _NANO,
+        attitudes=quaternion_from_mrp(np.asarray(loop.states.sigma_BN)),
+        positions=np.asarray(loop.states.r_BN_N) - np.asarray(HOLD_POINT),
+        torques=np.asarray(loop.torques.torqueRequestBody),
+    )
+
+
+# ---------------------------------------------------------------------- building
+@dataclass(frozen=True)
+class _Modules:
+    """The Basilisk modules the loop is built from (imported once)."""
+
+    SimulationBaseClass: Any
+    spacecraft: Any
+    extForceTorque: Any
+    simpleNav: Any
+    inertial3D: Any
+    attTrackingError: Any
+    mrpFeedback: Any
+    hillFrameRelativeControl: Any
+    messaging: Any
+
+
+_CACHE: list[_Modules] = []
+
+
+def _modules() -> _Modules:
+    if not _CACHE:
+        from Basilisk.architecture import messaging
+        from Basilisk.fswAlgorithms import (
+            attTrackingError,
+            hillFrameRelativeControl,
+            inertial3D,
+            mrpFeedback,
+        )
+        from Basilisk.simulation import extForceTorque, simpleNav, spacecraft
+        from Basilisk.utilities import SimulationBaseClass
+
+        _CACHE.append(
+            _Modules(
+                SimulationBaseClass,
+                spacecraft,
+                extForceTorque,
+                simpleNav,
+                inertial3D,
+                attTrackingError,
+                mrpFeedback,
+                hillFrameRelativeControl,
+                messaging,
+            )
+        )
+    return _CACHE[0]
+
+
+@dataclass
+class _Loop:
+    """A built simulation, its recorders, and every module and message it uses (SWIG
+    objects must stay referenced from Python while the simulation runs)."""
+
+    sim: Any
+    states: Any = None
+    torques: Any = None
+    parts: list[Any] = field(default_factory=list)
+
+    def add(self, task: str, *modules: Any) -> None:
+        """Add ``modules`` to ``task``, in order, and keep them."""
+        for module in modules:
+            self.sim.AddModelToTask(task, module)
+        self.parts.extend(modules)
+
+
+def _nanos(seconds: float) -> int:
+    return round(seconds * _NANO)
+
+
+def _build(m: _Modules, setup: BasiliskSetup) -> _Loop:
+    """The simulation with its two tasks, modules and recorders, not yet initialised."""
+    loop = _Loop(m.SimulationBaseClass.SimBaseClass())
+    process = loop.sim.CreateNewProcess("loop")
+    process.addTask(loop.sim.CreateNewTask("dynamics", _nanos(setup.dynamics_step)), 2)
+    process.addTask(loop.sim.CreateNewTask("fsw", _nanos(setup.control_period)), 1)
+    hub = _hub(m, setup)
+    loop.add("dynamics", hub)
+    actuator = m.extForceTorque.ExtForceTorque()
+    actuator.ModelTag = "extForceTorque"
+    hub.addDynamicEffector(actuator)
+    vehicle = m.messaging.VehicleConfigMsgPayload()
+    vehicle.massSC = setup.mass
+    vehicle.ISCPntB_B = np.asarray(setup.inertia, dtype=float).ravel().tolist()
+    vehicle_msg = m.messaging.VehicleConfigMsg().write(vehicle)
+    loop.parts.append(vehicle_msg)
+    navigation = m.simpleNav.SimpleNav()
+    navigation.ModelTag = "simpleNav"
+    navigation.scStateInMsg.subscribeTo(hub.scStateOutMsg)
+    loop.add("fsw", navigation)
+    control = _attitude_loop(m, loop, setup, navigation, vehicle_msg)
+    actuator.cmdTorqueInMsg.subscribeTo(control.cmdTorqueOutMsg)
+    if setup.position_gains is not None:
+        hold = _position_loop(m, loop, setup, navigation, vehicle_msg)
+        actuator.cmdForceInertialInMsg.subscribeTo(hold.forceOutMsg)
+    loop.add("fsw", actuator)
+    loop.states = hub.scStateOutMsg.recorder(_nanos(setup.control_period))
+    loop.torques = control.cmdTorqueOutMsg.recorder(_nanos(setup.control_period))
+    loop.add("fsw", loop.states, loop.torques)
+    return loop
+
+
+def _hub(m: _Modules, setup: BasiliskSetup) -> Any:
+    """The rigid spacecraft hub at its initial state."""
+    hub = m.spacecraft.Spacecraft()
+    hub.ModelTag = "hub"
+    hub.hub.mHub = setup.mass
+    hub.hub.IHubPntBc_B = np.asarray(setup.inertia, dtype=float).tolist()
+    hub.hub.r_CN_NInit = [[v] for v in HOLD_POINT]
+    hub.hub.v_CN_NInit = [[float(v)] for v in setup.velocity]
+    hub.hub.sigma_BNInit = [[float(v)] for v in mrp_from_quaternion(setup.attitude)]
+    body_rate = rotate(_conjugate(setup.attitude), setup.angular_velocity)
+    hub.hub.omega_BN_BInit = [[float(v)] for v in body_rate]
+    return hub
+
+
+def _attitude_loop(
+    m: _Modules, loop: _Loop, setup: BasiliskSetup, navigation: Any, vehicle_msg: Any
+) -> Any:
+    """inertial3D → attTrackingError → mrpFeedback in the flight-software task."""
+    guidance = m.inertial3D.inertial3D()
+    guidance.ModelTag = "inertial3D"
+    guidance.sigma_R0N = mrp_from_quaternion(setup.goal_attitude).tolist()
+    error = m.attTrackingError.attTrackingError()
+    error.ModelTag = "attTrackingError"
+    error.attNavInMsg.subscribeTo(navigation.attOutMsg)
+    error.attRefInMsg.subscribeTo(guidance.attRefOutMsg)
+    control = m.mrpFeedback.mrpFeedback()
+    control.ModelTag = "mrpFeedback"
+    control.K, control.P = setup.mrp_gains
+    control.Ki = -1.0  # no integral term
+    control.controlLawType = 1  # compensate ω × Iω with the body rate
+    control.guidInMsg.subscribeTo(error.attGuidOutMsg)
+    control.vehConfigInMsg.subscribeTo(vehicle_msg)
+    loop.add("fsw", guidance, error, control)
+    return control
+
+
+def _position_loop(
+    m: _Modules, loop: _Loop, setup: BasiliskSetup, navigation: Any, vehicle_msg: Any
+) -> Any:
+    """hillFrameRelativeControl about a constant chief at the hold point."""
+    chief = m.messaging.NavTransMsgPayload()
+    chief.r_BN_N = list(HOLD_POINT)
+    chief.v_BN_N = [0.0, CHIEF_SPEED, 0.0]
+    chief_msg = m.messaging.NavTransMsg().write(chief)
+    k, p = setup.position_gains
+    hold = m.hillFrameRelativeControl.HillFrameRelativeControl()
+    hold.ModelTag = "hillFrameRelativeControl"
+    hold.chiefTransInMsg.subscribeTo(chief_msg)
+    hold.deputyTransInMsg.subscribeTo(navigation.transOutMsg)
+    hold.deputyVehicleConfigInMsg.subscribeTo(vehicle_msg)
+    hold.setMu(CHIEF_MU)
+    hold.setK(np.diag([k, k, k]).ravel().tolist())
+    hold.setP(np.diag([p, p, p]).ravel().tolist())
+    hold.setReferencePosition([0.0, 0.0, 0.0])
+    hold.setReferenceVelocity([0.0, -CHIEF_SPEED, 0.0])  # at rest in the inertial frame
+    loop.parts.append(chief_msg)
+    loop.add("fsw", hold)
+    return hold
+
+
+def _conjugate(quaternion: np.ndarray) -> np.ndarray:
+    q = np.asarray(quaternion, dtype=float)
+    return np.concatenate([-q[:3], q[3:]])

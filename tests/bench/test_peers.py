@@ -1,0 +1,160 @@
+"""``dcsim bench peers``: the same slew in dcsim and in Basilisk (when installed)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from dcsim_plugins.controllers.pd import design_gains
+
+from dcsim.bench import peers
+from dcsim.bench.basilisk_loop import basilisk_missing, mrp_from_quaternion, quaternion_from_mrp
+from dcsim.registry import PluginRegistry
+
+BASILISK = basilisk_missing()
+needs_basilisk = pytest.mark.skipif(BASILISK is not None, reason=str(BASILISK))
+
+SHORT = replace(peers.SlewCase(), duration=40.0)
+"""The benchmark's slew, cut to 40 s: long enough to converge."""
+
+
+@pytest.fixture(scope="module")
+def registry():
+    return PluginRegistry.discover()
+
+
+@pytest.fixture(scope="module")
+def dcsim_rows(registry):
+    """dcsim's two rows over the short span: attitude only, and with the position held."""
+    return {hold: peers.fly_dcsim(SHORT, hold, registry) for hold in (False, True)}
+
+
+@pytest.fixture(scope="module")
+def basilisk_rows():
+    inertia = peers.flyer_inertia(SHORT)
+    return {
+        hold: peers.fly_peer(peers.basilisk_setup(SHORT, hold, inertia, SHORT.physics_step))
+        for hold in (False, True)
+    }
+
+
+def test_the_case_is_a_real_slew_and_its_gains_are_the_pd_plugins():
+    assert np.degrees(
+        peers.pointing_errors(np.array([SHORT.initial_attitude]), SHORT.goal_attitude)
+    ) == pytest.approx(90.0)
+    assert SHORT.attitude_gains == pytest.approx(design_gains(0.5, 0.9))
+    assert SHORT.position_gains == pytest.approx(design_gains(0.2, 0.9))
+    kp, kd = SHORT.attitude_gains
+    assert SHORT.mrp_gains(40.0) == pytest.approx((4 * 40.0 * kp, 40.0 * kd))
+
+
+def test_the_free_flyer_is_a_sphere_of_the_cases_mass():
+    inertia = peers.flyer_inertia(SHORT)
+    assert inertia == pytest.approx(0.4 * SHORT.mass * SHORT.radius**2 * np.eye(3))
+    with pytest.raises(ValueError, match="only for an isotropic inertia"):
+        peers.basilisk_setup(SHORT, False, np.diag([40.0, 40.0, 50.0]), 0.01)
+
+
+def test_dcsim_slews_to_the_goal_without_saturating(dcsim_rows):
+    for flight in dcsim_rows.values():
+        assert flight.times[-1] == pytest.approx(SHORT.duration)
+        assert np.degrees(flight.pointing_error[0]) == pytest.approx(90.0)
+        assert np.degrees(flight.pointing_error[-1]) < 1e-4
+        assert 5.0 < flight.peak_torque < SHORT.max_torque
+
+
+def test_dcsim_holds_the_position_only_when_asked(dcsim_rows):
+    drift = np.linalg.norm(SHORT.initial_velocity) * SHORT.duration
+    assert dcsim_rows[False].position_error[-1] == pytest.approx(drift, rel=1e-6)
+    held = dcsim_rows[True].position_error
+    assert 0.05 < held.max() < 0.5 and held[-1] < 1e-3
+
+
+def test_mrps_and_quaternions_convert_both_ways():
+    rng = np.random.default_rng(7)
+    quaternions = rng.normal(size=(20, 4))
+    quaternions /= np.linalg.norm(quaternions, axis=1, keepdims=True)
+    sigma = mrp_from_quaternion(quaternions)
+    assert np.all(np.linalg.norm(sigma, axis=1) <= 1.0 + 1e-12)
+    back = quaternion_from_mrp(sigma)
+    assert np.abs(np.sum(back * quaternions, axis=1)) == pytest.approx(np.ones(20))
+
+
+@needs_basilisk
+def test_mrps_follow_basilisks_attitude_convention():
+    from Basilisk.utilities import RigidBodyKinematics as rbk
+
+    from dcsim.geometry import rotate
+
+    q = np.asarray(SHORT.initial_attitude)
+    body_to_world = np.column_stack([rotate(q, axis) for axis in np.eye(3)])
+    assert np.asarray(rbk.MRP2C(mrp_from_quaternion(q))) == pytest.approx(body_to_world.T)
+
+
+@needs_basilisk
+def test_basilisk_flies_the_same_slew(dcsim_rows, basilisk_rows):
+    for hold in (False, True):
+        ours, theirs = dcsim_rows[hold], basilisk_rows[hold]
+        assert theirs.times == pytest.approx(ours.times)
+        assert theirs.pointing_error[0] == pytest.approx(ours.pointing_error[0], abs=1e-9)
+        assert np.degrees(theirs.pointing_error[-1]) < 1e-4
+        # MRP feedback is a little stiffer than the rotation-vector law at large angles
+        gap = np.degrees(peers.largest_gap(ours, theirs))
+        assert 0.1 < gap < 3.0
+        assert theirs.peak_torque == pytest.approx(ours.peak_torque, rel=0.15)
+
+
+@needs_basilisk
+def test_basilisk_holds_the_position_as_dcsim_does(dcsim_rows, basilisk_rows):
+    free, held = basilisk_rows[False], basilisk_rows[True]
+    assert free.position_error == pytest.approx(
+        dcsim_rows[False].position_error, rel=1e-4, abs=1e-6
+    )
+    assert held.position_error == pytest.approx(dcsim_rows[True].position_error, abs=2e-3)
+    assert held.position_error[-1] < 1e-3
+
+
+def test_the_table_has_both_rows_and_the_verdict(registry):
+    result = peers.bench_peers(1.0, 1, progress=lambda line: None)
+    table = peers.markdown_table(result).splitlines()
+    assert [line.split("|")[1].strip() for line in table[2:]] == [
+        "attitude slew",
+        "slew + position hold",
+    ]
+    text = peers.notes(result) + "\n" + peers.verdict(result)
+    if BASILISK is None:
+        for line in table[2:]:
+            cells = [cell.strip() for cell in line.strip("| ").split("|")]
+            assert len(cells) == 10 and float(cells[8]) > 0 and cells[9] in ("yes", "no")
+        assert "target (dcsim's attitude loop within 3× of Basilisk's wall time): " in text
+    else:
+        assert f"Basilisk was not flown: {BASILISK}" in text
+        assert "not measured, Basilisk was not flown" in text
+
+
+def test_the_command_prints_the_table_and_draws_the_plot(dcsim_cli, tmp_path):
+    plot = tmp_path / "peers.png"
+    result = dcsim_cli("bench", "peers", "--duration", "2", "--repeats", "1", "--plot", str(plot))
+    assert result.returncode == 0, result.stderr
+    assert "| attitude slew |" in result.stdout
+    assert "| slew + position hold |" in result.stdout
+    assert "attitude slew, run 1/1: dcsim" in result.stderr
+    if BASILISK is not None:
+        assert "Basilisk is not flown: " in result.stderr
+    assert plot.stat().st_size > 10_000
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--basilisk-step", "0.03", "0.03 s does not divide the 0.1 s control period"),
+        ("--repeats", "0", "0 is not in the range x>=1"),
+        ("--duration", "0.5", "0.5 is not in the range 1.0<=x<=86400.0"),
+    ],
+)
+def test_bad_options_are_refused_without_a_traceback(dcsim_cli, option, value, message):
+    result = dcsim_cli("bench", "peers", option, value)
+    assert result.returncode == 2
+    assert message in result.stderr
+    assert "Traceback" not in result.stderr
