@@ -91,6 +91,7 @@ from dcsim.errors import (
 from dcsim.fmu.instance import FmuCallError, FmuDescription, FmuError, FmuInstance
 from dcsim.geometry import (
     clip_norm,
+    cross,
     facing_axis,
     quaternion_between,
     quaternion_conjugate,
@@ -248,6 +249,7 @@ __all__ = [
     "RobotSpec",
     "RobotState",
     "rotate",
+    "cross",
     "facing_axis",
     "sight_angle",
     "rotation_vector",

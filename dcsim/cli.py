@@ -776,9 +776,7 @@ def bench_fmu_command(scenario: Path | None, duration: float, repeats: int) -> N
     click.echo(markdown_table(result))
 
 
-@bench_group.command(
-    "peers", short_help="dcsim's attitude loop beside Basilisk's: wall time, pointing error."
-)
+@bench_group.command("peers", short_help="dcsim's attitude loop beside Basilisk's.")
 @click.option(
     "--duration",
     type=click.FloatRange(min=1.0, max=86_400.0),

@@ -100,8 +100,23 @@ def rotate(q: ArrayLike, v: ArrayLike) -> Vector:
     q = np.asarray(q, dtype=float)
     v = np.asarray(v, dtype=float)
     u, w = q[:3], q[3]
-    t = 2.0 * np.cross(u, v)
-    return v + w * t + np.cross(u, t)
+    t = 2.0 * cross(u, v)
+    return v + w * t + cross(u, t)
+
+
+def cross(a: ArrayLike, b: ArrayLike) -> Vector:
+    """Cross product ``a × b`` of 3-vectors (or stacks of them, broadcast).
+
+    Two single vectors are multiplied in floats with ``numpy.cross``'s own operations
+    (``a₁b₂ − a₂b₁``, …), so the result is the same to the bit at a fraction of the cost.
+    """
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    if a.shape != (3,) or b.shape != (3,):
+        return np.cross(a, b)
+    a0, a1, a2 = a.tolist()
+    b0, b1, b2 = b.tolist()
+    return np.array((a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0))
 
 
 _BODY_AXES = np.vstack([np.eye(3), -np.eye(3)])
@@ -128,7 +143,7 @@ def quaternion_multiply(p: ArrayLike, q: ArrayLike) -> Vector:
     q = np.asarray(q, dtype=float)
     pv, pw = p[..., :3], p[..., 3:]
     qv, qw = q[..., :3], q[..., 3:]
-    vector = pw * qv + qw * pv + np.cross(pv, qv)
+    vector = pw * qv + qw * pv + cross(pv, qv)
     scalar = pw * qw - np.sum(pv * qv, axis=-1, keepdims=True)
     return np.concatenate([vector, scalar], axis=-1)
 

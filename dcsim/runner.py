@@ -57,6 +57,9 @@ SUMMARY_FIGURES = (
 )
 """The numeric fields of every run's summary; a mission adds its ``summary_names``."""
 
+_NO_SPREAD = np.zeros((6, 6))
+_NO_SPREAD.setflags(write=False)  # the true state's covariance, shared by every tick's estimate
+
 Progress = Callable[[float, float, str, str], None]
 """``progress(sim_time, duration, mode, mission_progress)``: times in s."""
 
@@ -344,7 +347,7 @@ class Runner:
         if "localiser" not in plugins:
             position, velocity, _, _ = world.collector_state()
             return StateEstimate(
-                world.time, position, velocity=velocity, covariance=np.zeros((6, 6)), converged=True
+                world.time, position, velocity=velocity, covariance=_NO_SPREAD, converged=True
             )
         if world.time > 0:
             call_plugin(plugins, "localiser", "predict", world.motion_input(), world.control_period)

@@ -82,7 +82,10 @@ def _shape_fits(shape: tuple[int, ...], wanted: tuple[int, ...]) -> bool:
     """Whether ``shape`` is ``wanted`` where ``-1`` in ``wanted`` accepts any length."""
     if len(shape) != len(wanted):
         return False
-    return all(w in (-1, s) for w, s in zip(wanted, shape, strict=True))
+    for w, s in zip(wanted, shape, strict=True):
+        if w != -1 and w != s:
+            return False
+    return True
 
 
 def _owned_read_only(value: np.ndarray) -> bool:

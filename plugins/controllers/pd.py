@@ -34,6 +34,7 @@ from dcsim.api import (
     StateEstimate,
     Surroundings,
     clip_norm,
+    cross,
     hookimpl,
     quantity,
     quaternion_conjugate,
@@ -127,7 +128,7 @@ class PDController(Controller):
         inertia = _world_inertia(self.robot.inertia, estimate.attitude)
         omega = estimate.angular_velocity
         wanted = self.kd_attitude * (rate - omega) + reference.angular_acceleration
-        torque = inertia @ wanted + np.cross(omega, inertia @ omega)
+        torque = inertia @ wanted + cross(omega, inertia @ omega)
         return clip_norm(torque, self.robot.max_torque)
 
 
