@@ -38,7 +38,14 @@ _LEADING_COLUMNS = (
     "qx", "qy", "qz", "qw",
     "mode", "converged",
 )  # fmt: skip
-_TRAILING_COLUMNS = ("fuel_used", "delta_v", "nearest_obstacle", "fx", "fy", "fz")
+SIGMA_COLUMNS = ("est_sigma_x", "est_sigma_y", "est_sigma_z")
+"""Standard deviations of the estimated position per axis (m): the square roots of the
+diagonal of the estimate's covariance, position block."""
+
+_TRAILING_COLUMNS = (
+    "fuel_used", "delta_v", "nearest_obstacle", "fx", "fy", "fz",
+    "wx", "wy", "wz", *SIGMA_COLUMNS,
+)  # fmt: skip
 _TEXT_COLUMNS = frozenset({"mode"})
 
 
@@ -52,8 +59,10 @@ def telemetry_columns(mission_columns: Sequence[str]) -> tuple[str, ...]:
     Every run records time (s); true and estimated position (m) and velocity (m/s);
     the attitude quaternion; the mission mode; localiser converged (0/1); then the
     mission's own columns (the debris mission's: targets carried and delivered); then
-    propellant used (kg), delta-v (m/s), the surface gap to the nearest obstacle (m)
-    and the commanded thrust (N).
+    propellant used (kg), delta-v (m/s), the surface gap to the nearest obstacle (m),
+    the commanded thrust (N), the true angular velocity (world frame, rad/s) and the
+    standard deviations of the estimated position (:data:`SIGMA_COLUMNS`, m; 0 when
+    the mission flies on the true state).
     """
     return (*_LEADING_COLUMNS, *mission_columns, *_TRAILING_COLUMNS)
 
