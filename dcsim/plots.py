@@ -219,8 +219,18 @@ def obstacle_panel(axis, times: np.ndarray, gap: np.ndarray, safety_distance: fl
     axis.axhline(0.0, color=_OBSTACLE, lw=0.6, ls=":", label="contact")
     axis.set(xlabel="time [s]", ylabel="gap [m]", title="Distance to the nearest obstacle")
     if finite.any() and np.max(gap[finite]) > 10 * max(safety_distance, 1.0):
-        axis.set_yscale("symlog", linthresh=max(safety_distance, 1.0))
+        _symlog_gaps(axis, gap[finite], max(safety_distance, 1.0))
     axis.legend(fontsize=8, loc="best")
+
+
+def _symlog_gaps(axis, gap: np.ndarray, linear: float) -> None:
+    """A log scale above ``linear`` (m) and a linear one below, down to just under the
+    least gap (or 0), ticked at 0 and the decades above ``linear`` only: the linear
+    stretch is too short to hold more labels."""
+    axis.set_yscale("symlog", linthresh=linear)
+    axis.set_ylim(bottom=min(float(np.min(gap)), 0.0) - 0.2 * linear)
+    decades = np.arange(np.ceil(np.log10(linear)), np.floor(np.log10(np.max(gap))) + 1)
+    axis.set_yticks([0.0, *(10.0**decades)])
 
 
 def limited_panel(
