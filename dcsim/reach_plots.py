@@ -29,7 +29,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
 import numpy as np  # noqa: E402
 
-from dcsim.plots import plots_folder, stacked  # noqa: E402
+from dcsim.plots import FrameAxes, plots_folder, save, stacked  # noqa: E402
 from dcsim.scenario.model import Scenario  # noqa: E402
 
 SIGHT_LIMIT_DEG = 60.0
@@ -114,21 +114,22 @@ def _path_figure(
     axis.plot(*drift.T, color=_BASE, lw=1.0, label="base displacement (from the start point)")
     axis.scatter(*flown[0], color=_START, s=40, label="start")
     axis.scatter(*target, color=_TARGET, s=40, label="target")
-    axis.set(xlabel="x [m]", ylabel="y [m]", zlabel="z [m]", title="End-effector path")
+    frame = FrameAxes.of(scenario, flown)
+    frame.name_axes(axis, (0, 1, 2))
+    axis.set_title("End-effector path")
     axis.legend(loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=3, fontsize=8)
-    for row, name in enumerate("xyz"):
+    for row in range(3):
         component = figure.add_subplot(3, 2, 2 * row + 2)
         component.plot(times, reference[:, row], color=_REFERENCE, ls="--", lw=1.0)
         component.plot(times, flown[:, row], color=_FLOWN, lw=1.2)
         component.axhline(target[row], color=_TARGET, lw=0.8)
         _mark_end(component, path_end)
-        component.set(ylabel=f"{name} [m]")
+        frame.name_axes(component, (row,), letters="y")
         component.grid(alpha=0.3)
     component.set_xlabel("time [s]")
     figure.suptitle(f"{title}: end effector (dashed: reference; green: target)")
     figure.tight_layout()
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
+    save(figure, path)
 
 
 def _timeline_figure(
@@ -167,8 +168,7 @@ def _timeline_figure(
         axis.set_xlabel("time [s]")
     figure.suptitle(f"{title}: timeline (dotted: end of the planned path)")
     figure.tight_layout()
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
+    save(figure, path)
 
 
 def _torques(axis, telemetry: Mapping[str, np.ndarray]) -> None:
@@ -226,5 +226,4 @@ def _joints_figure(
         axis.grid(alpha=0.3)
     figure.suptitle(f"{title}: joints")
     figure.tight_layout()
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
+    save(figure, path)

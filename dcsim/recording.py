@@ -38,7 +38,14 @@ _LEADING_COLUMNS = (
     "qx", "qy", "qz", "qw",
     "mode", "converged",
 )  # fmt: skip
-_TRAILING_COLUMNS = ("fuel_used", "delta_v", "nearest_obstacle", "fx", "fy", "fz")
+SIGMA_COLUMNS = ("est_sigma_x", "est_sigma_y", "est_sigma_z")
+"""Standard deviations of the estimated position per axis (m): the square roots of the
+diagonal of the estimate's covariance, position block."""
+
+_TRAILING_COLUMNS = (
+    "fuel_used", "delta_v", "nearest_obstacle", "fx", "fy", "fz",
+    "wx", "wy", "wz", *SIGMA_COLUMNS,
+)  # fmt: skip
 _TEXT_COLUMNS = frozenset({"mode"})
 
 UNITS = {
@@ -62,6 +69,8 @@ COLUMN_UNITS = {
     **dict.fromkeys(("vx", "vy", "vz", "est_vx", "est_vy", "est_vz", "delta_v"), "mps"),
     "fuel_used": "kg",
     **dict.fromkeys(("fx", "fy", "fz"), "N"),
+    **dict.fromkeys(("wx", "wy", "wz"), "radps"),
+    **dict.fromkeys(SIGMA_COLUMNS, "m"),
 }
 """Unit suffix of each column every run records (a column absent has no unit)."""
 
@@ -76,8 +85,10 @@ def telemetry_columns(mission_columns: Sequence[str]) -> tuple[str, ...]:
     Every run records time (s); true and estimated position (m) and velocity (m/s);
     the attitude quaternion; the mission mode; localiser converged (0/1); then the
     mission's own columns (the debris mission's: targets carried and delivered); then
-    propellant used (kg), delta-v (m/s), the surface gap to the nearest obstacle (m)
-    and the commanded thrust (N).
+    propellant used (kg), delta-v (m/s), the surface gap to the nearest obstacle (m),
+    the commanded thrust (N), the true angular velocity (world frame, rad/s) and the
+    standard deviations of the estimated position (:data:`SIGMA_COLUMNS`, m; 0 when
+    the mission flies on the true state).
     """
     return (*_LEADING_COLUMNS, *mission_columns, *_TRAILING_COLUMNS)
 
@@ -242,6 +253,12 @@ class Recorder:
             wallclock.perf_counter() - self._flushed_at > FLUSH_SECONDS
         ):
             self.flush()
+
+    @property
+    def waiting_rows(self) -> int:
+        """Rows recorded but not yet written to ``telemetry.csv`` (fewer than
+        :data:`FLUSH_ROWS`)."""
+        return len(self._pending)
 
     def event(self, values: dict[str, Any]) -> None:
         """Record one event: append it to ``events.jsonl`` and flush the telemetry."""

@@ -35,7 +35,13 @@ from dcsim.hookspecs import RunInfo
 from dcsim.messages import Command, Observations, Prior, StateEstimate
 from dcsim.missions import Mission, mission_class
 from dcsim.plugin_calls import PluginFailure, call_plugin
-from dcsim.recording import Recorder, RecordingError, telemetry_columns, telemetry_units
+from dcsim.recording import (
+    SIGMA_COLUMNS,
+    Recorder,
+    RecordingError,
+    telemetry_columns,
+    telemetry_units,
+)
 from dcsim.runsetup import RunSetup
 from dcsim.scenario import dump_scenario
 from dcsim.scenario.model import point_to_cartesian
@@ -424,21 +430,18 @@ class Runner:
             nearest_obstacle=out["nearest_obstacle_distance"],
         )
         row.update(zip(("fx", "fy", "fz"), command.force.tolist(), strict=True))
+        row.update(zip(("wx", "wy", "wz"), out["angular_velocity"].tolist(), strict=True))
+        variances = np.maximum(estimate.covariance.diagonal()[:3], 0.0)
+        row.update(zip(SIGMA_COLUMNS, np.sqrt(variances).tolist(), strict=True))
         self._accumulate(out, estimate)
         self.recorder.row(row)
         if self._step_observed:
             self._hook("dcsim_run_step", run=self.info, row=row)
 
     def _record_final(self, mode: str) -> None:
-        """Record the state reached by the last step (the run ends after it)."""
-        last = self.recorder.last_row
-        estimate = StateEstimate(
-            time=self.world.time,
-            position=[last["est_x"], last["est_y"], last["est_z"]],
-            velocity=[last["est_vx"], last["est_vy"], last["est_vz"]],
-            converged=bool(last["converged"]),
-        )
-        self._record(self.world.time, estimate, mode, Command())
+        """Record the state reached by the last step (the run ends after it), with the
+        last estimate (no new one is made)."""
+        self._record(self.world.time, self.estimate, mode, Command())
 
     def _event(self, name: str, at: float | None = None, **data: Any) -> None:
         event = {"t": self.world.time if at is None else at, "event": name, **data}

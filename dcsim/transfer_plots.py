@@ -7,11 +7,14 @@ obstacle is drawn at the start, the middle and the end of the run, lighter than 
 fixed ones and darker as time goes on, with the path it follows. Obstacles are drawn
 when they come within :data:`SCENE_MARGIN` (or half the flight's size) of the flight.
 
-``timeline.png`` shows speed, thrust, delta-v, tracking error and the surface gap to
-the nearest obstacle against time, with the mission's modes shaded behind, each change
-of mode marked and the path planner's answers (a plan, or "no path") along the top.
+``timeline.png`` shows speed, commanded thrust, attitude (the angle turned from the
+initial attitude), angular rate, delta-v, tracking error and the surface gap to the
+nearest obstacle against time, with the mission's modes shaded behind, each change of
+mode marked and the path planner's answers (a plan, or "no path") along the top.
 
-Drawn with matplotlib's non-interactive Agg backend, as :mod:`dcsim.plots` is.
+Axes are named and ticked as :class:`dcsim.plots.FrameAxes` says (radial, along-track
+and orbit-normal in the LVLH frame). Drawn with matplotlib's non-interactive Agg
+backend, as :mod:`dcsim.plots` is.
 """
 
 from __future__ import annotations
@@ -26,11 +29,25 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
 import numpy as np  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
 from dcsim.messages import ObjectKind, Shape, ShapeKind  # noqa: E402
-from dcsim.plots import obstacle_panel, plots_folder, stacked  # noqa: E402
+from dcsim.plots import (  # noqa: E402
+    LEGEND_ROW,
+    TITLE_ROOM,
+    FrameAxes,
+    attitude_panel,
+    obstacle_panel,
+    plots_folder,
+    rate_panel,
+    save,
+    speed_panel,
+    stack_layout,
+    stacked,
+    thrust_panel,
+)
 from dcsim.scenario.model import Scenario  # noqa: E402
 from dcsim.shape_outlines import outline, wireframe  # noqa: E402
 from dcsim.world.objects import build_objects  # noqa: E402
@@ -47,7 +64,6 @@ VIEW_PADDING = 0.03
 INSTANT_ALPHAS = (0.12, 0.22, 0.35)
 """Fill opacity of a moving obstacle at the start, middle and end of the run."""
 
-_AXIS_NAMES = "xyz"
 _FIXED = "0.45"  # colour of fixed obstacles
 _MOVING = "tab:purple"
 _GOAL = "tab:green"
@@ -150,8 +166,8 @@ def write_transfer_plots(
         return []
     paths = [folder / "path.png", folder / "timeline.png"]
     scene = build_scene(scenario, telemetry, read_planned(out_dir / "trajectory.csv"))
-    _path_figure(paths[0], scene, f"{scenario.name}: path (frame {scenario.world.frame})")
-    _timeline_figure(paths[1], scenario, telemetry, events, tuple(modes), safety_distance)
+    save(path_figure(scenario, scene), paths[0])
+    save(timeline_figure(scenario, telemetry, events, tuple(modes), safety_distance), paths[1])
     return paths
 
 
@@ -254,20 +270,30 @@ def _near(placed: Placed, lower: np.ndarray, upper: np.ndarray) -> bool:
 
 
 # ---------------------------------------------------------------------- path.png
-def _path_figure(path: Path, scene: Scene, title: str) -> None:
+def path_figure(scenario: Scenario, scene: Scene) -> Figure:
+    """The scene in 3-D and in the three side views :data:`VIEWS`, axes named after
+    ``scenario``'s frame.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The resolved scenario (its name and frame).
+    scene : Scene
+        What to draw (:func:`build_scene`).
+    """
+    frame = FrameAxes.of(scenario, np.vstack([scene.lower, scene.upper]))
     figure = plt.figure(figsize=(13, 11))
-    _draw_3d(figure.add_subplot(2, 2, 1, projection="3d"), scene)
+    _draw_3d(figure.add_subplot(2, 2, 1, projection="3d"), scene, frame)
     for index, view in enumerate(VIEWS, start=2):
-        _draw_view(figure.add_subplot(2, 2, index), scene, view)
+        _draw_view(figure.add_subplot(2, 2, index), scene, view, frame)
     figure.legend(handles=_legend(scene), loc="lower center", ncol=4, fontsize=9)
-    figure.suptitle(title)
+    figure.suptitle(f"{scenario.name}: path, {frame.description}")
     figure.tight_layout(rect=(0.0, 0.06, 1.0, 0.97))
     figure.subplots_adjust(wspace=0.35)  # room for the 3-D view's z label
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
+    return figure
 
 
-def _draw_3d(axis, scene: Scene) -> None:
+def _draw_3d(axis, scene: Scene, frame: FrameAxes) -> None:
     """The scene in 3-D: wireframes, paths and markers, with equal scales."""
     for placed in [*scene.obstacles, scene.goal]:
         _wireframes(axis, placed)
@@ -278,11 +304,9 @@ def _draw_3d(axis, scene: Scene) -> None:
         xlim=(scene.lower[0], scene.upper[0]),
         ylim=(scene.lower[1], scene.upper[1]),
         zlim=(scene.lower[2], scene.upper[2]),
-        xlabel="x [m]",
-        ylabel="y [m]",
-        zlabel="z [m]",
         title="3-D view",
     )
+    frame.name_axes(axis, (0, 1, 2))
     axis.set_box_aspect(np.maximum(scene.upper - scene.lower, 1e-3))
     axis.locator_params(nbins=5)  # a short side would crowd its ticks
 
@@ -297,7 +321,7 @@ def _wireframes(axis, placed: Placed, ls: str = "-") -> None:
         axis.plot(*placed.path.T, color=placed.colour, lw=0.8, ls=":")
 
 
-def _draw_view(axis, scene: Scene, view: tuple[int, int]) -> None:
+def _draw_view(axis, scene: Scene, view: tuple[int, int], frame: FrameAxes) -> None:
     """One side view: outlines filled, paths and markers, equal scales."""
     if scene.bounds is not None:
         _outlines(axis, scene.bounds, view, ls="--")
@@ -308,11 +332,10 @@ def _draw_view(axis, scene: Scene, view: tuple[int, int]) -> None:
     axis.set(
         xlim=(scene.lower[a], scene.upper[a]),
         ylim=(scene.lower[b], scene.upper[b]),
-        xlabel=f"{_AXIS_NAMES[a]} [m]",
-        ylabel=f"{_AXIS_NAMES[b]} [m]",
-        title=f"{_AXIS_NAMES[a]}-{_AXIS_NAMES[b]} view",
+        title=f"{frame.names[a]} / {frame.names[b]} view",
         aspect="equal",
     )
+    frame.name_axes(axis, view)
     axis.grid(alpha=0.3)
 
 
@@ -362,27 +385,43 @@ def _legend(scene: Scene) -> list:
 
 
 # ---------------------------------------------------------------------- timeline.png
-def _timeline_figure(
-    path: Path,
+def timeline_figure(
     scenario: Scenario,
     telemetry: Mapping[str, np.ndarray],
     events: Sequence[Mapping[str, Any]],
     modes: tuple[str, ...],
     safety_distance: float,
-) -> None:
+) -> Figure:
+    """Speed, thrust, attitude, angular rate, delta-v, tracking error and clearance over
+    time, the modes shaded and the planner's answers marked.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The resolved scenario of a ``transfer`` mission.
+    telemetry : mapping of str to ndarray
+        The telemetry columns.
+    events : sequence of mapping
+        The event log: its mode changes and the planner's answers are marked.
+    modes : tuple of str
+        The mission's modes, in the order the legend lists them.
+    safety_distance : float
+        Gap marked on the clearance panel, m.
+    """
     times = telemetry["time"]
-    speed = np.linalg.norm(stacked(telemetry, ("vx", "vy", "vz")), axis=1)
-    thrust = np.linalg.norm(stacked(telemetry, ("fx", "fy", "fz")), axis=1)
     robot = scenario.robot
-    figure, axes = plt.subplots(5, 1, figsize=(11, 12), sharex=True)
-    _limited(axes[0], times, speed, robot.max_speed, "speed [m/s]", "Speed", "max_speed")
-    _limited(axes[1], times, thrust, robot.max_force, "thrust [N]", "Thrust |F|", "max_force")
-    axes[2].plot(times, telemetry["delta_v"], color="tab:brown")
-    axes[2].set(ylabel="delta-v [m/s]", title="Delta-v used")
-    axes[3].plot(times, telemetry["tracking_error"], color=_FLOWN, lw=1.0)
-    axes[3].set(ylabel="error [m]", title="Tracking error |reference - estimate|")
-    obstacle_panel(axes[4], times, telemetry["nearest_obstacle"], safety_distance)
-    axes[4].set_title("Clearance: surface gap to the nearest obstacle")
+    names = FrameAxes.of(scenario, np.zeros(0)).names
+    figure, axes = plt.subplots(7, 1, figsize=(11, 16), sharex=True)
+    speed_panel(axes[0], telemetry, robot.max_speed)
+    thrust_panel(axes[1], telemetry, robot.max_force, names)
+    attitude_panel(axes[2], telemetry)
+    rate_panel(axes[3], telemetry, names)
+    axes[4].plot(times, telemetry["delta_v"], color="tab:brown")
+    axes[4].set(ylabel="delta-v [m/s]", title="Delta-v used")
+    axes[5].plot(times, telemetry["tracking_error"], color=_FLOWN, lw=1.0)
+    axes[5].set(ylabel="error [m]", title="Tracking error |reference - estimate|")
+    obstacle_panel(axes[6], times, telemetry["nearest_obstacle"], safety_distance)
+    axes[6].set_title("Clearance: surface gap to the nearest obstacle")
     for axis in axes:
         _shade_modes(axis, times, telemetry["mode"], modes)
         axis.grid(alpha=0.3)
@@ -394,30 +433,11 @@ def _timeline_figure(
         ncol=len(modes) + len(_ANSWER_HANDLES),
         fontsize=9,
         title="mode (shaded; a dash-dot line marks each change) and the planner's answers",
-        bbox_to_anchor=(0.5, 0.97),
+        bbox_to_anchor=(0.5, 1.0 - TITLE_ROOM / figure.get_figheight()),
     )
     figure.suptitle(f"{scenario.name}: timeline")
-    figure.tight_layout(rect=(0.0, 0.0, 1.0, 0.93))
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
-
-
-def _limited(
-    axis, times: np.ndarray, values: np.ndarray, limit: float, ylabel: str, title: str, name: str
-) -> None:
-    """A quantity over time with its limit as a dashed line."""
-    axis.plot(times, values, color=_FLOWN, lw=1.0)
-    axis.axhline(limit, color="k", ls="--", lw=0.8)
-    axis.set_ylim(0.0, 1.2 * max(limit, float(np.max(values))))
-    axis.annotate(
-        f"{name} {limit:.3g}",
-        (1.0, limit),
-        xycoords=("axes fraction", "data"),
-        ha="right",
-        va="bottom",
-        fontsize=8,
-    )
-    axis.set(ylabel=ylabel, title=title)
+    stack_layout(figure, len(axes), top=TITLE_ROOM + 2 * LEGEND_ROW, right=1.3)
+    return figure
 
 
 def _mode_colour(mode: str, modes: tuple[str, ...]) -> tuple:

@@ -1,13 +1,14 @@
 """The shipped debris mission flies exactly as it did: byte-identical records.
 
 The hashes are those of the first 130 s (a plan, a path, a grab, the controller's
-reset for the new mass) of ``dcsim run scenarios/default.yaml``. The events and the
-telemetry's rows are as recorded at commit c063456, before the robot and mission
-contracts were generalised; the telemetry's header line is checked on its own, since
-it gained its units (``x_m``, ``vx_mps``...) at a commit that moved no row: the hash of
-the rows below the header was taken on the commit before (c4bccb2). A change that moves
-any number of the debris mission's telemetry or events fails here; if such a change is
-meant, its commit says why and replaces the hashes.
+reset for the new mass) of ``dcsim run scenarios/default.yaml``. The events are as
+recorded at commit c063456, before the robot and mission contracts were generalised.
+The telemetry's header line is checked on its own (it gained its units, ``x_m``,
+``vx_mps``..., at a commit that moved no row); its rows are those of c063456 with the
+columns ``wx wy wz est_sigma_x est_sigma_y est_sigma_z`` appended, every earlier
+column unchanged. A change that moves any number of the debris mission's telemetry or
+events fails here; if such a change is meant, its commit says why and replaces the
+hashes.
 """
 
 from __future__ import annotations
@@ -22,9 +23,12 @@ from tests.conftest import REPO
 TELEMETRY_HEADER = (
     "time_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps,est_x_m,est_y_m,est_z_m,est_vx_mps,est_vy_mps,"
     "est_vz_mps,qx,qy,qz,qw,mode,converged,carried,delivered,fuel_used_kg,delta_v_mps,"
-    "nearest_obstacle_m,fx_N,fy_N,fz_N"
+    "nearest_obstacle_m,fx_N,fy_N,fz_N,wx_radps,wy_radps,wz_radps,est_sigma_x_m,est_sigma_y_m,"
+    "est_sigma_z_m"
 )
-TELEMETRY_ROWS_SHA256 = "97007c0936e73859b2cb32156f644d9aa9113313e732dad127ce4e3a2687beaf"
+TELEMETRY_ROWS_SHA256 = "255db4a44caa31be595e91b9cdadf9d404a39cc1503ec0e94281116e181241d2"
+ORIGINAL_COLUMNS = 27  # the columns recorded at c063456, before wx ... est_sigma_z
+ORIGINAL_ROWS_SHA256 = "97007c0936e73859b2cb32156f644d9aa9113313e732dad127ce4e3a2687beaf"
 EVENTS_SHA256 = "002f4b6204e2c8c146bb05876a76b6856c584fdd38ef97a3c532f38b35ab8e14"
 
 
@@ -43,3 +47,7 @@ def test_default_scenario_records_are_byte_identical_to_the_reference(tmp_path):
     header, newline, rows = (tmp_path / "telemetry.csv").read_bytes().partition(b"\n")
     assert header.decode() == TELEMETRY_HEADER and newline
     assert sha256(rows) == TELEMETRY_ROWS_SHA256
+    original = b"\n".join(
+        b",".join(line.split(b",")[:ORIGINAL_COLUMNS]) for line in rows.split(b"\n")
+    )
+    assert sha256(original) == ORIGINAL_ROWS_SHA256

@@ -15,6 +15,8 @@ import pytest
 from dcsim_plugins.localisers.trilateration import TrilaterationLocaliser
 
 from dcsim.api import Command, Controller, PluginParams, PluginRegistry, hookimpl, quantity
+from dcsim.geometry import quaternion_conjugate, quaternion_multiply, rotation_vector
+from dcsim.recording import SIGMA_COLUMNS
 from dcsim.registry import PluginOrigin
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
@@ -32,6 +34,7 @@ ALLOWED = {
     ("SELECT_NEXT", "MOVE_TO_NEXT"),
     ("SELECT_NEXT", "MOVE_TO_DROP"),
     ("SELECT_NEXT", "LOCALIZE"),
+    ("SELECT_NEXT", "IDLE"),
     ("MOVE_TO_NEXT", "GRAB"),
     ("MOVE_TO_NEXT", "MOVE_TO_DROP"),
     ("MOVE_TO_NEXT", "DEVISE_PLAN"),
@@ -40,6 +43,7 @@ ALLOWED = {
     ("GRAB", "DEVISE_PLAN"),
     ("MOVE_TO_DROP", "SELECT_NEXT"),
     ("MOVE_TO_DROP", "LOCALIZE"),
+    ("MOVE_TO_DROP", "IDLE"),
 }
 
 
@@ -128,6 +132,39 @@ def test_default_run_follows_the_executer_state_machine(default_run):
     for plan in (e for e in events if e["event"] == "plan"):
         times = [t for _, t in plan["tasks"]]
         assert all(t > plan["t"] for t in times) and np.all(np.diff(times) > 0)
+
+
+@SHARES_DEFAULT_RUN
+def test_after_the_last_delivery_the_mode_reads_idle(default_run):
+    runner, _, _ = default_run
+    events = runner.recorder.events
+    last_release = [e for e in events if e["event"] == "release"][-1]
+    last_mode = [e for e in events if e["event"] == "mode"][-1]
+    assert (last_mode["t"], last_mode["previous"], last_mode["mode"]) == (
+        last_release["t"],
+        "MOVE_TO_DROP",
+        "IDLE",
+    )
+    telemetry = runner.recorder.telemetry()
+    assert telemetry["mode"][-1] == "IDLE" and telemetry["mode"][-2] == "MOVE_TO_DROP"
+
+
+@SHARES_DEFAULT_RUN
+def test_telemetry_records_the_world_frame_angular_rate_and_the_estimates_sigma(default_run):
+    runner, _, _ = default_run
+    telemetry = runner.recorder.telemetry()
+    rate = np.column_stack([telemetry[c] for c in ("wx", "wy", "wz")])
+    attitude = np.column_stack([telemetry[c] for c in ("qx", "qy", "qz", "qw")])
+    assert np.abs(rate).max() > 0.05  # rad/s: the cargo turns the collector
+    # q(t + dt) = exp(ω dt) ⊗ q(t) with ω in the world frame, rad/s.
+    turned = rotation_vector(quaternion_multiply(attitude[1:], quaternion_conjugate(attitude[:-1])))
+    observed = turned / np.diff(telemetry["time"])[:, None]
+    mismatch = np.linalg.norm(observed - 0.5 * (rate[1:] + rate[:-1]), axis=1)
+    assert np.percentile(mismatch, 99) < 1e-3
+    sigma = np.column_stack([telemetry[c] for c in SIGMA_COLUMNS])
+    error = np.column_stack([telemetry[f"est_{a}"] - telemetry[a] for a in "xyz"])
+    assert np.all(sigma > 0) and np.all(sigma < 0.1)  # m
+    assert np.mean(np.abs(error) <= 3 * sigma) > 0.98  # a standard deviation, not a variance
 
 
 @SHARES_DEFAULT_RUN
@@ -309,7 +346,11 @@ def test_collisions_stop_the_run_or_are_counted(tmp_path):
     assert summary["status"] == "stopped" and summary["reason"] == "collision with object 3"
     collision = next(e for e in runner.recorder.events if e["event"] == "collision")
     assert collision["t"] == pytest.approx(9.01) and collision["body"] == "collector"
-    assert runner.recorder.rows[-1]["nearest_obstacle"] < 0
+    last, before = runner.recorder.rows[-1], runner.recorder.rows[-2]
+    assert last["nearest_obstacle"] < 0
+    # The row after the collision keeps the last estimate, its covariance included.
+    assert [last[c] for c in SIGMA_COLUMNS] == [before[c] for c in SIGMA_COLUMNS]
+    assert 0 < last["est_sigma_x"] < 0.5
     _, going_on = run(
         scenario_file(tmp_path, text + "stop: {on_collision: false}\n"), registry=registry
     )

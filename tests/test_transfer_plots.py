@@ -2,14 +2,18 @@
 
 from __future__ import annotations
 
+import json
+
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
+from dcsim.missions.transfer import TransferMission
 from dcsim.recording import read_telemetry
 from dcsim.registry import PluginRegistry
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
-from dcsim.transfer_plots import build_scene, read_planned
+from dcsim.transfer_plots import build_scene, path_figure, read_planned, timeline_figure
 from tests.conftest import REPO
 
 STATION = REPO / "scenarios" / "station_inspection.yaml"
@@ -68,3 +72,26 @@ def test_the_scene_holds_the_plan_the_station_and_the_moving_cylinder_at_three_i
     assert moving[0].centres[0, 1] > moving[0].centres[-1, 1]  # it drifts towards -y
     everything = np.vstack([scene.flown, *(p.centres for p in scene.obstacles)])
     assert np.all(everything >= scene.lower) and np.all(everything <= scene.upper)
+
+
+def test_the_station_views_name_the_lvlh_axes_and_the_timeline_shows_attitude_and_rate(
+    station_run,
+):
+    scenario, out, _ = station_run
+    telemetry = read_telemetry(out / "telemetry.csv", max_points=500)
+    events = [json.loads(line) for line in (out / "events.jsonl").read_text().splitlines()]
+    scene = build_scene(scenario, telemetry, read_planned(out / "trajectory.csv"))
+    try:
+        views = path_figure(scenario, scene).axes
+        assert [views[0].get_xlabel(), views[0].get_ylabel(), views[0].get_zlabel()] == [
+            "radial [m]",
+            "along-track [m]",
+            "orbit-normal [m]",
+        ]
+        assert [views[1].get_xlabel(), views[1].get_ylabel()] == ["radial [m]", "along-track [m]"]
+        timeline = timeline_figure(scenario, telemetry, events, TransferMission.modes, 0.5)
+        titles = [axis.get_title() for axis in timeline.axes]
+        assert "Attitude: angle turned from the initial attitude" in titles
+        assert "Angular rate (world frame)" in titles and "Commanded thrust" in titles
+    finally:
+        plt.close("all")

@@ -142,9 +142,11 @@ class Mission(ABC):
     ) -> list[Path]:
         """Draw the run's pictures into ``out_dir/plots``; return the files written.
 
-        The default draws the trajectory with every object's path and the timeline of
-        modes, propellant, localisation error and obstacle gap
-        (:func:`dcsim.plots.write_plots`). ``telemetry`` is thinned for plotting.
+        The default draws the trajectory with every object's path, the timeline of
+        modes (grabs and releases marked), propellant, delta-v and obstacle gap, the
+        motion (speed, thrust, attitude, angular rate) and the estimation error with
+        its ±3σ envelope (:func:`dcsim.plots.write_plots`). ``telemetry`` is thinned
+        for plotting.
         """
         from dcsim.plots import write_plots  # on use: it loads matplotlib
 

@@ -5,12 +5,15 @@ Modes (the thesis's §2.2.1 and §5.2)::
     LOCALIZE ──converged──► DEVISE_PLAN ──plan──► SELECT_NEXT ──pickup──► MOVE_TO_NEXT
         ▲                        ▲                 │   ▲   drop              │ in reach
         │                        │ replan          ▼   │                     ▼
-        └──── nothing left ──────┴──────────── MOVE_TO_DROP ◄──full/last── GRAB
+        └──── plan done ─────────┴──────────── MOVE_TO_DROP ◄──full/last── GRAB
                                   IDLE: converged, no target known
 
-Replanning happens when a new target enters sensor range, a grab fails, or a pickup
-can no longer be met. Every mode change, plan, grab, release and path failure is
-reported through the ``emit`` callback as an event.
+When a plan is done (the last drop of the plan made), the executer goes back to
+LOCALIZE to plan afresh, or to IDLE when nothing is left to do: no target in sight and
+no cargo on board (after the last delivery, say). Replanning happens when a new target
+enters sensor range, a grab fails, or a pickup can no longer be met. Every mode change,
+plan, grab, release and path failure is reported through the ``emit`` callback as an
+event.
 """
 
 from __future__ import annotations
@@ -271,9 +274,14 @@ class DebrisMission(Mission):
             self._go(Mode.IDLE, "nothing to plan")
         return self._holding()
 
+    def _plan_done(self, reason: str) -> None:
+        """Leave a finished plan: IDLE when nothing is left to do, else LOCALIZE."""
+        nothing_left = not (self._free_targets() or self.world.carried_ids())
+        self._go(Mode.IDLE if nothing_left else Mode.LOCALIZE, reason)
+
     def _select_next(self) -> Reference:
         if not self.steps:
-            self._go(Mode.LOCALIZE, "plan done")
+            self._plan_done("plan done")
             return self._holding()
         step = self.steps.popleft()
         self.trajectory = None
@@ -388,7 +396,10 @@ class DebrisMission(Mission):
                 self.emit("release", delivered=list(result.delivered), reason=result.reason)
                 self.trajectory = None
                 self.visit = None
-                self._go(Mode.SELECT_NEXT if self.steps else Mode.LOCALIZE, "delivered")
+                if self.steps:
+                    self._go(Mode.SELECT_NEXT, "delivered")
+                else:
+                    self._plan_done("delivered")
             elif not self.release_refused:
                 self.emit("release", delivered=[], reason=result.reason)
                 self.release_refused = True

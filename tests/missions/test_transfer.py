@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from dcsim.api import NoPath, PathPlanner, Trajectory
+from dcsim.recording import SIGMA_COLUMNS, read_telemetry
 from dcsim.registry import PluginOrigin, PluginRegistry
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
@@ -109,6 +110,8 @@ def test_no_path_is_retried_after_the_wait_and_the_goal_is_reached(tmp_path):
     assert summary["reached"] and 42.0 <= summary["time_to_goal_s"] < 60.0
     assert summary["nodes_expanded"] == 7.0 and summary["replans"] == 0
     assert summary["localiser"] == "none: the mission was fed the true state"
+    telemetry = read_telemetry(out / "telemetry.csv")
+    assert all(np.all(telemetry[c] == 0.0) for c in SIGMA_COLUMNS)  # the truth: σ = 0
     with (out / "trajectory.csv").open() as stream:
         rows = list(csv.DictReader(stream))
     assert len(rows) == 41 and float(rows[-1]["x_m"]) == pytest.approx(5.0)
