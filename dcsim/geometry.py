@@ -96,12 +96,19 @@ def quaternion_between(a: ArrayLike, b: ArrayLike) -> Vector:
 
 
 def rotate(q: ArrayLike, v: ArrayLike) -> Vector:
-    """Rotate vector ``v`` by unit quaternion ``q = [x, y, z, w]``."""
+    """Rotate vector ``v`` by unit quaternion ``q = [x, y, z, w]``: ``v + w t + u × t``
+    with ``t = 2 u × v`` (one vector in floats, the same operations as for a stack)."""
     q = np.asarray(q, dtype=float)
     v = np.asarray(v, dtype=float)
+    if q.shape == (4,) and v.shape == (3,):
+        x, y, z, w = q.tolist()
+        a, b, c = v.tolist()
+        tx, ty, tz = (2.0 * k for k in _cross_floats(x, y, z, a, b, c))
+        cx, cy, cz = _cross_floats(x, y, z, tx, ty, tz)
+        return np.array((a + w * tx + cx, b + w * ty + cy, c + w * tz + cz))
     u, w = q[:3], q[3]
-    t = 2.0 * cross(u, v)
-    return v + w * t + cross(u, t)
+    t = 2.0 * np.cross(u, v)
+    return v + w * t + np.cross(u, t)
 
 
 def cross(a: ArrayLike, b: ArrayLike) -> Vector:
@@ -114,9 +121,14 @@ def cross(a: ArrayLike, b: ArrayLike) -> Vector:
     b = np.asarray(b, dtype=float)
     if a.shape != (3,) or b.shape != (3,):
         return np.cross(a, b)
-    a0, a1, a2 = a.tolist()
-    b0, b1, b2 = b.tolist()
-    return np.array((a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0))
+    return np.array(_cross_floats(*a.tolist(), *b.tolist()))
+
+
+def _cross_floats(
+    a0: float, a1: float, a2: float, b0: float, b1: float, b2: float
+) -> tuple[float, float, float]:
+    """``a × b`` of two 3-vectors given by their components."""
+    return (a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0)
 
 
 _BODY_AXES = np.vstack([np.eye(3), -np.eye(3)])

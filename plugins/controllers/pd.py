@@ -134,8 +134,11 @@ class PDController(Controller):
 
 def _world_inertia(inertia: np.ndarray, attitude: np.ndarray) -> np.ndarray:
     """``R I Rᵀ``: a body-frame inertia tensor expressed in the world frame, kg·m²."""
-    rotation = np.column_stack([rotate(attitude, axis) for axis in np.eye(3)])
+    rotation = np.array([rotate(attitude, axis) for axis in _AXES]).T
     return rotation @ inertia @ rotation.T
+
+
+_AXES = np.eye(3)
 
 
 @hookimpl
