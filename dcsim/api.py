@@ -49,10 +49,11 @@ Space manipulator model (DH kinematics and dynamics of the source thesis 004)
     manipulator), :func:`load_reach_problem` (the path problem of a reach scenario);
     results :class:`ForwardKinematics`, :class:`InverseKinematicsResult`.
 Geometry
-    :func:`spherical_to_cartesian`, :func:`quaternion_between`, :func:`rotate`, :func:`unit`,
-    :func:`clip_norm`, :func:`quaternion_multiply`, :func:`quaternion_conjugate`,
-    :func:`rotation_vector`, :func:`quaternion_from_rotation_vector`, :func:`slerp`,
-    :func:`facing_axis`, :func:`sight_angle`.
+    :func:`spherical_to_cartesian`, :func:`quaternion_between`, :func:`rotate`,
+    :func:`cross`, :func:`unit`, :func:`clip_norm`, :func:`quaternion_multiply`,
+    :func:`quaternion_conjugate`, :func:`rotation_vector`,
+    :func:`quaternion_from_rotation_vector`, :func:`slerp`, :func:`facing_axis`,
+    :func:`sight_angle`.
 FMUs (FMI 2.0 co-simulation, through fmpy)
     :class:`FmuDescription`, :class:`FmuInstance`, :class:`FmuError`,
     :class:`FmuCallError`.

@@ -200,8 +200,6 @@ class Recorder:
         Every event so far.
     count : int
         Rows recorded so far.
-    last_row : dict or None
-        The latest row.
     """
 
     def __init__(
@@ -219,7 +217,6 @@ class Recorder:
         self.rows: list[dict[str, Any]] = []
         self.events: list[dict[str, Any]] = []
         self.count = 0
-        self.last_row: dict[str, Any] | None = None
         self._pending: list[str] = []
         self._flushed_at = wallclock.perf_counter()
         self._telemetry_file: IO[str] | None = None
@@ -243,7 +240,6 @@ class Recorder:
     def row(self, values: dict[str, Any]) -> None:
         """Record one telemetry row (a value for every column)."""
         self.count += 1
-        self.last_row = values
         if self.keep_rows:
             self.rows.append(values)
         if self._telemetry_file is None:

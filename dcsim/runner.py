@@ -431,8 +431,7 @@ class Runner:
         )
         row.update(zip(("fx", "fy", "fz"), command.force.tolist(), strict=True))
         row.update(zip(("wx", "wy", "wz"), out["angular_velocity"].tolist(), strict=True))
-        variances = np.maximum(estimate.covariance.diagonal()[:3], 0.0)
-        row.update(zip(SIGMA_COLUMNS, np.sqrt(variances).tolist(), strict=True))
+        row.update(zip(SIGMA_COLUMNS, _position_sigmas(estimate.covariance), strict=True))
         self._accumulate(out, estimate)
         self.recorder.row(row)
         if self._step_observed:
@@ -504,6 +503,13 @@ class Runner:
             "localiser": self._localiser_note(),
             "wall_time_by_phase_s": dict(sorted(self.laps.totals.items())),
         }
+
+
+def _position_sigmas(covariance: np.ndarray) -> list[float]:
+    """Standard deviations (m) along x, y and z from the first three diagonal entries of
+    an estimate's covariance (NaN for an axis a smaller covariance does not cover)."""
+    variances = np.maximum(covariance.diagonal()[:3], 0.0)
+    return [*np.sqrt(variances).tolist(), *[float("nan")] * (3 - len(variances))]
 
 
 def _with_readings(estimate: StateEstimate, observations: Observations) -> StateEstimate:

@@ -13,6 +13,7 @@ same telemetry and events, in memory or in a run directory.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 from collections.abc import Mapping, Sequence
@@ -20,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
 import yaml
 
 from dcsim.errors import Problem, ScenarioError
@@ -94,8 +96,8 @@ def override_texts(overrides: Overrides) -> list[str]:
     ----------
     overrides : sequence of str or mapping
         Texts, kept as they are (one text alone counts as one override), or a mapping
-        of key paths to plain values (``{"world.duration": 30}``), each value written
-        as YAML.
+        of key paths to plain values (``{"world.duration": 30}``; numpy numbers and
+        arrays count as plain), each value written as YAML.
 
     Raises
     ------
@@ -110,12 +112,24 @@ def override_texts(overrides: Overrides) -> list[str]:
     texts = []
     for key, value in overrides.items():
         try:
-            text = yaml.safe_dump(value, default_flow_style=True, width=1 << 30)
+            text = yaml.safe_dump(_plain(value), default_flow_style=True, width=1 << 30)
         except yaml.YAMLError:
             message = f"{value!r} is not plain data (numbers, text, lists, mappings)"
             raise ScenarioError("overrides", [Problem(str(key), message)]) from None
         texts.append(f"{key}={text.strip().removesuffix('...').strip()}")
     return texts
+
+
+def _plain(value: Any) -> Any:
+    """``value`` with numpy scalars and arrays (a notebook's ``np.linspace`` values)
+    turned into Python numbers and lists, at any depth."""
+    if isinstance(value, np.generic | np.ndarray):
+        return value.tolist()
+    if isinstance(value, Mapping):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    return value
 
 
 def setup_run(
@@ -276,10 +290,14 @@ def close_run(runner: Runner) -> RunResult:
     """
     if not runner.summary:
         runner.close()
-    out_dir = runner.info.out_dir
-    if out_dir is not None:
-        return read_run(out_dir)
-    summary = json.loads(to_json(runner.summary))
+    summary = json.loads(to_json(runner.summary))  # the runner's: it knows how writing ended
+    if runner.info.out_dir is not None:
+        try:
+            recorded = read_run(runner.info.out_dir)
+        except RunDirectoryError:
+            pass  # the records could not be written (the summary says why): what is in memory
+        else:
+            return dataclasses.replace(recorded, summary=summary, plugins=_plugins(summary))
     events = [json.loads(to_json(event)) for event in runner.recorder.events]
     return RunResult(summary, _memory_telemetry(runner.recorder), events, _plugins(summary))
 

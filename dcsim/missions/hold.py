@@ -54,6 +54,7 @@ class HoldMission(Mission):
     roles = ("controller",)
     modes = ("HOLD",)
     columns = ("position_error", "attitude_error", "tx", "ty", "tz")
+    units = {"position_error": "m", "attitude_error": "rad", "tx": "Nm", "ty": "Nm", "tz": "Nm"}
     summary_names = (
         "final_position_error_m",
         "final_attitude_error_deg",

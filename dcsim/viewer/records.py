@@ -18,16 +18,11 @@ import numpy as np
 import pandas as pd
 
 from dcsim.errors import DcsimError
+from dcsim.recording import column_name
 from dcsim.scenario import load_scenario
 from dcsim.scenario.model import Scenario
 
-UNIT_SUFFIXES = (
-    "m", "mps", "mps2", "s", "kg", "N", "Nm", "Ns",
-    "rad", "radps", "radps2", "deg", "degps", "kgm2",
-)  # fmt: skip
-"""Unit suffixes a column name may carry after an underscore (``x_m``): SI-style tokens."""
-
-_SUFFIX = re.compile(r"^(?P<name>.+?)(?:_(?:" + "|".join(UNIT_SUFFIXES) + r")|\s*\[[^\]]*\])$")
+_BRACKETED_UNIT = re.compile(r"^(?P<name>.+?)\s*\[[^\]]*\]$")  # ``time [s]``
 _TEXT_COLUMNS = ("mode",)
 
 
@@ -66,9 +61,11 @@ class RunRecords:
 
 
 def plain_name(column: str) -> str:
-    """A column name without its unit suffix: ``x_m`` → ``x``, ``time [s]`` → ``time``."""
-    match = _SUFFIX.match(column.strip())
-    return match.group("name") if match else column.strip()
+    """A column name without its unit: ``x_m`` → ``x`` (the suffixes of
+    :data:`dcsim.recording.UNITS`), ``time [s]`` → ``time``."""
+    column = column.strip()
+    match = _BRACKETED_UNIT.match(column)
+    return match.group("name") if match else column_name(column)
 
 
 def read_table(path: Path) -> dict[str, np.ndarray]:

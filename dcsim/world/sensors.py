@@ -34,9 +34,11 @@ class Sensors:
     """
 
     def __init__(self, scenario: Scenario, field: ObjectField, rng: np.random.Generator) -> None:
-        self.beacons = np.array(
-            [point_to_cartesian(p) for p in scenario.beacons.positions]
-        ).reshape(-1, 3)
+        self.beacons = (
+            np.array([point_to_cartesian(p) for p in scenario.beacons.positions])
+            .reshape(-1, 3)
+            .copy()
+        )  # its own data, not a view of the list's array
         self.beacons.setflags(write=False)  # shared by every range message, not copied
         self._settings = scenario.beacons
         self._sensor_range = scenario.robot.sensor_range

@@ -91,4 +91,4 @@ def test_scaffolded_plugin_installs_editable_and_passes_as_generated(fresh_env, 
     again = fresh_env.run(
         "dcsim", "new-plugin", "controller", "gentle", "--dir", str(tmp_path), cwd=tmp_path
     )
-    assert again.returncode == 2 and "already exists" in again.stderr
+    assert again.returncode == 2 and "already named 'gentle'" in again.stderr
