@@ -1014,7 +1014,7 @@ def bench_ant_colony_command(
 
     On every layout, for every cross-section, δ and variant: the colony's gap to the
     optimum that dynamic programming finds on the same graph, its cycles, and the wall
-    times of the graph, the colony, the whole plan and the DP, beside issue 17's targets
+    times of the graph, the colony, the whole plan and the DP, beside the targets
     (median gap ≤ 1 %, p95 ≤ 3 %, ≤ 0.5 s per plan with the line cross-section). Prints
     Markdown tables for docs/benchmarks.md; progress goes to stderr.
     """

@@ -88,7 +88,7 @@ GOAL = {"position": [0.0, 0.0, -23.0], "half_extents": [5.0, 5.0, 2.0]}
 BOUNDS = {"lower": [-16.0, -8.0, -25.0], "upper": [16.0, 8.0, 25.0]}
 """The source's position sampling box, m."""
 BUDGET = 10.0
-"""Planning budget of the bench's escapes, s (the issue's target: solved within 10 s)."""
+"""Planning budget of the bench's escapes, s (the target: solved within 10 s)."""
 
 
 def escape_scenario(seed: int) -> dict[str, Any]:

@@ -77,7 +77,7 @@ INITIAL_ATTITUDE = tuple(
 """The initial attitude ``[x, y, z, w]``: 90° away from the goal."""
 
 TARGET_RATIO = 3.0
-"""The issue's target: dcsim's loop within this factor of Basilisk's wall time."""
+"""The target: dcsim's loop within this factor of Basilisk's wall time."""
 
 
 @dataclass(frozen=True)
