@@ -73,7 +73,7 @@ def cli(ctx: click.Context, debug: bool) -> None:
     ctx.meta["dcsim.debug"] = debug
 
 
-@cli.command("plugins")
+@cli.command("plugins", short_help="List the registered plugins, or one's parameters.")
 @click.argument("name", required=False)
 @click.option(
     "--kind",
@@ -192,7 +192,7 @@ def validate_command(files: tuple[Path, ...]) -> None:
         sys.exit(EXIT_USER_ERROR)
 
 
-@cli.command("run")
+@cli.command("run", short_help="Run a scenario and record it in a run directory.")
 @click.argument("scenario", required=False, type=click.Path(dir_okay=False, path_type=Path))
 @click.option(
     "--out",
@@ -281,7 +281,7 @@ def _print_summary(summary: dict, out: Path) -> None:
     click.echo(f"  results in {out}")
 
 
-@cli.command("view")
+@cli.command("view", short_help="Write a page that replays a run in 3-D in a browser.")
 @click.argument("run_dir", type=click.Path(path_type=Path))
 @click.option(
     "--out",
@@ -363,7 +363,7 @@ def new_plugin_command(kind: str, name: str, directory: Path) -> None:
     click.echo(f"next: pip install -e '{root}[test]' && (cd {root} && pytest)")
 
 
-@cli.group("bench")
+@cli.group("bench", short_help="Measure dcsim and its plugins against references.")
 def bench_group() -> None:
     """Measure dcsim and its plugins; results go into docs/benchmarks.md."""
 
@@ -1346,7 +1346,7 @@ def robot_group() -> None:
     """The robot of a scenario file: its model for other tools."""
 
 
-@robot_group.command("urdf")
+@robot_group.command("urdf", short_help="Write the URDF of a scenario's manipulator.")
 @click.argument("scenario", type=click.Path(dir_okay=False, path_type=Path))
 @click.option(
     "-o",
@@ -1376,12 +1376,12 @@ def robot_urdf_command(scenario: Path, out: Path, overrides: tuple[str, ...]) ->
     click.echo(f"URDF of {model.n_joints}-joint manipulator written to {out}")
 
 
-@cli.group("fmu")
+@cli.group("fmu", short_help="FMI 2.0 co-simulation: export scenarios, couple FMUs.")
 def fmu_group() -> None:
     """FMI 2.0 co-simulation: export scenarios as FMUs, couple FMUs (docs/fmu.md)."""
 
 
-@fmu_group.command("export")
+@fmu_group.command("export", short_help="Build an FMI 2.0 co-simulation FMU of a scenario.")
 @click.argument("scenario", required=False, type=click.Path(dir_okay=False, path_type=Path))
 @click.option(
     "-o",
@@ -1434,7 +1434,7 @@ def fmu_export_command(
     click.echo(f"{kind} FMU written to {path}")
 
 
-@fmu_group.command("cosim")
+@fmu_group.command("cosim", short_help="Couple a plant FMU with a controller FMU through fmpy.")
 @click.argument("plant", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option(
     "--controller",

@@ -17,7 +17,7 @@ if TYPE_CHECKING:
 EXIT_INTERRUPTED = 130
 
 
-@click.group("campaign")
+@click.group("campaign", short_help="Many cases of one scenario on Dask.")
 def campaign_group() -> None:
     """Many cases of one scenario on Dask: Monte Carlo draws and sweeps (docs/campaigns.md)."""
 
@@ -52,7 +52,7 @@ def cluster_options(command: click.Command) -> click.Command:
     return command
 
 
-@campaign_group.command("run")
+@campaign_group.command("run", short_help="Run a campaign file's cases and collect them.")
 @click.argument("campaign", type=click.Path(dir_okay=False, path_type=Path))
 @click.option(
     "--out",
@@ -96,7 +96,7 @@ def run_command(
     _report(run_campaign(loaded, out, options, cases, force))
 
 
-@campaign_group.command("resume")
+@campaign_group.command("resume", short_help="Run the cases of a campaign that have no result.")
 @click.argument("directory", type=click.Path(file_okay=False, exists=True, path_type=Path))
 @cluster_options
 def resume_command(
@@ -110,7 +110,7 @@ def resume_command(
     _report(resume_campaign(directory, options))
 
 
-@campaign_group.command("rerun")
+@campaign_group.command("rerun", short_help="Run one case again and compare it byte for byte.")
 @click.argument("directory", type=click.Path(file_okay=False, exists=True, path_type=Path))
 @click.option("--case", "index", type=click.IntRange(min=0), required=True, help="Case index.")
 @click.option(

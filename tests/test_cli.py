@@ -232,15 +232,20 @@ def test_debug_shows_the_traceback(dcsim_cli):
     assert "ScenarioError" in result.stderr
 
 
-def test_bench_help_lists_every_bench_with_its_whole_one_line_description(dcsim_cli):
-    from dcsim.cli import bench_group
+@pytest.mark.parametrize("group", [(), ("bench",), ("campaign",), ("fmu",), ("robot",)])
+def test_every_help_lists_its_commands_with_whole_one_line_descriptions(dcsim_cli, group):
+    from dcsim.cli import cli
 
-    lines = dcsim_cli("bench", "--help").stdout.split("Commands:\n")[1].splitlines()
-    assert len(lines) == len(bench_group.commands)  # one line each, none wrapped
-    for name, command in bench_group.commands.items():
-        assert command.short_help and command.short_help.endswith(".")
-        assert f"  {name}  " in next(line for line in lines if line.split()[0] == name)
-        assert next(line for line in lines if line.split()[0] == name).endswith(command.short_help)
+    found = cli
+    for name in group:
+        found = found.commands[name]
+    lines = dcsim_cli(*group, "--help").stdout.split("Commands:\n")[1].splitlines()
+    assert len(lines) == len(found.commands)  # one line each, none wrapped
+    for name, command in found.commands.items():
+        line = next(line for line in lines if line.split()[0] == name)
+        description = command.get_short_help_str(limit=1000)
+        assert description.endswith(".") and "..." not in line
+        assert f"  {name}  " in line and line.endswith(description)
 
 
 # The least values the options of `bench world`, `manipulator` and `localisers` allow
