@@ -460,11 +460,7 @@ class World:
             float(q) for q in torque + np.asarray(self.inputs.disturbance_torque, dtype=float)
         )
         thrusts = self._propellant.burn(force, self._period_mass)
-        if self._arm is None and not len(self._candidates):
-            self._fly_alone(thrusts, disturbance, total_torque)
-            started: list[CollisionEvent] = []
-        else:
-            started = self._fly_with_contacts(thrusts, disturbance, total_torque)
+        started = self._fly_period(thrusts, disturbance, total_torque)
         self._set_body_mass(self.collector_mass())
         self.collisions += started
         return started
@@ -478,83 +474,44 @@ class World:
         pb.changeDynamics(self.collector, -1, mass=mass, physicsClientId=self._client)
         self._body_mass = mass
 
-    def _fly_with_contacts(
+    def _fly_period(
         self,
         thrusts: list[tuple[float, float, float]],
         disturbance: tuple[float, float, float],
         torque: tuple[float, float, float],
     ) -> list[CollisionEvent]:
-        """The period's physics steps, checking the broad phase's candidates after each."""
-        started: list[CollisionEvent] = []
-        for thrust in thrusts:
-            self._physics_step(thrust, disturbance, torque)
-            if len(self._candidates):
-                started += self._detect_collisions()
-        return started
-
-    def _fly_alone(
-        self,
-        thrusts: list[tuple[float, float, float]],
-        disturbance: tuple[float, float, float],
-        torque: tuple[float, float, float],
-    ) -> None:
-        """The period's physics steps of a free flyer with nothing in reach:
-        :meth:`_physics_step` with the branches that cannot apply taken out of the loop
-        (the same forces, to the bit)."""
+        """The control period's physics steps: thrust, disturbance and orbital forces on
+        the assembly (and the arm's joint torques), the broad phase's candidates checked
+        for contact after each step. What cannot change within the period is read once."""
         client, body, mass, n = self._client, self.collector, self._body_mass, self._mean_motion
         get_pose, get_velocity = pb.getBasePositionAndOrientation, pb.getBaseVelocity
         apply_force, step = pb.applyExternalForce, pb.stepSimulation
         cargo = [(c, self.field.objects[i].mass) for i, (c, _) in self._cargo.held.items()]
+        arm, links = self._arm, (self._arm_links if self._arm is not None else ())
         apply_torque = torque != (0.0, 0.0, 0.0)
+        check_contacts = len(self._candidates) > 0
         dx, dy, dz = disturbance
+        started: list[CollisionEvent] = []
         for tx, ty, tz in thrusts:
             position = get_pose(body, client)[0]
             fx, fy, fz = tx + dx, ty + dy, tz + dz
             if n is not None:
-                vx, vy, _ = get_velocity(body, client)[0]
-                fx += mass * (3.0 * n * n * position[0] + 2.0 * n * vy)
-                fy += mass * (-2.0 * n * vx)
-                fz += mass * (-n * n * position[2])
+                ax, ay, az = cw_acceleration(n, position, get_velocity(body, client)[0])
+                fx, fy, fz = fx + mass * ax, fy + mass * ay, fz + mass * az
                 for carried, carried_mass in cargo:
                     apply_cw_force(client, carried, carried_mass, n)
+                for link, link_mass in links:
+                    apply_cw_force_on_link(client, body, link, link_mass, n)
+            if arm is not None:
+                arm.apply_joint_torques(self._joint_torques)
             apply_force(body, -1, (fx, fy, fz), position, pb.WORLD_FRAME, client)
             if apply_torque:
                 pb.applyExternalTorque(body, -1, torque, pb.WORLD_FRAME, client)
             step(client)
-        self._steps += len(thrusts)
-
-    def _physics_step(
-        self,
-        thrust: tuple[float, float, float],
-        disturbance: tuple[float, float, float],
-        torque: tuple[float, float, float],
-    ) -> None:
-        """One physics step: thrust, disturbance and orbital forces on the assembly."""
-        client, body = self._client, self.collector
-        position, _ = pb.getBasePositionAndOrientation(body, physicsClientId=client)
-        fx, fy, fz = (thrust[k] + disturbance[k] for k in range(3))
-        if self._mean_motion is not None:
-            velocity, _ = pb.getBaseVelocity(body, physicsClientId=client)
-            ax, ay, az = cw_acceleration(self._mean_motion, position, velocity)
-            fx, fy, fz = (
-                fx + self._body_mass * ax,
-                fy + self._body_mass * ay,
-                fz + self._body_mass * az,
-            )
-            for index, (cargo, _) in self._cargo.held.items():
-                apply_cw_force(client, cargo, self.field.objects[index].mass, self._mean_motion)
-            if self._arm is not None:
-                for link, mass in self._arm_links:
-                    apply_cw_force_on_link(client, body, link, mass, self._mean_motion)
-        if self._arm is not None:
-            self._arm.apply_joint_torques(self._joint_torques)
-        pb.applyExternalForce(
-            body, -1, (fx, fy, fz), position, pb.WORLD_FRAME, physicsClientId=client
-        )
-        if torque != (0.0, 0.0, 0.0):
-            pb.applyExternalTorque(body, -1, torque, pb.WORLD_FRAME, physicsClientId=client)
-        pb.stepSimulation(physicsClientId=client)
-        self._steps += 1
+            self._steps += 1
+            if check_contacts:
+                started += self._detect_collisions()
+        return started
 
     def _update_broad_phase(self, force: np.ndarray) -> None:
         """Find the free objects that could touch the assembly in the coming period."""
