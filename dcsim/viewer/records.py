@@ -19,6 +19,7 @@ import pandas as pd
 
 from dcsim.errors import DcsimError
 from dcsim.recording import column_name
+from dcsim.runs import read_events, telemetry_frame
 from dcsim.scenario import load_scenario
 from dcsim.scenario.model import Scenario
 
@@ -90,11 +91,11 @@ def read_table(path: Path) -> dict[str, np.ndarray]:
         If the file cannot be read or parsed as CSV.
     """
     try:
-        frame = pd.read_csv(path, dtype={name: str for name in _TEXT_COLUMNS})
-    except (OSError, ValueError, pd.errors.ParserError) as error:
+        frame = telemetry_frame(path)
+    except (OSError, ValueError) as error:  # unreadable, not UTF-8, not CSV
         raise ViewError(f"cannot read {path}: {error}") from None
-    if len(frame) and not _ends_with_newline(path):
-        frame = frame.iloc[:-1]
+    if not len(frame.columns):
+        raise ViewError(f"cannot read {path}: it is empty, not even a header line")
     table: dict[str, np.ndarray] = {}
     for column in frame.columns:
         name = plain_name(str(column))
@@ -143,25 +144,20 @@ def read_run(directory: Path) -> RunRecords:
         directory=directory,
         scenario=scenario,
         telemetry=telemetry,
-        events=read_events(directory / "events.jsonl"),
+        events=_events(directory / "events.jsonl"),
         summary=_read_summary(directory / "summary.json"),
         planned=_planned_positions(directory / "trajectory.csv"),
     )
 
 
-def read_events(path: Path) -> list[dict[str, Any]]:
-    """The events of an ``events.jsonl`` (none if missing); a line cut short is left out."""
+def _events(path: Path) -> list[dict[str, Any]]:
+    """The events of an ``events.jsonl`` (:func:`dcsim.runs.read_events`); none if missing."""
     if not path.is_file():
         return []
-    events = []
-    for line in path.read_text(encoding="utf-8").splitlines():
-        try:
-            event = json.loads(line)
-        except json.JSONDecodeError:
-            continue
-        if isinstance(event, dict) and "t" in event and "event" in event:
-            events.append(event)
-    return events
+    try:
+        return read_events(path)
+    except (OSError, ValueError) as error:
+        raise ViewError(f"cannot read {path}: {error}") from None
 
 
 def _read_summary(path: Path) -> dict[str, Any]:
@@ -180,12 +176,3 @@ def _planned_positions(path: Path) -> np.ndarray:
     if not all(axis in table for axis in "xyz"):
         return np.zeros((0, 3))
     return np.column_stack([table[axis] for axis in "xyz"])
-
-
-def _ends_with_newline(path: Path) -> bool:
-    with path.open("rb") as stream:
-        stream.seek(0, 2)
-        if stream.tell() == 0:
-            return True
-        stream.seek(-1, 2)
-        return stream.read(1) == b"\n"
