@@ -137,6 +137,18 @@ def test_rerun_repeats_a_case_bit_for_bit(twelve, tmp_path):
 
 
 @ON_DASK
+def test_a_local_cluster_s_workers_keep_their_event_loop_off_the_case():
+    import dask
+
+    from dcsim.campaign.engine import QUIET_WORKER_SETTINGS, dask_client
+
+    with dask_client(ClusterOptions(workers=1)) as client:
+        seen = client.run(lambda: {key: dask.config.get(key) for key in QUIET_WORKER_SETTINGS})
+    assert list(seen.values()) == [QUIET_WORKER_SETTINGS]
+    assert QUIET_WORKER_SETTINGS["distributed.worker.profile.enabled"] is False
+
+
+@ON_DASK
 def test_a_dying_worker_loses_no_case_and_a_raising_plugin_is_a_failed_case(tmp_path, monkeypatch):
     dist = make_distribution(
         tmp_path / "dist",
@@ -316,6 +328,10 @@ def test_the_campaign_bench_compares_direct_runs_with_the_engine(tmp_path):
     path = campaign_file(tmp_path / "campaign", TWELVE_CASES)
     bench = bench_campaign(path, tmp_path / "bench", 2, [1], 2.0, progress=lambda line: None)
     assert bench.cases == 2 and set(bench.campaign_s) == {1}
-    assert bench.same_results and bench.direct_s > 0
-    assert "| campaign, 1 worker |" in markdown_table(bench)
-    assert len(list((tmp_path / "bench" / "direct").iterdir())) == 2
+    assert bench.same_results and min(bench.direct_s) > 0
+    assert len(bench.worker_case_s) == 2 and 0 < sum(bench.worker_case_s) < bench.campaign_s[1]
+    assert bench.case_overhead() > -1
+    table = markdown_table(bench)
+    assert "| campaign, 1 worker |" in table and "(after the campaigns)" in table
+    for folder in ("direct", "direct-again"):
+        assert len(list((tmp_path / "bench" / folder).iterdir())) == 2
