@@ -15,7 +15,11 @@ $(STAMP): pyproject.toml setup.cfg
 
 # One pytest-xdist worker per core; tests marked with one xdist_group share a worker
 # (and the set-up they share). `.venv/bin/pytest` alone runs the suite in one process.
+# dcsim's and the plugins' bytecode is compiled first: where PYTHONDONTWRITEBYTECODE is
+# set, every process the suite starts (`dcsim` commands, Dask workers) would otherwise
+# compile them again, about 1.3 s each.
 test: $(STAMP)
+	$(BIN)/python -m compileall -q dcsim plugins
 	$(BIN)/python -m pytest -n auto --dist loadgroup
 
 run: $(STAMP)
