@@ -133,7 +133,7 @@ def dask_client(options: ClusterOptions) -> Iterator[Client]:
                 n_workers=options.workers or local_worker_count(),
                 threads_per_worker=1,
                 processes=True,
-                dashboard_address=None,
+                dashboard_address="127.0.0.1:0",  # loopback, any free port: campaigns side by side
                 silence_logs=logging.CRITICAL,
             )
     except (OSError, TimeoutError) as error:
