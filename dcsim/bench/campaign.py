@@ -9,8 +9,8 @@ with it: the baseline is their mean.
 
 Two overheads are reported. *Per case*: the median over the cases of a case's own wall
 time inside the one-worker campaign's worker (set-up included) against the same case
-run directly (the mean of its two direct runs); the median leaves out the worker's
-first case, which imports dcsim and its plugins. *In all*: the one-worker campaign's
+run directly (the mean of its two direct runs); the median is not moved by the
+worker's first case, which also imports dcsim and its plugins. *In all*: the one-worker campaign's
 wall time, which adds starting the cluster, the workers' imports and the results
 table, statistics and plots at the end, against the direct runs'. The
 speed-up is one worker's wall time over each other count's. The tables of every worker
