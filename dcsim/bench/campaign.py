@@ -110,17 +110,18 @@ def bench_campaign(
     selected = campaign_cases(campaign, registry, cases)
     before = _run_directly(campaign, selected, registry, out / "direct")
     progress(f"direct: {len(selected)} cases in {sum(before):.1f} s")
-    walls, tables = {}, []
+    walls, tables = {}, {}
     for count in sorted({1, *workers}):
         began = time.perf_counter()
         run = run_campaign(campaign, out / f"workers-{count}", ClusterOptions(workers=count), cases)
         walls[count] = time.perf_counter() - began
-        tables.append(run.table)
+        tables[count] = run.table
         progress(f"{count} worker(s): {walls[count]:.1f} s")
     after = _run_directly(campaign, selected, registry, out / "direct-again")
     progress(f"direct again: {len(selected)} cases in {sum(after):.1f} s")
-    in_workers = [float(t) for t in tables[0].sort_values("case")["case_wall_time_s"]]
-    compared = [table.drop(columns=list(TIMING_COLUMNS), errors="ignore") for table in tables]
+    # the table's rows and the direct passes both follow the case index
+    in_workers = [float(t) for t in tables[1].sort_values("case")["case_wall_time_s"]]
+    compared = [t.drop(columns=list(TIMING_COLUMNS), errors="ignore") for t in tables.values()]
     same = all(table.equals(compared[0]) for table in compared)
     return CampaignBench(len(selected), (before, after), walls, in_workers, same)
 
