@@ -71,7 +71,8 @@ class MotionModel(ABC):
 
     @classmethod
     def stacked_state(cls, stacked: Any, t: float) -> tuple[Vector, Vector]:
-        """Positions and velocities (N, 3) at time ``t`` (s) of models gathered by :meth:`stack`."""
+        """Positions and velocities (N, 3) at time ``t`` (s) of models gathered by :meth:`stack`,
+        as new arrays."""
         states = [m.state_at(t) for m in stacked]
         return np.array([p for p, _ in states]), np.array([v for _, v in states])
 
@@ -100,6 +101,9 @@ class MotionSet:
 
     def state_at(self, t: float) -> tuple[Vector, Vector]:
         """Positions and velocities (N, 3) of all models at time ``t`` (s)."""
+        if len(self._groups) == 1:  # one class: its group is every model, in order
+            cls, _, stacked = self._groups[0]
+            return cls.stacked_state(stacked, t)
         positions = np.zeros((self.size, 3))
         velocities = np.zeros((self.size, 3))
         for cls, group, stacked in self._groups:
@@ -301,26 +305,30 @@ class ClohessyWiltshireMotion(MotionModel):
 
     @classmethod
     def stack(cls, models: Sequence[MotionModel]) -> Any:
-        """Initial states (transposed), mean motions and epochs as arrays."""
-        return (
-            _stack(models, "position").T,
-            _stack(models, "velocity").T,
-            _stack(models, "mean_motion"),
-            _stack(models, "epoch"),
-        )
+        """Initial states (transposed), mean motions and epochs as arrays.
+
+        Mean motions and epochs that every model shares (one orbit, one epoch: the usual
+        field) are kept as floats instead, so the trigonometry and the coefficients of
+        the closed form are computed once per time rather than once per model.
+        """
+        n, epoch = _stack(models, "mean_motion"), _stack(models, "epoch")
+        if (n == n[0]).all() and (epoch == epoch[0]).all():
+            n, epoch = float(n[0]), float(epoch[0])
+        return _stack(models, "position").T, _stack(models, "velocity").T, n, epoch
 
     @classmethod
     def stacked_state(cls, stacked: Any, t: float) -> tuple[Vector, Vector]:
         """Vectorised :meth:`state_at` of many Clohessy–Wiltshire motions at time ``t``."""
         position, velocity, n, epoch = stacked
-        return _cw_state(position, velocity, n, t - epoch)
+        return _cw_state(position, velocity, n, float(t) - epoch)
 
 
 def _cw_state(p0: ArrayLike, v0: ArrayLike, n: ArrayLike, tau: np.ndarray) -> tuple[Vector, Vector]:
     """The Clohessy–Wiltshire closed form; components of ``p0``, ``v0`` broadcast with τ.
 
-    With floats for ``n`` and ``τ`` (one model at one time) the arithmetic stays in
-    Python floats, the same IEEE operations without numpy's per-scalar overhead.
+    With floats for ``n`` and ``τ`` (one model, or models sharing them, at one time) the
+    coefficients stay in Python floats: the same IEEE operations, in the same order, as
+    numpy's element by element, without its per-call overhead.
     """
     nt = n * tau
     s, c = _sin_cos(nt)

@@ -101,6 +101,31 @@ def test_one_cw_model_at_one_time_equals_its_array_evaluation_to_the_bit():
         assert velocity.tolist() == velocities[0].tolist()
 
 
+def test_a_field_on_one_orbit_equals_its_models_one_by_one_to_the_bit():
+    """Shared mean motion and epoch take the batch's scalar path; mixed ones its array
+    path. Both give each model's own numbers exactly (telemetry depends on it)."""
+    from dcsim.motion import MotionSet
+
+    rng = np.random.default_rng(7)
+
+    def field(epochs):
+        return [
+            ClohessyWiltshireMotion(
+                tuple(rng.normal(0, 50, 3)), tuple(rng.normal(0, 0.05, 3)), N, e
+            )
+            for e in epochs
+        ]
+
+    for models in (field([0.0] * 9), field(rng.uniform(-50, 50, 9))):
+        batch = MotionSet(models)
+        for t in rng.uniform(0, 5000, 50):
+            positions, velocities = batch.state_at(float(t))
+            for model, position, velocity in zip(models, positions, velocities, strict=True):
+                expected_position, expected_velocity = model.state_at(float(t))
+                assert position.tolist() == expected_position.tolist()
+                assert velocity.tolist() == expected_velocity.tolist()
+
+
 def test_row_lengths_are_numpys_norms_to_the_bit():
     from dcsim.geometry import row_lengths
 
