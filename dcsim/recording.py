@@ -244,7 +244,7 @@ class Recorder:
             self.rows.append(values)
         if self._telemetry_file is None:
             return
-        self._pending.append(",".join(_cell(values[c]) for c in self.columns))
+        self._pending.append(",".join(map(_cell, map(values.__getitem__, self.columns))))
         if len(self._pending) >= FLUSH_ROWS or (
             wallclock.perf_counter() - self._flushed_at > FLUSH_SECONDS
         ):
@@ -412,6 +412,9 @@ def _parse(header: Sequence[str], lines: Sequence[Sequence[str]]) -> dict[str, n
 
 
 def _cell(value: Any) -> str:
-    if isinstance(value, float | np.floating):
+    """A telemetry value as CSV text: floats by their shortest round-trip repr."""
+    if type(value) is float:  # nearly every cell
+        return repr(value)
+    if isinstance(value, np.floating):
         return repr(float(value))
     return str(value)
