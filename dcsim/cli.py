@@ -658,6 +658,7 @@ def bench_controllers_command(
     first_seed: int,
     controllers: str,
     scheduler: str | None,
+    connect_timeout: float | None,
     workers: int | None,
     worker_deaths: int,
     overrides: tuple[str, ...],
@@ -685,7 +686,7 @@ def bench_controllers_command(
         names,
         range(first_seed, first_seed + seeds),
         overrides,
-        cluster_choice(scheduler, workers, worker_deaths),
+        cluster_choice(scheduler, connect_timeout, workers, worker_deaths),
         progress=lambda line: click.echo(line, err=True),
     )
     click.echo(markdown_table(runs))

@@ -23,8 +23,8 @@ def campaign_group() -> None:
 
 
 def cluster_options(command: click.Command) -> click.Command:
-    """Add the options that choose where cases run (``--scheduler``, ``--workers``,
-    ``--worker-deaths``) to a command."""
+    """Add the options that choose where cases run (``--scheduler``, ``--connect-timeout``,
+    ``--workers``, ``--worker-deaths``) to a command."""
     options = [
         click.option(
             "--scheduler",
@@ -32,6 +32,12 @@ def cluster_options(command: click.Command) -> click.Command:
             help="Run on this existing Dask scheduler (its workers need dcsim and the "
             "campaign's plugins installed, and the campaign directory at the same path). "
             "Default: a local cluster.",
+        ),
+        click.option(
+            "--connect-timeout",
+            type=click.FloatRange(min=0.1, max=3600.0),
+            metavar="SECONDS",
+            help="Seconds to wait for the --scheduler before giving up. Default: 10.",
         ),
         click.option(
             "--workers",
@@ -72,6 +78,7 @@ def run_command(
     force: bool,
     cases: int | None,
     scheduler: str | None,
+    connect_timeout: float | None,
     workers: int | None,
     worker_deaths: int,
 ) -> None:
@@ -90,7 +97,7 @@ def run_command(
     if out is None:
         stamp = f"{datetime.now():%Y%m%d-%H%M%S}"
         out = Path("runs") / "campaigns" / f"{file_name_part(loaded.spec.name)}-{stamp}"
-    options = cluster_choice(scheduler, workers, worker_deaths)
+    options = cluster_choice(scheduler, connect_timeout, workers, worker_deaths)
     count = loaded.spec.total_cases if cases is None else min(cases, loaded.spec.total_cases)
     click.echo(f"campaign {loaded.spec.name}: {count} cases {_where(options)} → {out}", err=True)
     _report(run_campaign(loaded, out, options, cases, force))
@@ -100,12 +107,16 @@ def run_command(
 @click.argument("directory", type=click.Path(file_okay=False, exists=True, path_type=Path))
 @cluster_options
 def resume_command(
-    directory: Path, scheduler: str | None, workers: int | None, worker_deaths: int
+    directory: Path,
+    scheduler: str | None,
+    connect_timeout: float | None,
+    workers: int | None,
+    worker_deaths: int,
 ) -> None:
     """Run the cases of campaign DIRECTORY that have no result yet (after Ctrl-C or a crash)."""
     from dcsim.campaign import resume_campaign
 
-    options = cluster_choice(scheduler, workers, worker_deaths)
+    options = cluster_choice(scheduler, connect_timeout, workers, worker_deaths)
     click.echo(f"resuming {directory} {_where(options)}", err=True)
     _report(resume_campaign(directory, options))
 
@@ -136,17 +147,29 @@ def rerun_command(directory: Path, index: int, out: Path | None) -> None:
 
 
 def cluster_choice(
-    scheduler: str | None, workers: int | None, worker_deaths: int
+    scheduler: str | None,
+    connect_timeout: float | None,
+    workers: int | None,
+    worker_deaths: int,
 ) -> ClusterOptions:
-    """The cluster the options chose; ``--workers`` with ``--scheduler`` is an error."""
+    """The cluster the options chose; ``--workers`` with ``--scheduler``, or
+    ``--connect-timeout`` without it, is an error."""
     from dcsim.campaign import ClusterOptions
+    from dcsim.campaign.engine import CONNECT_TIMEOUT
 
     if scheduler is not None and workers is not None:
         raise click.BadParameter(
             "--workers sizes the local cluster; an existing scheduler has its own workers",
             param_hint="--workers",
         )
-    return ClusterOptions(scheduler, workers, worker_deaths)
+    if scheduler is None and connect_timeout is not None:
+        raise click.BadParameter(
+            "--connect-timeout is for a cluster given by --scheduler; the local cluster "
+            "is started here",
+            param_hint="--connect-timeout",
+        )
+    timeout = CONNECT_TIMEOUT if connect_timeout is None else connect_timeout
+    return ClusterOptions(scheduler, workers, worker_deaths, timeout)
 
 
 def _where(options: ClusterOptions) -> str:

@@ -30,7 +30,7 @@ if TYPE_CHECKING:
     from distributed import Client, Future
 
 CONNECT_TIMEOUT = 10.0
-"""Seconds to wait for a scheduler given by address."""
+"""Seconds to wait for a scheduler given by address, unless the options say otherwise."""
 
 QUIET_WORKER_SETTINGS: dict[str, Any] = {
     "distributed.worker.profile.enabled": False,
@@ -68,11 +68,15 @@ class ClusterOptions:
         Workers that may die running one case before it is a failed case (local
         cluster only; an existing scheduler keeps its own
         ``distributed.scheduler.allowed-failures``).
+    connect_timeout : float
+        Seconds to wait for the scheduler at ``scheduler`` (a scheduler started by a
+        batch job may need longer than the default).
     """
 
     scheduler: str | None = None
     workers: int | None = None
     worker_deaths: int = 3
+    connect_timeout: float = CONNECT_TIMEOUT
 
 
 @dataclass(frozen=True)
@@ -106,8 +110,8 @@ def dask_client(options: ClusterOptions) -> Iterator[Client]:
     Raises
     ------
     ClusterError
-        If the scheduler cannot be reached in :data:`CONNECT_TIMEOUT` seconds or the
-        local cluster cannot start.
+        If the scheduler cannot be reached in ``options.connect_timeout`` seconds or
+        the local cluster cannot start.
     """
     import dask
     from distributed import Client, LocalCluster
@@ -115,7 +119,7 @@ def dask_client(options: ClusterOptions) -> Iterator[Client]:
     _quiet_logs()
     if options.scheduler is not None:
         try:
-            client = Client(options.scheduler, timeout=CONNECT_TIMEOUT)
+            client = Client(options.scheduler, timeout=options.connect_timeout)
         except (OSError, TimeoutError, ValueError) as error:
             raise ClusterError(
                 f"cannot reach the Dask scheduler at {options.scheduler}: {error}"

@@ -19,6 +19,7 @@ import pytest
 import dcsim.api
 from dcsim.campaign import ClusterOptions, load_campaign, replay_case, run_campaign
 from dcsim.campaign.cases import campaign_cases
+from dcsim.campaign.engine import ClusterError, dask_client
 from dcsim.campaign.run import read_journal
 from dcsim.registry import PluginRegistry
 from dcsim.runner import Runner
@@ -140,7 +141,7 @@ def test_rerun_repeats_a_case_bit_for_bit(twelve, tmp_path):
 def test_a_local_cluster_s_workers_keep_their_event_loop_off_the_case():
     import dask
 
-    from dcsim.campaign.engine import QUIET_WORKER_SETTINGS, dask_client
+    from dcsim.campaign.engine import QUIET_WORKER_SETTINGS
 
     with dask_client(ClusterOptions(workers=1)) as client:
         seen = client.run(lambda: {key: dask.config.get(key) for key in QUIET_WORKER_SETTINGS})
@@ -315,11 +316,28 @@ def test_a_campaign_runs_on_a_scheduler_and_workers_started_apart(tmp_path):
 
 def test_an_unreachable_scheduler_is_an_error_not_a_traceback(tmp_path, dcsim_cli):
     path = campaign_file(tmp_path, "name: c\nscenario: BASE\n")
-    done = dcsim_cli("campaign", "run", str(path), "--scheduler", f"tcp://127.0.0.1:{free_port()}")
+    address = f"tcp://127.0.0.1:{free_port()}"
+    done = dcsim_cli("campaign", "run", str(path), "--scheduler", address, "--connect-timeout", "1")
     assert done.returncode == 2
     assert "\nerror: cannot reach the Dask scheduler at tcp://127.0.0.1:" in done.stderr
     assert "Traceback" not in done.stderr
     assert not (tmp_path / "runs").exists()  # nothing written
+
+
+def test_the_connect_timeout_is_how_long_an_unreachable_scheduler_is_waited_for():
+    options = ClusterOptions(f"tcp://127.0.0.1:{free_port()}", connect_timeout=0.5)
+    started = time.perf_counter()
+    with pytest.raises(ClusterError, match="cannot reach the Dask scheduler"):
+        with dask_client(options):
+            pass
+    assert time.perf_counter() - started < 5  # half a second, not the default's ten
+
+
+def test_a_connect_timeout_without_a_scheduler_is_a_usage_error(tmp_path, dcsim_cli):
+    path = campaign_file(tmp_path, "name: c\nscenario: BASE\n")
+    done = dcsim_cli("campaign", "run", str(path), "--connect-timeout", "5")
+    assert done.returncode == 2 and "--connect-timeout is for a cluster given by" in done.stderr
+    assert not (tmp_path / "runs").exists()
 
 
 @ON_DASK
