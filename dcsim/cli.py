@@ -390,9 +390,10 @@ def bench_world_command(objects: str, duration: float) -> None:
     For each field size, one synthetic LVLH scenario is stepped bare (stepSimulation
     only) and flown by the full runner; the closed loop is split by phase of the run
     loop. Then the default scenario is flown once for its real-time factor. Prints a
-    Markdown table for docs/benchmarks.md.
+    Markdown table for docs/benchmarks.md, and the floor under the default scenario's
+    real-time factor: stepping, the per-step force calls and the localiser plugin alone.
     """
-    from dcsim.bench.world import bench_world, markdown_table
+    from dcsim.bench.world import bench_world, floor_line, loop_floor, markdown_table
     from dcsim.runner import Runner
 
     words = [word.strip() for word in objects.split(",")]
@@ -403,12 +404,14 @@ def bench_world_command(objects: str, duration: float) -> None:
     sizes = [int(word) for word in words]
     rows = bench_world(sizes, duration, progress=lambda line: click.echo(line, err=True))
     click.echo(markdown_table(rows))
-    summary = Runner(prepare_run(registry=_registry())).run()
+    registry = _registry()
+    summary = Runner(prepare_run(registry=registry)).run()
     click.echo(
         f"\ndefault scenario: {summary['status']} ({summary['reason']}), "
         f"{summary['sim_time_s']:.1f} s simulated in {summary['wall_time_s']:.2f} s, "
         f"real-time factor {summary['real_time_factor']:.0f}"
     )
+    click.echo(floor_line(loop_floor(summary["sim_time_s"], summary["wall_time_s"], registry)))
 
 
 @bench_group.command("soak", short_help="A long run's memory and time per tick; FMU lifetimes.")

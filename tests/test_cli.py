@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 import yaml
@@ -258,6 +259,17 @@ def test_bench_world_prints_a_table_for_each_size(dcsim_cli):
     ]
     assert [row.split("|")[1].strip() for row in rows] == ["0", "5"]
     assert "default scenario: completed (all targets delivered)" in result.stdout
+    floor = re.search(
+        r"floor of the default scenario over its 724\.2 s: stepping ([\d.]+) s \+ per-step "
+        r"state reads and forces ([\d.]+) s \+ localiser plugin alone ([\d.]+) s = ([\d.]+) s, "
+        r"so a real-time factor of at most (\d+)",
+        result.stdout,
+    )
+    assert floor, result.stdout
+    parts, total, ceiling = [float(v) for v in floor.groups()[:3]], *map(float, floor.groups()[3:])
+    assert min(parts) >= 0 and parts[0] > 0 and parts[2] > 0
+    assert total == pytest.approx(sum(parts), abs=0.021)  # four roundings to 0.01
+    assert ceiling == pytest.approx(724.2 / total, rel=0.05)
     assert "5 objects: bare stepping" in result.stderr
     negative = dcsim_cli("bench", "world", "--objects", "5,-1")
     assert negative.returncode == 2 and "expected integers >= 0" in negative.stderr

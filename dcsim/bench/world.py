@@ -12,6 +12,12 @@ Both are reported as wall time per simulated second, and the closed loop is spli
 phase of the run loop (the runner's lap timer): the world's control-period step
 (physics included), sensors, localiser, mission (planners included), controller and
 recording.
+
+Then the default scenario is flown, and the floor under its real-time factor measured:
+what any run of it pays whatever the framework does around it, for the span it flew
+(:func:`loop_floor`): PyBullet's stepping, the state reads and force applications
+each physics step needs, and the localiser plugin's own predict, update and estimate
+once a tick.
 """
 
 from __future__ import annotations
@@ -22,10 +28,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from dcsim.interfaces import Localiser
+from dcsim.messages import MotionInput, Prior
 from dcsim.motion import mean_motion
 from dcsim.registry import PluginRegistry
 from dcsim.runner import Runner
-from dcsim.runsetup import build_run
+from dcsim.runsetup import build_run, prepare_run
 from dcsim.scenario.model import Scenario
 from dcsim.seeding import component_rng
 from dcsim.world import World
@@ -154,3 +162,104 @@ def markdown_table(rows: list[WorldBenchRow]) -> str:
             f"{100 * r.overhead:.0f} % | {1 / r.closed_loop:.0f} | {phases} |"
         )
     return "\n".join(lines)
+
+
+@dataclass(frozen=True)
+class LoopFloor:
+    """Wall time (s) a run of a scenario cannot avoid, for the span it flew.
+
+    Attributes
+    ----------
+    sim_time : float
+        Simulated span, s.
+    stepping : float
+        ``stepSimulation`` once per physics step.
+    forces : float
+        Beyond ``stepping``: reading the collector's pose and velocity and applying a
+        force each physics step, as the world does for thrust and orbital forces.
+    localiser : float
+        The localiser plugin alone: predict, update (with the ranges of every beacon)
+        and estimate once per control period.
+    closed_loop : float
+        The run's own wall time.
+    """
+
+    sim_time: float
+    stepping: float
+    forces: float
+    localiser: float
+    closed_loop: float
+
+    @property
+    def ceiling(self) -> float:
+        """The real-time factor if everything else in the loop cost nothing."""
+        return self.sim_time / (self.stepping + self.forces + self.localiser)
+
+
+def loop_floor(
+    sim_time: float, closed_loop: float, registry: PluginRegistry, repeats: int = 3
+) -> LoopFloor:
+    """Measure the floor of the default scenario over ``sim_time`` simulated seconds, the
+    span a run of it flew in ``closed_loop`` seconds (best of ``repeats`` for each part)."""
+    setup = prepare_run(registry=registry)
+    with World(setup.scenario, component_rng(0, "world")) as world:
+        ticks = round(sim_time / world.control_period)
+        steps = ticks * world.steps_per_control
+        stepping = _best(repeats, lambda: _step_bare(world, steps))
+        forced = _best(repeats, lambda: _step_with_forces(world, steps))
+        ranges = world.beacon_ranges()
+        localiser = setup.plugins["localiser"]
+        position = world.collector_state()[0]
+        timed = _best(
+            repeats, lambda: _localise(localiser, ranges, position, ticks, world.control_period)
+        )
+    return LoopFloor(sim_time, stepping, max(forced - stepping, 0.0), timed, closed_loop)
+
+
+def _best(repeats: int, measure: Callable[[], None]) -> float:
+    """Shortest wall time of ``repeats`` calls of ``measure``, s."""
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        measure()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def _step_bare(world: World, steps: int) -> None:
+    for _ in range(steps):
+        pb.stepSimulation(physicsClientId=world.client)
+
+
+def _step_with_forces(world: World, steps: int) -> None:
+    client, body = world.client, world.collector
+    for _ in range(steps):
+        position = pb.getBasePositionAndOrientation(body, physicsClientId=client)[0]
+        pb.getBaseVelocity(body, physicsClientId=client)
+        pb.applyExternalForce(
+            body, -1, (0.0, 0.0, 0.0), position, pb.WORLD_FRAME, physicsClientId=client
+        )
+        pb.stepSimulation(physicsClientId=client)
+
+
+def _localise(
+    localiser: Localiser, ranges: list, position: np.ndarray, ticks: int, period: float
+) -> None:
+    localiser.reset(Prior(position, 0.5, np.zeros(3), 0.01), 0.0)
+    still = MotionInput(acceleration=np.zeros(3))
+    for _ in range(ticks):
+        localiser.predict(still, period)
+        localiser.update(ranges)
+        localiser.estimate()
+
+
+def floor_line(floor: LoopFloor) -> str:
+    """The floor as a paragraph of text for the bench's output."""
+    total = floor.stepping + floor.forces + floor.localiser
+    return (
+        f"floor of the default scenario over its {floor.sim_time:.1f} s: stepping "
+        f"{floor.stepping:.2f} s + per-step state reads and forces {floor.forces:.2f} s + "
+        f"localiser plugin alone {floor.localiser:.2f} s = {total:.2f} s, so a real-time "
+        f"factor of at most {floor.ceiling:.0f} if the rest of the loop were free "
+        f"(the whole loop: {floor.closed_loop:.2f} s)"
+    )
