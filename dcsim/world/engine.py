@@ -346,12 +346,15 @@ class World:
         if not obstacles.size:
             return float("inf")
         positions = self.field.free_states(self.time)[0][obstacles]
-        centres, part_radii = zip(*self._assembly_spheres(), strict=True)
-        distances = np.array([row_lengths(positions - centre) for centre in centres])
-        bounds = distances - radii - np.array(part_radii)[:, None]
-        if not self._cargo.held and spheres.all():  # every pair exact: sphere to sphere
+        parts = self._assembly_spheres()
+        centres = np.array([centre for centre, _ in parts])
+        part_radii = np.array([radius for _, radius in parts])
+        distances = row_lengths(positions - centres[:, None])  # (parts, obstacles)
+        bounds = distances - radii - part_radii[:, None]
+        is_sphere = self._assembly_is_sphere()
+        if spheres.all() and is_sphere.all():  # every pair exact: sphere to sphere
             return float(bounds.min())
-        exact = np.outer(self._assembly_is_sphere(), spheres)
+        exact = np.outer(is_sphere, spheres)
         nearest = float(np.min(bounds, where=exact, initial=np.inf))
         if exact.all():
             return nearest
@@ -397,7 +400,7 @@ class World:
 
     def _assembly_is_sphere(self) -> np.ndarray:
         """Whether each part of :meth:`_assembly_spheres` is a sphere (the collector is)."""
-        return np.array([True, *(self.field.is_sphere[i] for i in self._cargo.held)])
+        return np.array([True, *self.field.is_sphere[list(self._cargo.held)]])
 
     def parameters(self) -> dict[str, float]:
         """Named scalar parameters of the world as a system (fixed for its lifetime)."""
