@@ -50,7 +50,8 @@ Space manipulator model (DH kinematics and dynamics of the source thesis 004)
     results :class:`ForwardKinematics`, :class:`InverseKinematicsResult`.
 Geometry
     :func:`spherical_to_cartesian`, :func:`quaternion_between`, :func:`rotate`,
-    :func:`cross`, :func:`unit`, :func:`clip_norm`, :func:`quaternion_multiply`,
+    :func:`cross`, :func:`length`, :func:`row_lengths`, :func:`unit`, :func:`clip_norm`,
+    :func:`quaternion_multiply`,
     :func:`quaternion_conjugate`, :func:`rotation_vector`,
     :func:`quaternion_from_rotation_vector`, :func:`slerp`, :func:`facing_axis`,
     :func:`sight_angle`.
@@ -94,12 +95,14 @@ from dcsim.geometry import (
     clip_norm,
     cross,
     facing_axis,
+    length,
     quaternion_between,
     quaternion_conjugate,
     quaternion_from_rotation_vector,
     quaternion_multiply,
     rotate,
     rotation_vector,
+    row_lengths,
     sight_angle,
     slerp,
     spherical_to_cartesian,
@@ -251,6 +254,8 @@ __all__ = [
     "RobotState",
     "rotate",
     "cross",
+    "length",
+    "row_lengths",
     "facing_axis",
     "sight_angle",
     "rotation_vector",

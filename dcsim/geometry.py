@@ -114,14 +114,22 @@ def rotate(q: ArrayLike, v: ArrayLike) -> Vector:
 def cross(a: ArrayLike, b: ArrayLike) -> Vector:
     """Cross product ``a × b`` of 3-vectors (or stacks of them, broadcast).
 
-    Two single vectors are multiplied in floats with ``numpy.cross``'s own operations
-    (``a₁b₂ − a₂b₁``, …), so the result is the same to the bit at a fraction of the cost.
+    Computed with ``numpy.cross``'s own operations (``a₁b₂ − a₂b₁``, …), so the result
+    is the same to the bit at a fraction of the cost: in floats for two single vectors,
+    one array operation per term for stacks.
     """
     a = np.asarray(a, dtype=float)
     b = np.asarray(b, dtype=float)
-    if a.shape != (3,) or b.shape != (3,):
-        return np.cross(a, b)
-    return np.array(_cross_floats(*a.tolist(), *b.tolist()))
+    if a.shape == (3,) and b.shape == (3,):
+        return np.array(_cross_floats(*a.tolist(), *b.tolist()))
+    if a.ndim == 0 or b.ndim == 0 or a.shape[-1] != 3 or b.shape[-1] != 3:
+        return np.cross(a, b)  # 2-vectors, and numpy's own errors
+    first = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+    out = np.empty(first.shape + (3,))
+    out[..., 0] = first
+    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
 
 
 def _cross_floats(

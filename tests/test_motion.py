@@ -131,3 +131,24 @@ def test_row_lengths_are_numpys_norms_to_the_bit():
 
     vectors = np.random.default_rng(6).normal(0, 1e3, (500, 3))
     assert row_lengths(vectors).tolist() == np.linalg.norm(vectors, axis=1).tolist()
+
+
+@pytest.mark.parametrize(
+    ("a_shape", "b_shape"), [((3,), (3,)), ((40, 3), (40, 3)), ((40, 3), (3,)), ((2, 5, 3), (5, 3))]
+)
+def test_cross_products_are_numpys_to_the_bit(a_shape, b_shape):
+    from dcsim.api import cross
+
+    rng = np.random.default_rng(8)
+    for scale in (1e-9, 1.0, 1e9):
+        a, b = rng.normal(0, scale, a_shape), rng.normal(0, 1.0, b_shape)
+        assert cross(a, b).tobytes() == np.cross(a, b).tobytes()
+    zeros = np.zeros(a_shape)  # signed zeros as numpy gives them
+    assert cross(zeros, -np.ones(b_shape)).tobytes() == np.cross(zeros, -np.ones(b_shape)).tobytes()
+
+
+def test_a_vector_s_length_is_numpys_norm_to_the_bit():
+    from dcsim.api import length
+
+    for vector in np.random.default_rng(9).normal(0, 1e3, (200, 3)):
+        assert length(vector) == np.linalg.norm(vector)

@@ -107,11 +107,14 @@ from dcsim.api import (
     Surroundings,
     array_field,
     clip_norm,
+    cross,
     hookimpl,
+    length,
     message,
     quantity,
     quaternion_between,
     rotate,
+    row_lengths,
     unit,
 )
 
@@ -257,14 +260,14 @@ def perpendicular_repulsion(
         ``C × V``, ``V × C`` and, per row, whichever makes the larger cosine with
         ``attraction`` (``plus`` on a tie).
     """
-    plus = np.cross(closeness, relative_velocity)
-    minus = np.cross(relative_velocity, closeness)
+    plus = cross(closeness, relative_velocity)
+    minus = cross(relative_velocity, closeness)
     take_plus = _cosine(plus, attraction) >= _cosine(minus, attraction)
     return plus, minus, np.where(take_plus[:, None], plus, minus)
 
 
 def _cosine(vectors: np.ndarray, reference: np.ndarray) -> np.ndarray:
-    norms = np.linalg.norm(vectors, axis=1) * np.linalg.norm(reference)
+    norms = row_lengths(vectors) * length(reference)
     return np.divide(vectors @ reference, norms, out=np.zeros(len(vectors)), where=norms > 0)
 
 
@@ -296,16 +299,16 @@ def repulsion(
     -------
     ndarray (K, 3)
     """
-    depth = np.linalg.norm(closeness, axis=1)
+    depth = row_lengths(closeness)
     radial = closeness / np.maximum(depth, 1e-12)[:, None]
-    speed = np.linalg.norm(relative_velocity, axis=1)
-    size = np.linalg.norm(chosen, axis=1)
+    speed = row_lengths(relative_velocity)
+    size = row_lengths(chosen)
     sine = np.divide(size, depth * speed, out=np.zeros(len(depth)), where=depth * speed > _PARALLEL)
     if speed_scale > 0:
         sine *= np.minimum(speed / speed_scale, 1.0)
     perpendicular = chosen / np.maximum(size, 1e-300)[:, None]
     fallback = radial + _sidestep(radial, attraction)
-    fallback /= np.linalg.norm(fallback, axis=1)[:, None]
+    fallback /= row_lengths(fallback)[:, None]
     direction = sine[:, None] * perpendicular + (1.0 - sine)[:, None] * fallback
     return gain * depth[:, None] * direction
 
@@ -314,9 +317,9 @@ def _sidestep(radial: np.ndarray, attraction: np.ndarray) -> np.ndarray:
     """Unit directions perpendicular to each ``radial`` row, on the side ``attraction`` leans to."""
     lean = attraction - (radial @ attraction)[:, None] * radial
     axis = np.eye(3)[np.argmin(np.abs(radial), axis=1)]
-    fixed = np.cross(radial, axis)
-    side = np.where(np.linalg.norm(lean, axis=1)[:, None] > 1e-9, lean, fixed)
-    return side / np.linalg.norm(side, axis=1)[:, None]
+    fixed = cross(radial, axis)
+    side = np.where(row_lengths(lean)[:, None] > 1e-9, lean, fixed)
+    return side / row_lengths(side)[:, None]
 
 
 def _states(time: float, surroundings: Surroundings) -> tuple[np.ndarray, ...]:
@@ -367,8 +370,8 @@ def early_dodge(
     -------
     ndarray (3,)
     """
-    closing = limit + np.linalg.norm(velocities, axis=1)  # fastest closing speed, m/s
-    near = np.linalg.norm(away, axis=1) < sphere + closing * lookahead
+    closing = limit + row_lengths(velocities)  # fastest closing speed, m/s
+    near = row_lengths(away) < sphere + closing * lookahead
     away, velocities, sphere = away[near], velocities[near], sphere[near]
     planned = np.asarray(planned, dtype=float)
     for _ in range(passes):
@@ -376,7 +379,7 @@ def early_dodge(
         squared = np.einsum("ij,ij->i", relative, relative)
         t_star = np.einsum("ij,ij->i", away, relative) / np.maximum(squared, 1e-12)
         miss = away - relative * t_star[:, None]
-        missed_by = np.linalg.norm(miss, axis=1)
+        missed_by = row_lengths(miss)
         threat = (squared > 1e-8) & (t_star > 0) & (t_star < lookahead) & (missed_by < sphere)
         if not threat.any():
             break
@@ -386,9 +389,9 @@ def early_dodge(
                 direction = miss[i] / missed_by[i]
                 needed = sphere[i] - missed_by[i]
             else:
-                closeness = unit(away[i]) * max(sphere[i] - np.linalg.norm(away[i]), 1e-3)
+                closeness = unit(away[i]) * max(sphere[i] - length(away[i]), 1e-3)
                 chosen = perpendicular_repulsion(closeness[None], relative[i][None], planned)[2]
-                if np.linalg.norm(chosen) < 1e-12:
+                if length(chosen) < 1e-12:
                     chosen = _sidestep(unit(away[i])[None], planned)
                 direction = unit(chosen[0])
                 needed = np.sqrt(max(sphere[i] ** 2 - missed_by[i] ** 2, 0.0))
@@ -430,12 +433,12 @@ def braking_limit(
     -------
     ndarray (3,)
     """
-    distance = np.linalg.norm(away, axis=1)
+    distance = row_lengths(away)
     gap = distance - keep
     normal = away / np.maximum(distance, 1e-12)[:, None]
     stoppable = acceleration * (-lag + np.sqrt(lag**2 + 2.0 * np.maximum(gap, 0.0) / acceleration))
     allowed = np.where(gap > 0, stoppable, escape_gain * gap)  # approach speed, m/s
-    closing = limit + np.linalg.norm(velocities, axis=1)  # fastest closing speed, m/s
+    closing = limit + row_lengths(velocities)  # fastest closing speed, m/s
     watch = np.flatnonzero(gap < closing**2 / (2.0 * acceleration) + closing * lag)
     planned = np.asarray(planned, dtype=float)
     for _ in range(_BRAKE_PASSES):
@@ -494,8 +497,8 @@ class ElasticController(Controller):
     ) -> tuple[MoveCommand, np.ndarray]:
         """The Move message and the heading it rotates."""
         desired = self.desired_velocity(time, estimate, reference, surroundings)
-        speed = float(np.linalg.norm(desired))
-        if np.linalg.norm(estimate.velocity) > 1e-6:
+        speed = length(desired)
+        if length(estimate.velocity) > 1e-6:
             heading = unit(estimate.velocity)
         else:  # at rest: the heading is taken to be the way it is about to go
             heading = unit(desired) if speed > 0 else np.array([1.0, 0.0, 0.0])
@@ -581,7 +584,7 @@ class ElasticController(Controller):
         collector is inside its safety sphere and the two are closing; once they
         separate, pushing on would only cost fuel.
         """
-        distance = np.linalg.norm(away, axis=1)
+        distance = row_lengths(away)
         sphere = surroundings.safety_distance + self.robot.radius + radii
         closing = np.einsum("ij,ij->i", away, relative) > 0
         repel = (distance < sphere) & closing
