@@ -23,6 +23,7 @@ once a tick.
 from __future__ import annotations
 
 import time
+import timeit
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -205,25 +206,21 @@ def loop_floor(
     with World(setup.scenario, component_rng(0, "world")) as world:
         ticks = round(sim_time / world.control_period)
         steps = ticks * world.steps_per_control
-        stepping = _best(repeats, lambda: _step_bare(world, steps))
-        forced = _best(repeats, lambda: _step_with_forces(world, steps))
+        stepping = _best(lambda: _step_bare(world, steps), repeats)
+        forced = _best(lambda: _step_with_forces(world, steps), repeats)
         ranges = world.beacon_ranges()
         localiser = setup.plugins["localiser"]
         position = world.collector_state()[0]
+        _localise(localiser, ranges, position, 1, world.control_period)  # imports on first use
         timed = _best(
-            repeats, lambda: _localise(localiser, ranges, position, ticks, world.control_period)
+            lambda: _localise(localiser, ranges, position, ticks, world.control_period), repeats
         )
     return LoopFloor(sim_time, stepping, max(forced - stepping, 0.0), timed, closed_loop)
 
 
-def _best(repeats: int, measure: Callable[[], None]) -> float:
+def _best(measure: Callable[[], None], repeats: int) -> float:
     """Shortest wall time of ``repeats`` calls of ``measure``, s."""
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        measure()
-        times.append(time.perf_counter() - start)
-    return min(times)
+    return min(timeit.repeat(measure, number=1, repeat=repeats))
 
 
 def _step_bare(world: World, steps: int) -> None:
