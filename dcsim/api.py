@@ -283,6 +283,7 @@ def run_campaign(
     out: str | Path,
     *,
     scheduler: str | None = None,
+    connect_timeout: float | None = None,
     workers: int | None = None,
     cases: int | None = None,
     force: bool = False,
@@ -301,6 +302,8 @@ def run_campaign(
     scheduler : str, optional
         Address of an existing Dask scheduler (``tcp://host:port``); a local cluster
         when None.
+    connect_timeout : float, optional
+        Seconds to wait for the scheduler at ``scheduler`` (10 when None).
     workers : int, optional
         Worker processes of the local cluster (one per core when None).
     cases : int, optional
@@ -316,5 +319,6 @@ def run_campaign(
     from dcsim.campaign import ClusterOptions
     from dcsim.campaign import run_campaign as run
 
-    options = ClusterOptions(scheduler, workers)
+    waiting = {} if connect_timeout is None else {"connect_timeout": connect_timeout}
+    options = ClusterOptions(scheduler, workers, **waiting)
     return run(Path(campaign), Path(out), options, cases, force).table

@@ -333,6 +333,18 @@ def test_the_connect_timeout_is_how_long_an_unreachable_scheduler_is_waited_for(
     assert time.perf_counter() - started < 5  # half a second, not the default's ten
 
 
+def test_the_python_api_passes_the_connect_timeout_on(tmp_path):
+    from dcsim.api import run_campaign
+
+    path = campaign_file(tmp_path, "name: c\nscenario: BASE\n")
+    started = time.perf_counter()
+    with pytest.raises(ClusterError, match="cannot reach the Dask scheduler"):
+        run_campaign(path, tmp_path / "out", scheduler=f"tcp://127.0.0.1:{free_port()}",
+                     connect_timeout=0.5)  # fmt: skip
+    assert time.perf_counter() - started < 8  # not the default's ten seconds
+    assert not (tmp_path / "out").exists()
+
+
 def test_a_connect_timeout_without_a_scheduler_is_a_usage_error(tmp_path, dcsim_cli):
     path = campaign_file(tmp_path, "name: c\nscenario: BASE\n")
     done = dcsim_cli("campaign", "run", str(path), "--connect-timeout", "5")
