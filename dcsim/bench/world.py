@@ -179,8 +179,8 @@ class LoopFloor:
         Beyond ``stepping``: reading the collector's pose and velocity and applying a
         force each physics step, as the world does for thrust and orbital forces.
     localiser : float
-        The localiser plugin alone: predict, update (with the ranges of every beacon)
-        and estimate once per control period.
+        The localiser plugin alone: predict, update (with the beacon ranges the
+        collector reads at its start) and estimate once per control period.
     closed_loop : float
         The run's own wall time.
     """
