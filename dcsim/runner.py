@@ -22,6 +22,7 @@ the telemetry, events and summary recorded so far are written.
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 import time as wallclock
 from collections.abc import Callable
@@ -514,18 +515,20 @@ def _position_sigmas(covariance: np.ndarray) -> list[float]:
 def _with_readings(estimate: StateEstimate, observations: Observations) -> StateEstimate:
     """The localiser's estimate with the attitude sensors' and encoders' readings.
 
-    Both messages were checked when they were made, and the readings are the world's
-    read-only arrays, so the copy is built without checking them again (every tick).
+    A plain :class:`StateEstimate` is copied without its checks (every tick): its own
+    fields were checked when it was made, and the readings are the world's read-only
+    arrays (PyBullet's unit quaternion, and as many joint rates as angles). A subclass
+    a plugin returns is rebuilt through its constructor, so its own rules still apply.
     """
-    return type(estimate).trusted(
-        **{
-            **estimate.__dict__,
-            "attitude": observations.attitude,
-            "angular_velocity": observations.angular_velocity,
-            "joint_positions": observations.joint_positions,
-            "joint_velocities": observations.joint_velocities,
-        }
-    )
+    readings = {
+        "attitude": observations.attitude,
+        "angular_velocity": observations.angular_velocity,
+        "joint_positions": observations.joint_positions,
+        "joint_velocities": observations.joint_velocities,
+    }
+    if type(estimate) is StateEstimate:
+        return StateEstimate.trusted(**{**estimate.__dict__, **readings})
+    return dataclasses.replace(estimate, **readings)
 
 
 def terminal_progress(stream: Any = None) -> Progress | None:

@@ -9,12 +9,22 @@ import subprocess
 import textwrap
 import time
 import types
+from functools import cached_property
 
 import numpy as np
 import pytest
 from dcsim_plugins.localisers.trilateration import TrilaterationLocaliser
 
-from dcsim.api import Command, Controller, PluginParams, PluginRegistry, hookimpl, quantity
+from dcsim.api import (
+    Command,
+    Controller,
+    PluginParams,
+    PluginRegistry,
+    StateEstimate,
+    hookimpl,
+    message,
+    quantity,
+)
 from dcsim.geometry import quaternion_conjugate, quaternion_multiply, rotation_vector
 from dcsim.recording import SIGMA_COLUMNS
 from dcsim.registry import PluginOrigin
@@ -56,6 +66,27 @@ class BiasedLocaliser(TrilaterationLocaliser):
     def estimate(self):
         estimate = super().estimate()
         return type(estimate)(**{**estimate.__dict__, "position": estimate.position - [0.8, 0, 0]})
+
+
+@message
+class SpreadEstimate(StateEstimate):
+    """An estimate with a derived quantity cached on first use (in its ``__dict__``)."""
+
+    @cached_property
+    def spread(self) -> float:
+        return float(np.trace(self.covariance))
+
+
+class SpreadLocaliser(TrilaterationLocaliser):
+    """Trilateration whose estimates are :class:`SpreadEstimate`, their spread read."""
+
+    name = "spread"
+    summary = "Trilateration with its own estimate class (test)"
+
+    def estimate(self):
+        estimate = SpreadEstimate(**super().estimate().__dict__)
+        assert estimate.spread >= 0  # cached now
+        return estimate
 
 
 class ExplodingParams(PluginParams):
@@ -250,6 +281,18 @@ def test_same_scenario_and_seed_give_identical_files(tmp_path):
     seed_5 = (tmp_path / "a" / "telemetry.csv").read_text().splitlines()
     seed_6 = (tmp_path / "c" / "telemetry.csv").read_text().splitlines()
     assert len(seed_5) == len(seed_6) > 1000 and seed_5[-1] != seed_6[-1]  # the seed matters
+
+
+def test_a_localiser_s_own_estimate_class_gets_the_attitude_readings():
+    runner, summary = run(
+        overrides=["localiser.plugin=spread", "world.duration=3"],
+        registry=registry_with(SpreadLocaliser),
+    )
+    assert summary["status"] == "completed", summary["reason"]
+    estimate = runner.estimate
+    assert type(estimate) is SpreadEstimate and estimate.spread >= 0
+    attitude = runner.world.collector_state()[2]
+    assert estimate.attitude.tolist() == attitude.tolist()
 
 
 def test_a_raising_plugin_fails_the_run_and_keeps_what_was_recorded(tmp_path):
