@@ -303,7 +303,8 @@ def run_campaign(
         Address of an existing Dask scheduler (``tcp://host:port``); a local cluster
         when None.
     connect_timeout : float, optional
-        Seconds to wait for the scheduler at ``scheduler`` (10 when None).
+        Seconds to wait for the scheduler at ``scheduler`` (10 when None); only with
+        ``scheduler``.
     workers : int, optional
         Worker processes of the local cluster (one per core when None).
     cases : int, optional
@@ -315,10 +316,14 @@ def run_campaign(
     -------
     pandas.DataFrame
         One row per case: index, seed, dispersed values, status, reason, metrics.
+
+    Raises
+    ------
+    ValueError
+        If ``connect_timeout`` is not positive, or given without ``scheduler``.
     """
     from dcsim.campaign import ClusterOptions
     from dcsim.campaign import run_campaign as run
 
-    waiting = {} if connect_timeout is None else {"connect_timeout": connect_timeout}
-    options = ClusterOptions(scheduler, workers, **waiting)
+    options = ClusterOptions(scheduler, workers, connect_timeout=connect_timeout)
     return run(Path(campaign), Path(out), options, cases, force).table

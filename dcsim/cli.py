@@ -689,7 +689,7 @@ def bench_controllers_command(
         names,
         range(first_seed, first_seed + seeds),
         overrides,
-        cluster_choice(scheduler, connect_timeout, workers, worker_deaths),
+        cluster_choice(scheduler, workers, worker_deaths, connect_timeout),
         progress=lambda line: click.echo(line, err=True),
     )
     click.echo(markdown_table(runs))

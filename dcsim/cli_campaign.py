@@ -37,7 +37,8 @@ def cluster_options(command: click.Command) -> click.Command:
             "--connect-timeout",
             type=click.FloatRange(min=0.1, max=3600.0),
             metavar="SECONDS",
-            help="Seconds to wait for the --scheduler before giving up. Default: 10.",
+            help="Seconds to wait for the --scheduler before giving up. Default: 10 "
+            "(dcsim.campaign.engine.CONNECT_TIMEOUT).",
         ),
         click.option(
             "--workers",
@@ -97,7 +98,7 @@ def run_command(
     if out is None:
         stamp = f"{datetime.now():%Y%m%d-%H%M%S}"
         out = Path("runs") / "campaigns" / f"{file_name_part(loaded.spec.name)}-{stamp}"
-    options = cluster_choice(scheduler, connect_timeout, workers, worker_deaths)
+    options = cluster_choice(scheduler, workers, worker_deaths, connect_timeout)
     count = loaded.spec.total_cases if cases is None else min(cases, loaded.spec.total_cases)
     click.echo(f"campaign {loaded.spec.name}: {count} cases {_where(options)} → {out}", err=True)
     _report(run_campaign(loaded, out, options, cases, force))
@@ -116,7 +117,7 @@ def resume_command(
     """Run the cases of campaign DIRECTORY that have no result yet (after Ctrl-C or a crash)."""
     from dcsim.campaign import resume_campaign
 
-    options = cluster_choice(scheduler, connect_timeout, workers, worker_deaths)
+    options = cluster_choice(scheduler, workers, worker_deaths, connect_timeout)
     click.echo(f"resuming {directory} {_where(options)}", err=True)
     _report(resume_campaign(directory, options))
 
@@ -148,14 +149,13 @@ def rerun_command(directory: Path, index: int, out: Path | None) -> None:
 
 def cluster_choice(
     scheduler: str | None,
-    connect_timeout: float | None,
     workers: int | None,
     worker_deaths: int,
+    connect_timeout: float | None,
 ) -> ClusterOptions:
     """The cluster the options chose; ``--workers`` with ``--scheduler``, or
     ``--connect-timeout`` without it, is an error."""
     from dcsim.campaign import ClusterOptions
-    from dcsim.campaign.engine import CONNECT_TIMEOUT
 
     if scheduler is not None and workers is not None:
         raise click.BadParameter(
@@ -168,8 +168,7 @@ def cluster_choice(
             "is started here",
             param_hint="--connect-timeout",
         )
-    timeout = CONNECT_TIMEOUT if connect_timeout is None else connect_timeout
-    return ClusterOptions(scheduler, workers, worker_deaths, timeout)
+    return ClusterOptions(scheduler, workers, worker_deaths, connect_timeout)
 
 
 def _where(options: ClusterOptions) -> str:

@@ -68,15 +68,34 @@ class ClusterOptions:
         Workers that may die running one case before it is a failed case (local
         cluster only; an existing scheduler keeps its own
         ``distributed.scheduler.allowed-failures``).
-    connect_timeout : float
+    connect_timeout : float or None
         Seconds to wait for the scheduler at ``scheduler`` (a scheduler started by a
-        batch job may need longer than the default).
+        batch job may need longer); None waits :data:`CONNECT_TIMEOUT`. Only with
+        ``scheduler``.
+
+    Raises
+    ------
+    ValueError
+        If ``connect_timeout`` is not positive, or given without ``scheduler``.
     """
 
     scheduler: str | None = None
     workers: int | None = None
     worker_deaths: int = 3
-    connect_timeout: float = CONNECT_TIMEOUT
+    connect_timeout: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.connect_timeout is None:
+            return
+        if self.scheduler is None:
+            raise ValueError("connect_timeout is for a scheduler given by address")
+        if not self.connect_timeout > 0:
+            raise ValueError(f"connect_timeout must be positive, got {self.connect_timeout}")
+
+    @property
+    def scheduler_wait(self) -> float:
+        """Seconds to wait for the scheduler at :attr:`scheduler`."""
+        return CONNECT_TIMEOUT if self.connect_timeout is None else self.connect_timeout
 
 
 @dataclass(frozen=True)
@@ -110,7 +129,7 @@ def dask_client(options: ClusterOptions) -> Iterator[Client]:
     Raises
     ------
     ClusterError
-        If the scheduler cannot be reached in ``options.connect_timeout`` seconds or
+        If the scheduler cannot be reached in ``options.scheduler_wait`` seconds or
         the local cluster cannot start.
     """
     import dask
@@ -119,7 +138,7 @@ def dask_client(options: ClusterOptions) -> Iterator[Client]:
     _quiet_logs()
     if options.scheduler is not None:
         try:
-            client = Client(options.scheduler, timeout=options.connect_timeout)
+            client = Client(options.scheduler, timeout=options.scheduler_wait)
         except (OSError, TimeoutError, ValueError) as error:
             raise ClusterError(
                 f"cannot reach the Dask scheduler at {options.scheduler}: {error}"

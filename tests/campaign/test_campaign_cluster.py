@@ -339,10 +339,27 @@ def test_the_python_api_passes_the_connect_timeout_on(tmp_path):
     path = campaign_file(tmp_path, "name: c\nscenario: BASE\n")
     started = time.perf_counter()
     with pytest.raises(ClusterError, match="cannot reach the Dask scheduler"):
-        run_campaign(path, tmp_path / "out", scheduler=f"tcp://127.0.0.1:{free_port()}",
-                     connect_timeout=0.5)  # fmt: skip
+        address = f"tcp://127.0.0.1:{free_port()}"
+        run_campaign(path, tmp_path / "out", scheduler=address, connect_timeout=0.5)
     assert time.perf_counter() - started < 8  # not the default's ten seconds
     assert not (tmp_path / "out").exists()
+
+
+def test_the_command_line_s_connect_timeout_reaches_the_cluster_options():
+    from dcsim.cli_campaign import cluster_choice
+
+    chosen = cluster_choice("tcp://127.0.0.1:8786", None, 3, 2.5)
+    assert chosen.scheduler_wait == 2.5
+    assert cluster_choice("tcp://127.0.0.1:8786", None, 3, None).scheduler_wait == 10.0
+
+
+@pytest.mark.parametrize(
+    ("scheduler", "timeout", "message"),
+    [(None, 5.0, "is for a scheduler"), ("tcp://h:1", 0.0, "positive")],
+)
+def test_cluster_options_refuse_a_connect_timeout_they_cannot_use(scheduler, timeout, message):
+    with pytest.raises(ValueError, match=message):
+        ClusterOptions(scheduler, connect_timeout=timeout)
 
 
 def test_a_connect_timeout_without_a_scheduler_is_a_usage_error(tmp_path, dcsim_cli):
