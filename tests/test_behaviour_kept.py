@@ -51,3 +51,22 @@ def test_default_scenario_records_are_byte_identical_to_the_reference(tmp_path):
         b",".join(line.split(b",")[:ORIGINAL_COLUMNS]) for line in rows.split(b"\n")
     )
     assert sha256(original) == ORIGINAL_ROWS_SHA256
+
+
+CROWDED_TELEMETRY_SHA256 = "93d069eb68b590ef7d4238134ecd4606909b4a704d1fcd577a8cad63daf2e959"
+CROWDED_EVENTS_SHA256 = "126e2500f5196cdf74aaa83d2f856020a9fc9847e58d516b807454a361087721"
+
+
+def test_crowded_field_records_are_byte_identical_to_the_reference(tmp_path):
+    """The elastic controller's numbers: the first 120 s of ``dcsim run
+    scenarios/crowded_field.yaml`` (the collector dodges and brakes to within 1.3 m of
+    an obstacle), as recorded at commit 8f80d82, before its norms and cross products
+    were computed without numpy's per-call overhead."""
+    setup = prepare_run(
+        REPO / "scenarios" / "crowded_field.yaml",
+        ["world.duration=120"],
+        registry=PluginRegistry.discover(),
+    )
+    Runner(setup, tmp_path).run()
+    assert sha256((tmp_path / "telemetry.csv").read_bytes()) == CROWDED_TELEMETRY_SHA256
+    assert sha256((tmp_path / "events.jsonl").read_bytes()) == CROWDED_EVENTS_SHA256
