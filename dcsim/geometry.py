@@ -50,9 +50,10 @@ def length(vector: ArrayLike) -> float:
     return math.sqrt(float(flat.dot(flat)))
 
 
-def row_lengths(vectors: np.ndarray) -> np.ndarray:
-    """Euclidean norms along the last axis of a float array: ``np.linalg.norm(vectors,
+def row_lengths(vectors: ArrayLike) -> np.ndarray:
+    """Euclidean norms along the last axis (taken as floats): ``np.linalg.norm(vectors,
     axis=-1)`` to the bit, without its dispatch."""
+    vectors = np.asarray(vectors, dtype=float)
     return np.sqrt(np.add.reduce(vectors * vectors, axis=-1))
 
 

@@ -71,8 +71,8 @@ class MotionModel(ABC):
 
     @classmethod
     def stacked_state(cls, stacked: Any, t: float) -> tuple[Vector, Vector]:
-        """Positions and velocities (N, 3) at time ``t`` (s) of models gathered by :meth:`stack`,
-        as new arrays."""
+        """Positions and velocities at time ``t`` (s) of models gathered by :meth:`stack`:
+        new float arrays of shape (N, 3), in the order of the models."""
         states = [m.state_at(t) for m in stacked]
         return np.array([p for p, _ in states]), np.array([v for _, v in states])
 
@@ -323,7 +323,7 @@ class ClohessyWiltshireMotion(MotionModel):
         return _cw_state(position, velocity, n, float(t) - epoch)
 
 
-def _cw_state(p0: ArrayLike, v0: ArrayLike, n: ArrayLike, tau: np.ndarray) -> tuple[Vector, Vector]:
+def _cw_state(p0: ArrayLike, v0: ArrayLike, n: ArrayLike, tau: ArrayLike) -> tuple[Vector, Vector]:
     """The Clohessy–Wiltshire closed form; components of ``p0``, ``v0`` broadcast with τ.
 
     With floats for ``n`` and ``τ`` (one model, or models sharing them, at one time) the
@@ -355,7 +355,7 @@ def _columns(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> Vector:
     if isinstance(x, float) and isinstance(y, float) and isinstance(z, float):
         return np.array((x, y, z))
     shape = np.shape(x)
-    if np.shape(y) != shape or np.shape(z) != shape:  # (broadcast_shapes costs ~8 us)
+    if np.shape(y) != shape or np.shape(z) != shape:  # broadcast only when needed
         shape = np.broadcast_shapes(shape, np.shape(y), np.shape(z))
     out = np.empty(shape + (3,))
     out[..., 0], out[..., 1], out[..., 2] = x, y, z

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dcsim.interfaces import Localiser
-from dcsim.messages import MotionInput, Prior
+from dcsim.messages import BeaconRange, MotionInput, Prior
 from dcsim.motion import mean_motion
 from dcsim.registry import PluginRegistry
 from dcsim.runner import Runner
@@ -114,8 +114,7 @@ def bare_stepping(scenario: Scenario) -> float:
     with World(scenario, component_rng(0, "world")) as world:
         steps = round(scenario.world.duration / world.physics_step)
         start = time.perf_counter()
-        for _ in range(steps):
-            pb.stepSimulation(physicsClientId=world.client)
+        _step_bare(world, steps)
         return (time.perf_counter() - start) / scenario.world.duration
 
 
@@ -200,8 +199,23 @@ class LoopFloor:
 def loop_floor(
     sim_time: float, closed_loop: float, registry: PluginRegistry, repeats: int = 3
 ) -> LoopFloor:
-    """Measure the floor of the default scenario over ``sim_time`` simulated seconds, the
-    span a run of it flew in ``closed_loop`` seconds (best of ``repeats`` for each part)."""
+    """Measure the floor of the default scenario over the span a run of it flew.
+
+    Parameters
+    ----------
+    sim_time : float
+        Simulated span the run flew, s.
+    closed_loop : float
+        The run's wall time, s (reported beside the floor).
+    registry : PluginRegistry
+        Where the scenario's localiser plugin comes from.
+    repeats : int
+        Each part is timed this many times; the shortest counts.
+
+    Returns
+    -------
+    LoopFloor
+    """
     setup = prepare_run(registry=registry)
     with World(setup.scenario, component_rng(0, "world")) as world:
         ticks = round(sim_time / world.control_period)
@@ -224,11 +238,14 @@ def _best(measure: Callable[[], None], repeats: int) -> float:
 
 
 def _step_bare(world: World, steps: int) -> None:
+    """``stepSimulation`` alone, ``steps`` times."""
     for _ in range(steps):
         pb.stepSimulation(physicsClientId=world.client)
 
 
 def _step_with_forces(world: World, steps: int) -> None:
+    """``steps`` physics steps with the collector's state read and a force applied before
+    each, as the world steps a control period."""
     client, body = world.client, world.collector
     for _ in range(steps):
         position = pb.getBasePositionAndOrientation(body, physicsClientId=client)[0]
@@ -240,8 +257,14 @@ def _step_with_forces(world: World, steps: int) -> None:
 
 
 def _localise(
-    localiser: Localiser, ranges: list, position: np.ndarray, ticks: int, period: float
+    localiser: Localiser,
+    ranges: list[BeaconRange],
+    position: np.ndarray,
+    ticks: int,
+    period: float,
 ) -> None:
+    """Reset ``localiser`` at ``position`` (m) and run ``ticks`` periods of ``period`` s
+    with the same ``ranges``, standing still."""
     localiser.reset(Prior(position, 0.5, np.zeros(3), 0.01), 0.0)
     still = MotionInput(acceleration=np.zeros(3))
     for _ in range(ticks):
@@ -251,7 +274,8 @@ def _localise(
 
 
 def floor_line(floor: LoopFloor) -> str:
-    """The floor as a paragraph of text for the bench's output."""
+    """The floor as one line of the bench's output: its parts, their sum, the ceiling on
+    the real-time factor, and the whole loop's wall time (s)."""
     total = floor.stepping + floor.forces + floor.localiser
     return (
         f"floor of the default scenario over its {floor.sim_time:.1f} s: stepping "
