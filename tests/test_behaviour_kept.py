@@ -36,13 +36,18 @@ def sha256(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
-def test_default_scenario_records_are_byte_identical_to_the_reference(tmp_path):
+def fly(out, scenario: str, seconds: float) -> None:
+    """Fly the first ``seconds`` of a shipped scenario into the run directory ``out``."""
     setup = prepare_run(
-        REPO / "scenarios" / "default.yaml",
-        ["world.duration=130"],
+        REPO / "scenarios" / f"{scenario}.yaml",
+        [f"world.duration={seconds}"],
         registry=PluginRegistry.discover(),
     )
-    Runner(setup, tmp_path).run()
+    Runner(setup, out).run()
+
+
+def test_default_scenario_records_are_byte_identical_to_the_reference(tmp_path):
+    fly(tmp_path, "default", 130)
     assert sha256((tmp_path / "events.jsonl").read_bytes()) == EVENTS_SHA256
     header, newline, rows = (tmp_path / "telemetry.csv").read_bytes().partition(b"\n")
     assert header.decode() == TELEMETRY_HEADER and newline
@@ -62,11 +67,6 @@ def test_crowded_field_records_are_byte_identical_to_the_reference(tmp_path):
     scenarios/crowded_field.yaml`` (the collector dodges and brakes to within 1.3 m of
     an obstacle), as recorded at commit 8f80d82, before its norms and cross products
     were computed without numpy's per-call overhead."""
-    setup = prepare_run(
-        REPO / "scenarios" / "crowded_field.yaml",
-        ["world.duration=120"],
-        registry=PluginRegistry.discover(),
-    )
-    Runner(setup, tmp_path).run()
+    fly(tmp_path, "crowded_field", 120)
     assert sha256((tmp_path / "telemetry.csv").read_bytes()) == CROWDED_TELEMETRY_SHA256
     assert sha256((tmp_path / "events.jsonl").read_bytes()) == CROWDED_EVENTS_SHA256
