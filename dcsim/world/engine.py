@@ -356,8 +356,6 @@ class World:
             return float(bounds.min())
         exact = np.outer(is_sphere, spheres)
         nearest = float(np.min(bounds, where=exact, initial=np.inf))
-        if exact.all():
-            return nearest
         return self._nearest_shaped_gap(nearest, bounds, distances, ~exact, obstacles)
 
     def _nearest_shaped_gap(
