@@ -337,9 +337,9 @@ def test_the_python_api_passes_the_connect_timeout_on(tmp_path):
     from dcsim.api import run_campaign
 
     path = campaign_file(tmp_path, "name: c\nscenario: BASE\n")
+    address = f"tcp://127.0.0.1:{free_port()}"
     started = time.perf_counter()
     with pytest.raises(ClusterError, match="cannot reach the Dask scheduler"):
-        address = f"tcp://127.0.0.1:{free_port()}"
         run_campaign(path, tmp_path / "out", scheduler=address, connect_timeout=0.5)
     assert time.perf_counter() - started < 8  # not the default's ten seconds
     assert not (tmp_path / "out").exists()
