@@ -31,8 +31,9 @@ from dcsim.runsetup import prepare_run
 from dcsim.scenario import load_scenario
 from dcsim.scenario.model import MAX_SEED
 
-if TYPE_CHECKING:  # the bench modules are imported by their commands only
+if TYPE_CHECKING:  # the bench modules and the runner are imported by their commands only
     from dcsim.bench.path_planners import PlannerChoice, ProblemResult
+    from dcsim.runner import Runner
 
 EXIT_USER_ERROR = 2
 
@@ -247,9 +248,11 @@ def run_command(
         stamp = f"{datetime.now():%Y%m%d-%H%M%S}"
         out = Path("runs") / f"{file_name_part(setup.scenario.name)}-{stamp}"
     prepare_run_directory(out, force)
-    summary = Runner(setup, out, progress=terminal_progress()).run()
+    runner = Runner(setup, out, progress=terminal_progress())
+    summary = runner.run()
     if sys.stderr.isatty():
         click.echo("", err=True)
+    _print_plugin_traceback(runner)
     _print_summary(summary, out)
     if view:
         _write_view(out)
@@ -257,6 +260,16 @@ def run_command(
         sys.exit(130)
     if summary["status"] == "failed":
         sys.exit(1)
+
+
+def _print_plugin_traceback(runner: Runner) -> None:
+    """With ``--debug``, print the traceback of the plugin whose exception ended the run
+    (it is also kept in the run's ``plugin_failed`` event)."""
+    failure = runner.failure
+    if failure is None or failure.traceback is None:
+        return
+    if click.get_current_context().find_root().meta.get("dcsim.debug"):
+        click.echo(failure.traceback.rstrip(), err=True)
 
 
 def _print_summary(summary: dict, out: Path) -> None:

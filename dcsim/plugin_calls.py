@@ -1,15 +1,19 @@
-"""Calling plugins during a run: every exception a plugin raises becomes a recorded failure."""
+"""Calling plugins during a run: every exception a plugin raises, and every answer that
+breaks its kind's contract (:mod:`dcsim.plugin_outputs`), becomes a recorded failure
+that names the plugin."""
 
 from __future__ import annotations
 
+import traceback
 from collections.abc import Mapping
 from typing import Any
 
 from dcsim.interfaces import Plugin
+from dcsim.plugin_outputs import EXPECTED, answers, output_problem
 
 
 class PluginFailure(Exception):
-    """A plugin raised during a run.
+    """A plugin raised, or answered with something its kind may not return, during a run.
 
     Attributes
     ----------
@@ -18,22 +22,74 @@ class PluginFailure(Exception):
     plugin : str
         The plugin's name.
     method : str
-        The method that raised.
-    error : BaseException
-        What it raised.
+        The method that raised or answered.
+    error : BaseException or None
+        What it raised; None when it answered wrongly.
+    problem : str
+        What is wrong, in words: the exception (``RuntimeError: boom``) or the answer
+        (``returned ndarray; expected a Command with finite force...``).
+    time : float or None
+        Scenario time of the control tick it happened in, s (set by the runner).
     """
 
-    def __init__(self, role: str, plugin: str, method: str, error: BaseException) -> None:
+    def __init__(
+        self,
+        role: str,
+        plugin: str,
+        method: str,
+        error: BaseException | None = None,
+        problem: str = "",
+    ) -> None:
         self.role, self.plugin, self.method, self.error = role, plugin, method, error
-        super().__init__(
-            f"{role} plugin '{plugin}' raised in {method}(): {type(error).__name__}: {error}"
-        )
+        self.problem = problem or f"{type(error).__name__}: {error}"
+        self.time: float | None = None
+        super().__init__()
+
+    def __str__(self) -> str:
+        verb = "raised in" if self.error is not None else "broke its contract in"
+        when = "" if self.time is None else f" at t = {self.time:g} s"
+        return f"{self.role} plugin '{self.plugin}' {verb} {self.method}(){when}: {self.problem}"
+
+    @property
+    def traceback(self) -> str | None:
+        """The plugin's own traceback, formatted, when it raised."""
+        if self.error is None:
+            return None
+        return "".join(traceback.format_exception(self.error))
 
 
-def call_plugin(plugins: Mapping[str, Plugin], role: str, method: str, *args: Any) -> Any:
-    """Call ``plugins[role].method(*args)``, wrapping any exception in :class:`PluginFailure`."""
+def call_plugin(
+    plugins: Mapping[str, Plugin], role: str, method: str, *args: Any, joints: int | None = None
+) -> Any:
+    """Call ``plugins[role].method(*args)`` and check its answer.
+
+    Parameters
+    ----------
+    plugins : mapping of str to Plugin
+        The run's plugins by role.
+    role, method : str
+        Whose method to call.
+    *args
+        Its arguments.
+    joints : int, optional
+        The robot's number of joints, which a controller's command must match.
+
+    Raises
+    ------
+    PluginFailure
+        If the plugin raised, or answered with a value its kind may not return
+        (:func:`dcsim.plugin_outputs.output_problem`).
+    """
     plugin = plugins[role]
     try:
-        return getattr(plugin, method)(*args)
+        answer = getattr(plugin, method)(*args)
     except Exception as error:  # a plugin's own bug ends the run, recorded
         raise PluginFailure(role, plugin.name, method, error) from error
+    if answers(plugin.kind, method):
+        problem = output_problem(plugin.kind, method, answer, joints)
+        if problem is not None:
+            expected = EXPECTED[plugin.kind, method]
+            raise PluginFailure(
+                role, plugin.name, method, problem=f"{problem}; expected {expected}"
+            )
+    return answer

@@ -16,7 +16,8 @@ columns, its summary fields and when it is finished. Plots are drawn into ``plot
 of the run directory at the end. A run ends ``completed`` (the mission says so, or
 ``world.duration`` is reached), ``stopped`` (a collision with ``stop.on_collision``,
 ``stop.max_wall_time``, the mission says so, or an interrupt with Ctrl-C) or
-``failed`` (a plugin or hook raised). Whatever the ending,
+``failed`` (a plugin or hook raised, or a plugin answered with something its kind may
+not return: :mod:`dcsim.plugin_outputs`). Whatever the ending,
 the telemetry, events and summary recorded so far are written.
 """
 
@@ -147,6 +148,9 @@ class Runner:
         The scenario's mission, from :meth:`open` on.
     estimate : StateEstimate or None
         The estimate at the current time (the localiser's, with the attitude sensors').
+    failure : PluginFailure or None
+        The plugin failure that ended the run, if one did (its ``traceback`` is the
+        plugin's own, when it raised).
     mode : str or None
         The mission mode decided for the current control period.
     outputs : dict of str to object
@@ -179,6 +183,7 @@ class Runner:
         self.outputs: dict[str, Any] = {}
         self.summary: dict[str, Any] = {}
         self.laps = LapTimer()
+        self.failure: PluginFailure | None = None
         self._command = Command()
         self._robot_changes = 0
         self._started = 0.0
@@ -301,9 +306,18 @@ class Runner:
         except _RunEnded as end:
             self._end(end.status, end.reason)
         except PluginFailure as failure:
+            failure.time = self.world.time
+            self.failure = failure
             self._end("failed", str(failure))
+            error = failure.problem if failure.error is None else str(failure.error)
+            details = {} if failure.traceback is None else {"traceback": failure.traceback}
             self._event(
-                "plugin_failed", role=failure.role, plugin=failure.plugin, error=str(failure.error)
+                "plugin_failed",
+                role=failure.role,
+                plugin=failure.plugin,
+                method=failure.method,
+                error=error,
+                **details,
             )
         except (HookFailure, RecordingError) as failure:
             self._end("failed", str(failure))
@@ -340,7 +354,14 @@ class Runner:
             call_plugin(plugins, "controller", "reset", world.robot_spec())
         surroundings = self.mission.surroundings(observations)
         self._command = call_plugin(
-            plugins, "controller", "command", t, estimate, reference, surroundings
+            plugins,
+            "controller",
+            "command",
+            t,
+            estimate,
+            reference,
+            surroundings,
+            joints=len(observations.joint_positions),
         )
         laps.lap("controller")
         self._record(t, estimate, self.mission.mode, self._command)

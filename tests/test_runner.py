@@ -303,8 +303,8 @@ def test_a_raising_plugin_fails_the_run_and_keeps_what_was_recorded(tmp_path):
         registry=registry_with(ExplodingController),
     )
     assert summary["status"] == "failed"
-    assert (
-        summary["reason"] == "controller plugin 'explodes' raised in command(): RuntimeError: boom"
+    assert summary["reason"] == (
+        "controller plugin 'explodes' raised in command() at t = 2 s: RuntimeError: boom"
     )
     last = json.loads((out / "events.jsonl").read_text().splitlines()[-1])
     assert (

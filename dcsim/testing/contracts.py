@@ -22,14 +22,12 @@ import numpy as np
 from dcsim.errors import PluginInterfaceError, PluginParameterError
 from dcsim.interfaces import PLUGIN_KINDS, Controller, Localiser, Plugin
 from dcsim.messages import (
-    Command,
-    NoPath,
-    Plan,
     Reference,
     StateEstimate,
     Surroundings,
     Trajectory,
 )
+from dcsim.plugin_outputs import ANSWER_METHODS, EXPECTED, output_problem
 from dcsim.registry import check_plugin_class
 from dcsim.testing import problems
 
@@ -266,11 +264,29 @@ def _first_difference(first: list, second: list) -> int:
 
 
 def run_plugin(plugin_class: type[Plugin], inputs: list, what: str) -> list:
-    """Feed ``inputs`` to a fresh instance; an exception becomes a violation naming ``what``."""
+    """Feed ``inputs`` to a fresh instance and return its answers.
+
+    An exception, or an answer of the wrong type or with a non-finite number
+    (:func:`checked_answer`), becomes a violation naming ``what``.
+    """
     try:
-        return feed(make(plugin_class), inputs)
+        outputs = feed(make(plugin_class), inputs)
     except Exception as error:  # a plugin's own failure: name it, with the problem posed
         raise ContractViolation(f"raised {type(error).__name__}: {error} on {what}") from error
+    for index, output in enumerate(outputs):
+        checked_answer(plugin_class.kind, output, f"{what} (answer {index})")
+    return outputs
+
+
+def checked_answer(kind: str, output: Any, what: str, joints: int | None = None) -> Any:
+    """``output`` when it is an answer a plugin of ``kind`` may give (the check a run makes
+    at the plugin boundary, :func:`dcsim.plugin_outputs.output_problem`); otherwise a
+    violation saying what was wrong on ``what`` and what was expected."""
+    method = ANSWER_METHODS[kind]
+    problem = output_problem(kind, method, output, joints)
+    if problem is not None:
+        fail(f"{problem} on {what}; expected {EXPECTED[kind, method]}")
+    return output
 
 
 # --------------------------------------------------------------------- every kind
@@ -381,43 +397,15 @@ def check_no_mutation(plugin_class: type[Plugin]) -> None:
 
 
 def _check_output(kind: str, output: Any) -> str | None:
-    """Why an output is not of the documented type, shape and finiteness (None if fine)."""
-    expected = {
-        "localiser": (StateEstimate,),
-        "task_planner": (Plan,),
-        "path_planner": (Trajectory, NoPath),
-        "controller": (Command,),
-    }[kind]
-    if not isinstance(output, expected):
-        wanted = " or ".join(t.__name__ for t in expected)
-        return f"returned {type(output).__name__}, expected {wanted}"
-    if isinstance(output, NoPath):
-        return None if output.reason.strip() else "returned NoPath without a reason"
-    arrays = [getattr(output, f.name) for f in dataclasses.fields(output)]
-    if isinstance(output, Plan):
-        arrays += [
-            x
-            for task in output.tasks
-            for x in (task.pickup_time, task.pickup_point, task.pickup_velocity)
-        ]
-        arrays += [x for visit in output.drop_visits for x in (visit.time, visit.point)]
-    numbers = [
-        np.asarray(a, dtype=float)
-        for a in arrays
-        if isinstance(a, (float, int, np.ndarray)) and not isinstance(a, bool)
-    ]
-    if not all(np.all(np.isfinite(n)) for n in numbers):
-        return f"returned non-finite values: {output!r}"
+    """Why an output is not of the documented type, shape and finiteness, or (for an
+    estimate) its covariance not symmetric (None if fine)."""
+    problem = output_problem(kind, ANSWER_METHODS[kind], output)
+    if problem is not None:
+        return problem
     if isinstance(output, StateEstimate):
         covariance = output.covariance
-        if covariance.shape[0] != covariance.shape[1] or not np.allclose(
-            covariance, covariance.T, rtol=1e-9, atol=1e-12
-        ):
+        if not np.allclose(covariance, covariance.T, rtol=1e-9, atol=1e-12):
             return f"covariance is not a symmetric square matrix: {covariance!r}"
-    if isinstance(output, Trajectory) and (
-        len(output.times) < 2 or np.any(np.diff(output.times) <= 0)
-    ):
-        return "trajectory times are not strictly increasing over at least two samples"
     return None
 
 

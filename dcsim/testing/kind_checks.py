@@ -29,6 +29,7 @@ from dcsim.testing import problems
 from dcsim.testing.contracts import (
     LOCALISER_ERROR_BOUND,
     TIME_SLACK,
+    checked_answer,
     contract,
     fail,
     make,
@@ -577,8 +578,12 @@ def check_double_integrator(plugin_class: type[Plugin]) -> None:
     reference = Reference(time=0.0, position=[0.0, 0.0, 0.0])
     for k in range(10_000):
         estimate = StateEstimate(time=k * dt, position=position, velocity=velocity, converged=True)
-        force = plugin.command(k * dt, estimate, reference, Surroundings()).force
-        velocity = velocity + force / robot.mass * dt
+        command = checked_answer(
+            "controller",
+            plugin.command(k * dt, estimate, reference, Surroundings()),
+            f"the double integrator at t = {k * dt:g} s",
+        )
+        velocity = velocity + command.force / robot.mass * dt
         position = position + velocity * dt
     error, speed = float(np.linalg.norm(position)), float(np.linalg.norm(velocity))
     if error > 0.1 or speed > 0.01:
@@ -622,6 +627,10 @@ def check_manipulator_convergence(plugin_class: type[Plugin]) -> None:
         )
     except Exception as error:  # a plugin's own failure: name it, with the problem posed
         fail(f"raised {type(error).__name__}: {error} on a manipulator near its reference")
+    for t, command in zip(loop.times, loop.commands, strict=False):
+        checked_answer(
+            "controller", command, f"a manipulator near its reference at t = {t:g} s", joints.size
+        )
     joint_error = np.abs(loop.q[:, 7:] - joints).max(axis=1) / np.abs(offset).max()
     attitude_error = np.linalg.norm(rotation_vector(loop.q[:, 3:7]), axis=1) / 0.03
     worst = float(np.nanmax(np.maximum(joint_error, attitude_error)))

@@ -10,6 +10,7 @@ import time
 
 import numpy as np
 import pytest
+from dcsim_plugins.controllers.computed_torque import ComputedTorqueController
 from dcsim_plugins.controllers.pd import PDController
 from dcsim_plugins.localisers.trilateration import TrilaterationLocaliser
 from dcsim_plugins.path_planners.straight_line import StraightLinePlanner
@@ -187,6 +188,36 @@ class BoastfulPathPlanner(StraightLinePlanner):
     handles_moving_obstacles = False
 
 
+class NaNController(PDController):
+    name = "nan-force"
+    summary = "Commands a NaN force from the start (test)"
+
+    def command(self, time, estimate, reference, surroundings):
+        return Command(force=[np.nan, 0.0, 0.0])
+
+
+class LateInfController(PDController):
+    name = "late-inf"
+    summary = "Commands like PD, then an infinite torque after 50 s (test)"
+
+    def command(self, time, estimate, reference, surroundings):
+        command = super().command(time, estimate, reference, surroundings)
+        if time > 50.0:
+            return Command(force=command.force, torque=[0.0, 0.0, np.inf])
+        return command
+
+
+class LateNaNArmController(ComputedTorqueController):
+    name = "late-nan-arm"
+    summary = "Computed torque, then NaN joint torques after 5 s (test)"
+
+    def command(self, time, estimate, reference, surroundings):
+        command = super().command(time, estimate, reference, surroundings)
+        if time > 5.0:
+            return Command(joint_torques=np.full(command.joint_torques.shape, np.nan))
+        return command
+
+
 # SlowPlanner's checks sleep through its budgets for some 15 s: the tests reading them
 # share one pass, in one pytest-xdist worker.
 SHARES_SLOW_CHECKS = pytest.mark.xdist_group("slow-planner-checks")
@@ -216,6 +247,17 @@ def results_of(plugin: type) -> dict[str, CheckResult]:
         (SlowPathPlanner, {"honours_time_budget"}),
         (BoastfulPathPlanner, {"declares_obstacle_motion"}),
         (PeekingController, {"uses_only_the_public_api"}),
+        (
+            NaNController,
+            {
+                "commands_within_limits",
+                "rests_at_the_reference",
+                "stabilises_a_double_integrator",
+                "outputs_well_formed",
+            },
+        ),
+        (LateInfController, {"stabilises_a_double_integrator"}),
+        (LateNaNArmController, {"converges_on_a_manipulator"}),
     ],
     ids=lambda value: getattr(value, "name", None) or "-".join(sorted(value)),
 )
@@ -235,6 +277,15 @@ def test_messages_say_what_the_plugin_did():
     assert "the limits are 5.0 N" in results["commands_within_limits"].message
     slow = results_of(SlowPlanner)["honours_time_budget"].message
     assert "with a budget of 0.3 s" in slow
+
+
+def test_non_finite_commands_are_named_with_their_time():
+    late = results_of(LateInfController)["stabilises_a_double_integrator"].message
+    assert "returned non-finite numbers: torque [0.0, 0.0, inf]" in late
+    assert "on the double integrator at t = 50.1 s" in late
+    arm = results_of(LateNaNArmController)["converges_on_a_manipulator"].message
+    assert "returned non-finite numbers: joint_torques" in arm
+    assert "on a manipulator near its reference at t = 5.01 s" in arm
 
 
 def test_path_planner_messages_say_what_the_plugin_did():

@@ -1,0 +1,136 @@
+"""What each plugin kind hands back, and the check every answer passes at the boundary.
+
+A localiser's ``estimate()`` gives a :class:`~dcsim.messages.StateEstimate`, a task
+planner's ``plan()`` a :class:`~dcsim.messages.Plan`, a path planner's ``plan()`` a
+:class:`~dcsim.messages.Trajectory` or a :class:`~dcsim.messages.NoPath` with a reason,
+and a controller's ``command()`` a :class:`~dcsim.messages.Command`. Messages check
+their own shapes when they are built; what is left to check is the type, the numbers
+(every one finite), the things a message cannot know alone (how many joints the robot
+has) and a trajectory's clock. The runner checks every answer this way
+(:func:`dcsim.plugin_calls.call_plugin`), and so does the conformance suite, so a
+plugin that breaks its contract is named where it happens instead of one tick later in
+another plugin.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import fields, is_dataclass
+from functools import cache
+from typing import Any
+
+import numpy as np
+
+from dcsim.messages import Command, NoPath, Plan, StateEstimate, Trajectory
+
+ANSWER_METHODS: dict[str, str] = {
+    "localiser": "estimate",
+    "task_planner": "plan",
+    "path_planner": "plan",
+    "controller": "command",
+}
+"""The method of each kind whose answer is checked (the kind's other methods answer None)."""
+
+EXPECTED: dict[tuple[str, str], str] = {
+    ("localiser", "estimate"): "a StateEstimate with finite numbers",
+    ("task_planner", "plan"): "a Plan with finite times and points",
+    ("path_planner", "plan"): (
+        "a Trajectory (at least two samples, strictly increasing times, finite numbers) "
+        "or a NoPath with a reason"
+    ),
+    ("controller", "command"): (
+        "a Command with finite force, torque and joint torques (none, or one per joint)"
+    ),
+}
+"""What each answering method must return, in words, by ``(kind, method)``."""
+
+_TYPES: dict[tuple[str, str], tuple[type, ...]] = {
+    ("localiser", "estimate"): (StateEstimate,),
+    ("task_planner", "plan"): (Plan,),
+    ("path_planner", "plan"): (Trajectory, NoPath),
+    ("controller", "command"): (Command,),
+}
+
+
+def answers(kind: str, method: str) -> bool:
+    """Whether ``method`` of a plugin of ``kind`` hands back a value that is checked."""
+    return (kind, method) in _TYPES
+
+
+def output_problem(kind: str, method: str, output: Any, joints: int | None = None) -> str | None:
+    """What is wrong with a plugin's answer, in words, or None when nothing is.
+
+    Parameters
+    ----------
+    kind : str
+        The plugin's kind (``localiser``, ``task_planner``, ``path_planner``,
+        ``controller``).
+    method : str
+        The method that answered; a method not in :data:`EXPECTED` (``reset``,
+        ``predict``, ``update``) answers nothing that is checked.
+    output : object
+        What it returned.
+    joints : int, optional
+        The robot's number of joints, when known: a command gives one torque per joint,
+        or none (no joint torque).
+
+    Returns
+    -------
+    str or None
+        E.g. ``"returned ndarray"`` or ``"returned non-finite numbers: force [nan 0 0]"``.
+    """
+    wanted = _TYPES.get((kind, method))
+    if wanted is None:
+        return None
+    if not isinstance(output, wanted):
+        return f"returned {type(output).__name__}"
+    if isinstance(output, NoPath):
+        return None if str(output.reason).strip() else "returned a NoPath without a reason"
+    for name, value in _numbers(output):
+        if not _finite(value):
+            return f"returned non-finite numbers: {name} {_show(value)}"
+    if isinstance(output, Command) and joints is not None:
+        given = len(output.joint_torques)
+        if given not in (0, joints):
+            return f"returned {given} joint torques for a robot with {joints} joints"
+    if isinstance(output, Trajectory) and (
+        len(output.times) < 2 or np.any(np.diff(output.times) <= 0)
+    ):
+        return "returned a trajectory whose times do not increase strictly over two samples or more"
+    return None
+
+
+def _numbers(message: Any, prefix: str = "") -> Iterator[tuple[str, Any]]:
+    """Every number a message holds, by field path: floats, arrays, and those of the
+    messages in its tuples (a plan's tasks and drop visits)."""
+    for name in _field_names(type(message)):
+        value = getattr(message, name)
+        if isinstance(value, tuple):
+            for index, item in enumerate(value):
+                if is_dataclass(item):
+                    yield from _numbers(item, f"{prefix}{name}[{index}].")
+        elif isinstance(value, (float, np.ndarray)) or (
+            isinstance(value, int) and not isinstance(value, bool)
+        ):
+            yield f"{prefix}{name}", value
+
+
+@cache
+def _field_names(cls: type) -> tuple[str, ...]:
+    """The field names of a message class (once per class: answers are checked every tick)."""
+    return tuple(f.name for f in fields(cls))
+
+
+def _finite(value: float | np.ndarray) -> bool:
+    if isinstance(value, np.ndarray):
+        return bool(np.isfinite(value).all())
+    return math.isfinite(value)
+
+
+def _show(value: float | np.ndarray) -> str:
+    """A short rendering of a value for a message."""
+    if isinstance(value, np.ndarray) and value.size > 6:
+        bad = int(value.size - np.isfinite(value).sum())
+        return f"(shape {value.shape}, {bad} non-finite)"
+    return str(value.tolist() if isinstance(value, np.ndarray) else value)
