@@ -52,10 +52,14 @@ class PluginFailure(Exception):
 
     @property
     def traceback(self) -> str | None:
-        """The plugin's own traceback, formatted, when it raised."""
+        """The plugin's own traceback, formatted, when it raised: from the plugin's
+        method down (the frame of :func:`call_plugin` that called it left out)."""
         if self.error is None:
             return None
-        return "".join(traceback.format_exception(self.error))
+        frames = self.error.__traceback__
+        if frames is not None and frames.tb_next is not None:
+            frames = frames.tb_next
+        return "".join(traceback.format_exception(type(self.error), self.error, frames))
 
 
 def call_plugin(
