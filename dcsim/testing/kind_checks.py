@@ -202,10 +202,11 @@ def check_budget(plugin_class: type[Plugin]) -> None:
             request = problems.posed(plugin_class, request)
     plugin = make(plugin_class)
     start = time.perf_counter()
-    plugin.plan(request)
+    answer = plugin.plan(request)
     elapsed = time.perf_counter() - start
     if elapsed > 1.2 * request.time_budget + TIME_SLACK:
         fail(f"took {elapsed:.3f} s with a budget of {request.time_budget} s")
+    checked_answer(plugin_class.kind, answer, f"a problem with a {request.time_budget:g} s budget")
 
 
 # --------------------------------------------------------------------- path planner
