@@ -8,6 +8,12 @@ worker died is run again elsewhere by the scheduler until ``worker_deaths`` work
 have died running it, then it is an outcome with that reason. Ctrl-C cancels what is
 left and is raised again for the caller to keep what finished.
 
+A local cluster's worker processes are started by spawning: each imports the main
+module again, as :mod:`multiprocessing` does. A script that starts a campaign when
+imported would start one in every worker; :func:`dask_client` refuses that (and a main
+module fed on standard input, which the workers cannot import) with a
+:class:`ClusterError` that says what to change.
+
 Workers hold one case at a time (``worker-saturation`` 1): a worker that dies takes
 only the case it was running with it. A local cluster's workers run with
 :data:`QUIET_WORKER_SETTINGS`: a case runs in a worker thread, and every wake-up of the
@@ -17,7 +23,9 @@ worker's event loop takes the GIL from it (docs/benchmarks.md, "Campaigns on Das
 from __future__ import annotations
 
 import logging
+import multiprocessing
 import os
+import sys
 import uuid
 from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
@@ -146,6 +154,7 @@ def dask_client(options: ClusterOptions) -> Iterator[Client]:
         with client:
             yield client
         return
+    _check_main_module()
     settings = {
         "distributed.scheduler.allowed-failures": options.worker_deaths - 1,
         "distributed.scheduler.worker-saturation": 1.0,
@@ -162,8 +171,41 @@ def dask_client(options: ClusterOptions) -> Iterator[Client]:
             )
     except (OSError, TimeoutError) as error:
         raise ClusterError(f"cannot start a local Dask cluster: {error}") from None
+    except RuntimeError as error:  # a worker process failed while it started
+        raise ClusterError(
+            f"cannot start a local Dask cluster ({error}): its worker processes import the "
+            'main module again, so a script must run campaigns under `if __name__ == "__main__":`;'
+            " the error a worker printed above says what failed"
+        ) from None
     with cluster, Client(cluster) as client:
         yield client
+
+
+def _check_main_module() -> None:
+    """Refuse a local cluster whose worker processes could not import the main module.
+
+    Raises
+    ------
+    ClusterError
+        If this process is a worker still importing the main module (the script has
+        no ``if __name__ == "__main__":`` guard), or the main module was read from
+        standard input.
+    """
+    if getattr(multiprocessing.current_process(), "_inheriting", False):
+        raise ClusterError(
+            "run_campaign was called while Python was importing the main module in a new "
+            "process: Dask's worker processes import the main module again, and each would "
+            "start the campaign anew. Put the script's calls under "
+            '`if __name__ == "__main__":`'
+        )
+    main_file = getattr(sys.modules.get("__main__"), "__file__", None)
+    if main_file is not None and not os.path.exists(main_file):
+        raise ClusterError(
+            f"a local Dask cluster cannot start from a main module read from {main_file} "
+            "(its worker processes import the main module again from its file): save the "
+            "code as a script, with the calls that run campaigns under `if __name__ == "
+            '"__main__":`, and run `python SCRIPT`'
+        )
 
 
 def run_tasks(

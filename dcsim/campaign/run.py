@@ -119,7 +119,9 @@ def run_campaign(
     RunDirectoryError
         If ``out`` holds something (without ``force``) or cannot be written.
     ClusterError
-        If the cluster cannot be reached or started.
+        If the cluster cannot be reached or started, or a local one is asked for while
+        Python imports the main module in a worker process (a script without its
+        ``if __name__ == "__main__":`` guard) or from standard input.
     """
     if not isinstance(campaign, Campaign):
         campaign = load_campaign(campaign)
