@@ -62,6 +62,8 @@ from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
 from tests.conftest import REPO
 
+pytestmark = pytest.mark.xdist_group("behaviour-kept")  # one worker flies the flights once
+
 REFERENCE = REPO / "tests" / "data" / "behaviour"
 FLIGHTS = {"default": 130, "crowded_field": 120}
 """Each reference flight: scenario name → seconds flown."""

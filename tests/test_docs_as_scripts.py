@@ -96,6 +96,7 @@ def test_a_script_that_runs_a_campaign_without_its_guard_gets_a_dcsim_error(scen
     assert done.returncode == 1
     assert f"dcsim.campaign.engine.ClusterError: {GUARD_MESSAGE}" in done.stderr
     assert 'under `if __name__ == "__main__":`' in done.stderr
+    assert "ClusterError: cannot start a local Dask cluster (" in done.stderr
     assert not (tmp_path / "runs" / "unguarded").exists()
 
 
