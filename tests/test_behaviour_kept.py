@@ -26,11 +26,12 @@ The tolerance, from measured differences. Flown with ``OPENBLAS_CORETYPE=Prescot
 reference windows differ by at most 2.2e-13 in any value (the force columns; positions
 8e-14, event fields 6e-14), with the same events; the whole default mission (724.2 s)
 by at most 3.8e-12 (Prescott), 3.2e-11 (Sandybridge) and 1.1e-10 (SkylakeX), in
-``nearest_obstacle_m`` (attitude 7e-11), with the same 29 events. ``RTOL = ATOL = 1e-9``
-is nine times the largest over the whole mission and four thousand times the largest
-within the reference windows. A change of
-the pd controller's damping ratio by 1e-7 moves the forces by 2.4e-7 N within 20 s, far
-outside it (``test_the_tolerance_catches_a_changed_controller_gain``). To see where this
+``nearest_obstacle_m`` (attitude 7e-11), with the same 29 events (the commands are in
+docs/architecture.md, "What is reproducible"). ``RTOL = ATOL = 1e-9`` is nine times the
+largest over the whole mission and four thousand times the largest within the
+reference windows. A change of the pd controller's damping ratio by 1e-7 moves the
+forces by 2.4e-7 N within 20 s, far outside it
+(``test_the_tolerance_catches_a_changed_controller_gain``). To see where this
 machine stands, run this file with another kernel:
 ``OPENBLAS_CORETYPE=Prescott .venv/bin/pytest tests/test_behaviour_kept.py``. Bit for bit
 against the reference, on the machine that recorded it (Haswell kernels)::
@@ -39,7 +40,8 @@ against the reference, on the machine that recorded it (Haswell kernels)::
     zcat tests/data/behaviour/default-130s/telemetry.csv.gz | cmp - /tmp/d/telemetry.csv
 
 A change that moves the missions' records beyond the tolerance fails here; if such a
-change is meant, its commit says why and records the reference again.
+change is meant, its commit says why and records the reference again (the run
+directory's ``events.jsonl`` as it is, its ``telemetry.csv`` through ``gzip -9 -n``).
 """
 
 from __future__ import annotations
