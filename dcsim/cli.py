@@ -6,7 +6,6 @@ no traceback; ``dcsim --debug ...`` shows the traceback instead.
 
 from __future__ import annotations
 
-import difflib
 import json
 import re
 import sys
@@ -22,7 +21,7 @@ import click
 
 from dcsim import __version__
 from dcsim.cli_campaign import campaign_group, cluster_choice, cluster_options
-from dcsim.errors import DcsimError, PluginLoadWarning, PluginNotFoundError
+from dcsim.errors import DcsimError, PluginLoadWarning, PluginNotFoundError, did_you_mean
 from dcsim.interfaces import PLUGIN_KINDS
 from dcsim.params import ParameterInfo, parameter_infos
 from dcsim.registry import PluginRegistry, RegisteredPlugin
@@ -119,9 +118,9 @@ def _plugins_named(registry: PluginRegistry, name: str, kind: str | None) -> lis
     if kind is not None:
         registry.get(kind, name)  # raises, with the names of that kind
     names = sorted({p.name for p in registry.plugins()})
-    close = difflib.get_close_matches(name, names, n=1)
-    hint = f"; did you mean '{close[0]}'?" if close else ""
-    raise PluginNotFoundError(f"no plugin named '{name}' (see dcsim plugins){hint}")
+    raise PluginNotFoundError(
+        f"no plugin named '{name}' (see dcsim plugins)" + did_you_mean(name, names)
+    )
 
 
 def _print_parameters(plugins: list[RegisteredPlugin], as_json: bool) -> None:
@@ -212,7 +211,8 @@ def validate_command(files: tuple[Path, ...]) -> None:
     multiple=True,
     metavar="KEY.PATH=VALUE",
     help="Override one scenario value, e.g. --set robot.max_force=20 or "
-    "--set targets[0].motion.r=150000; the value is read as YAML. Repeatable.",
+    "--set targets[0].motion.r=150000; the value is read as YAML. A path ending in [+] "
+    "appends to the list there: --set 'targets[+]={id: 9, ...}'. Repeatable.",
 )
 @click.option(
     "--view",

@@ -9,11 +9,37 @@ plugin and keeps its traceback.
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 
 class DcsimError(Exception):
     """Base class of every error a user can cause and fix."""
+
+
+def did_you_mean(word: str, names: Iterable[str]) -> str:
+    """The hint an error gives for a name that is not known: the closest known name.
+
+    Case is ignored in the comparison, so ``EKF`` finds ``ekf``.
+
+    Parameters
+    ----------
+    word : str
+        The name given.
+    names : iterable of str
+        The names known there.
+
+    Returns
+    -------
+    str
+        ``"; did you mean 'ekf'?"``, or an empty string when no name is close.
+    """
+    folded: dict[str, str] = {}
+    for name in names:
+        folded.setdefault(name.casefold(), name)
+    close = difflib.get_close_matches(word.casefold(), list(folded), n=1)
+    return f"; did you mean '{folded[close[0]]}'?" if close else ""
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,7 @@ from typing import Any, Literal, Union, get_args, get_origin
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from pydantic_core import ErrorDetails, to_jsonable_python
 
-from dcsim.errors import PluginParameterError, Problem
+from dcsim.errors import PluginParameterError, Problem, did_you_mean
 
 _BOUND_SYMBOLS = {"gt": ">", "ge": ">=", "lt": "<", "le": "<="}
 
@@ -222,9 +222,10 @@ def describe_error(model: type[BaseModel] | None, field: str | None, error: Erro
     if error["type"] == "missing":
         return "required but missing"
     if error["type"] == "extra_forbidden":
-        allowed = ", ".join(model.model_fields) if model is not None else ""
-        hint = f" (known keys: {allowed})" if allowed else ""
-        return f"unknown key{hint}"
+        if model is None:
+            return "unknown key"
+        known = ", ".join(model.model_fields)
+        return f"unknown key (known keys: {known})" + did_you_mean(str(field), model.model_fields)
     message = f"{short_repr(error['input'])} is not allowed: {error['msg']}"
     if model is not None and field in model.model_fields:
         bounds, unit = field_bounds(model, field), field_unit(model, field)

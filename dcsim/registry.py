@@ -11,7 +11,6 @@ Set it to an empty string to load only the built-ins.
 
 from __future__ import annotations
 
-import difflib
 import importlib.metadata as md
 import inspect
 import os
@@ -31,6 +30,7 @@ from dcsim.errors import (
     PluginInterfaceError,
     PluginLoadWarning,
     PluginNotFoundError,
+    did_you_mean,
 )
 from dcsim.interfaces import PLUGIN_KINDS, Plugin
 from dcsim.params import PluginParams
@@ -274,11 +274,10 @@ class PluginRegistry:
         entries = self._plugins.get((kind, name))
         if not entries:
             available = self.names(kind)
-            close = difflib.get_close_matches(name, available, n=1)
-            hint = f"; did you mean '{close[0]}'?" if close else ""
             listing = ", ".join(available) or "none installed"
             raise PluginNotFoundError(
-                f"no {kind} plugin named '{name}' (available: {listing}){hint}"
+                f"no {kind} plugin named '{name}' (available: {listing})"
+                + did_you_mean(name, available)
             )
         if len(entries) > 1:
             raise DuplicatePluginError(self._duplicate_message((kind, name)))

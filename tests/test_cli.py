@@ -206,7 +206,10 @@ def test_run_writes_resolved_scenario_with_seed_and_overrides(dcsim_cli, tmp_pat
             "controller.params.gian=2",
             "controller.params.gian: unknown key (known keys: bandwidth, damping, attitude_bandwidth, attitude_damping)",
         ),
-        ("targets[7].mass=1", "targets[7]: index 7 is out of range (the list has 4 items)"),
+        (
+            "targets[7].mass=1",
+            "targets[7]: index 7 is out of range (the list has 4 items; [+] appends)",
+        ),
         ("robot.mass", "expected key.path=value"),
     ],
 )
@@ -216,6 +219,16 @@ def test_run_user_errors_exit_2_without_traceback(dcsim_cli, override, expected)
     assert result.stderr.startswith("error: ")
     assert expected in result.stderr
     assert f"--set {override}" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+@pytest.mark.parametrize("command", ["run", "validate"])
+def test_a_campaign_file_given_as_a_scenario_gets_one_error_naming_the_command(dcsim_cli, command):
+    campaign = REPO / "scenarios" / "campaigns" / "default_dispersed.yaml"
+    result = dcsim_cli(command, str(campaign))
+    assert result.returncode == 2
+    assert "(1 problem)" in result.stderr
+    assert f"this is a campaign file: run it with `dcsim campaign run {campaign}`" in result.stderr
     assert "Traceback" not in result.stderr
 
 

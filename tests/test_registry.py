@@ -67,6 +67,12 @@ def test_a_throw_away_module_registers_through_the_hook():
     assert plugin.params.gain == 3.0
 
 
+def test_a_name_in_the_wrong_case_is_suggested_in_the_right_one():
+    registry = PluginRegistry.discover()
+    with pytest.raises(PluginNotFoundError, match=r"did you mean 'ekf'\?"):
+        registry.get("localiser", "EKF")
+
+
 def test_unknown_name_suggests_the_closest():
     registry = PluginRegistry.discover()
     with pytest.raises(

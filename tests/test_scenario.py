@@ -276,6 +276,51 @@ def test_overrides_apply_and_are_validated(tmp_path, registry):
     ]
 
 
+def test_unknown_keys_and_types_suggest_the_closest_known_one(tmp_path):
+    path = write(
+        tmp_path,
+        """\
+        world:
+          duraton: 100
+        robot:
+          type: Manipulator
+        mission:
+          type: Reach
+        """,
+    )
+    with pytest.raises(ScenarioError) as info:
+        validate(ScenarioDocument.from_file(path))
+    assert "did you mean 'reach'?" in str(info.value)
+    found = problems(write(tmp_path, "world:\n  duraton: 100\nrobot:\n  type: Manipulator\n"))
+    assert found[0].endswith(
+        "world.duraton: unknown key (known keys: frame, orbit, physics_step, "
+        "control_period, duration, seed); did you mean 'duration'?"
+    )
+    assert found[1].endswith(
+        "unknown robot type 'Manipulator'; known: free-flyer, manipulator; "
+        "did you mean 'manipulator'?"
+    )
+
+
+def test_a_plugin_name_in_the_wrong_case_is_suggested_in_the_right_one(tmp_path, registry):
+    found = problems(write(tmp_path, "localiser:\n  plugin: EKF\n"), registry=registry)
+    assert found == [
+        f"{tmp_path / 'scenario.yaml'}:2:3: localiser.plugin: no localiser plugin named 'EKF' "
+        "(available: ekf, sspf, trilateration, ukf); did you mean 'ekf'?"
+    ]
+
+
+def test_a_campaign_file_gets_one_error_saying_what_it_is(tmp_path):
+    campaign = REPO / "scenarios" / "campaigns" / "default_dispersed.yaml"
+    assert problems(campaign) == [
+        f"{campaign}: this is a campaign file: run it with `dcsim campaign run {campaign}`"
+    ]
+    stray = tmp_path / "stray.yaml"  # a scenario's own sections and a stray key
+    stray.write_text((REPO / "scenarios" / "default.yaml").read_text() + "scenario: x.yaml\n")
+    (found,) = problems(stray)
+    assert "scenario: unknown key" in found
+
+
 @pytest.mark.parametrize(
     "text, path",
     [
@@ -293,6 +338,25 @@ def test_key_paths_parse_and_format(text, path):
 def test_malformed_key_paths_are_rejected(bad):
     with pytest.raises(ValueError):
         parse_key_path(bad)
+
+
+def test_an_override_ending_in_plus_appends_to_a_list(tmp_path):
+    base = REPO / "scenarios" / "default.yaml"
+    item = "{id: 99, radius: 1.0, motion: {type: static, position: [50, 0, 0]}}"
+    scenario = load_scenario(base, [f"targets[+]={item}", "targets[4].radius=2"])
+    assert [t.id for t in scenario.targets][-1] == 99 and scenario.targets[4].radius == 2
+    bare = write(tmp_path, "world:\n  seed: 1\n")
+    assert len(load_scenario(bare, [f"obstacles[+]={item}"]).obstacles) == 1  # list created
+    assert problems(base, ["targets[+]={id: 98, radius: -1, motion: {type: static}}"])[0] == (
+        "--set targets[+]={id: 98, radius: -1, motion: {type: static}}: targets[4].radius: "
+        "-1 is not allowed: Input should be greater than 0 (allowed: > 0 m)"
+    )
+    assert problems(base, ["world[+]=1"]) == [
+        "--set world[+]=1: world: is not a list: [+] appends to a list"
+    ]
+    assert problems(base, ["targets[+].id=3"]) == [
+        "--set targets[+].id=3: [+] must end the key path: give the whole item as the value"
+    ]
 
 
 def test_spherical_points_convert_to_cartesian(tmp_path):

@@ -25,6 +25,8 @@ from dcsim.scenario.yamltext import (
 
 KeyPath = tuple[str | int, ...]
 _TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_-]*)|\[(\d+)\]")
+APPEND = "[+]"
+"""Ending of an override's key path that appends its value to the list there."""
 
 
 def format_key_path(path: KeyPath) -> str:
@@ -167,6 +169,9 @@ class ScenarioDocument:
     def apply_override(self, assignment: str) -> None:
         """Apply one ``key.path=value`` override; the value is parsed as YAML.
 
+        A key path ending in ``[+]`` (``targets[+]={...}``) appends the value to the list
+        there, which is created if the document has none.
+
         Raises
         ------
         ScenarioError
@@ -174,19 +179,30 @@ class ScenarioDocument:
         """
         source = f"--set {assignment}"
         key_text, sep, value_text = assignment.partition("=")
+        key_text = key_text.strip()
+        append = key_text.endswith(APPEND)
         try:
             if not sep:
                 raise ValueError("expected key.path=value")
-            path = parse_key_path(key_text.strip())
-            if len(path) > MAX_DEPTH:
+            if APPEND in key_text and not append:
+                raise ValueError(
+                    f"{APPEND} must end the key path: give the whole item as the value"
+                )
+            path = parse_key_path(key_text.removesuffix(APPEND))
+            if len(path) + append > MAX_DEPTH:
                 raise ValueError(f"the key path is more than {MAX_DEPTH} keys long")
             value = compose(value_text)[1] if value_text.strip() else None
         except ValueError as exc:
             raise ScenarioError(self.filename, [Problem("", str(exc), source=source)]) from None
         container: Any = self.data
-        for depth, key in enumerate(path[:-1]):
-            container = self._descend(container, key, path[: depth + 1], path[depth + 1], source)
-        self._assign(container, path, value, source)
+        steps = path if append else path[:-1]
+        following = (*path[1:], 0) if append else path[1:]
+        for depth, (key, nxt) in enumerate(zip(steps, following, strict=True)):
+            container = self._descend(container, key, path[: depth + 1], nxt, source)
+        if append:
+            path = self._append(container, path, value, source)
+        else:
+            self._assign(container, path, value, source)
         self.overrides[path] = source
 
     def _descend(
@@ -209,13 +225,21 @@ class ScenarioDocument:
             self._fail(path[:-1], "is a list: select an item with [index] first", source)
         container[key] = value
 
+    def _append(self, container: Any, path: KeyPath, value: Any, source: str) -> KeyPath:
+        """Append ``value`` to the list at ``path``; the key path of the new item."""
+        if not isinstance(container, list):
+            self._fail(path, "is not a list: [+] appends to a list", source)
+        container.append(value)
+        return (*path, len(container) - 1)
+
     def _check_index(self, container: Any, index: int, where: KeyPath, source: str) -> None:
         if not isinstance(container, list):
             self._fail(where, "is not a list here", source)
         if index >= len(container):
             self._fail(
                 where,
-                f"index {index} is out of range (the list has {len(container)} items)",
+                f"index {index} is out of range (the list has {len(container)} items; "
+                f"{APPEND} appends)",
                 source,
             )
 

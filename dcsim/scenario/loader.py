@@ -26,7 +26,7 @@ import numpy as np
 import yaml
 from pydantic import BaseModel, TypeAdapter, ValidationError
 
-from dcsim.errors import DcsimError, PluginParameterError, Problem, ScenarioError
+from dcsim.errors import DcsimError, PluginParameterError, Problem, ScenarioError, did_you_mean
 from dcsim.params import describe_error, short_repr
 from dcsim.registry import PluginRegistry
 from dcsim.scenario.document import KeyPath, ScenarioDocument, format_key_path
@@ -39,6 +39,9 @@ from dcsim.scenario.model import (
 )
 
 DEFAULT_SCENARIO = "default.yaml"
+
+ROBOT_TYPES = ("free-flyer", "manipulator")
+"""The values of ``robot.type``."""
 
 
 def default_scenario_path() -> Path:
@@ -126,6 +129,7 @@ def validate(doc: ScenarioDocument) -> Scenario:
     ScenarioError
         With one problem per invalid value.
     """
+    _refuse_campaign(doc)
     model = _scenario_model(doc)
     try:
         scenario = model.model_validate(doc.data)
@@ -138,6 +142,27 @@ def validate(doc: ScenarioDocument) -> Scenario:
     if problems:
         raise ScenarioError(doc.filename, sorted(problems, key=_document_order))
     return scenario
+
+
+def _refuse_campaign(doc: ScenarioDocument) -> None:
+    """Answer a campaign file given as a scenario with one error saying what it is.
+
+    A document is taken for a campaign file when it names a base ``scenario`` and has
+    none of a scenario's own sections.
+
+    Raises
+    ------
+    ScenarioError
+        If the document is a campaign file.
+    """
+    if "scenario" not in doc.data:
+        return
+    from dcsim.campaign.spec import CampaignSpec  # campaigns build on this module
+
+    scenario_only = set(Scenario.model_fields) - set(CampaignSpec.model_fields)
+    if scenario_only.isdisjoint(doc.data):
+        message = f"this is a campaign file: run it with `dcsim campaign run {doc.filename}`"
+        raise ScenarioError(doc.filename, [Problem("", message)])
 
 
 def _document_order(problem: Problem) -> tuple[bool, int, int]:
@@ -465,6 +490,8 @@ def _scenario_model(doc: ScenarioDocument) -> type[Scenario]:
     missions = mission_types()
     if not isinstance(mission_type, str) or mission_type not in missions:
         message = f"unknown mission type {short_repr(mission_type)}; known: {', '.join(missions)}"
+        if isinstance(mission_type, str):
+            message += did_you_mean(mission_type, missions)
         raise ScenarioError(doc.filename, [doc.problem(("mission", "type"), message)])
     return scenario_model(missions[mission_type].Settings)
 
@@ -478,7 +505,9 @@ def schema_problems(
         path, owner, field = _locate(doc.data, err["loc"], model)
         if err["type"] == "robot_type" and isinstance(err["input"], dict):
             tag = err["input"].get("type")  # the robot section's tag names no robot type
-            message = f"unknown robot type {short_repr(tag)}; known: free-flyer, manipulator"
+            message = f"unknown robot type {short_repr(tag)}; known: {', '.join(ROBOT_TYPES)}"
+            if isinstance(tag, str):
+                message += did_you_mean(tag, ROBOT_TYPES)
             messages.setdefault((*path, "type"), []).append(message)
             continue
         exact = bool(err["loc"]) and path[-1:] == (err["loc"][-1],)
