@@ -1501,7 +1501,7 @@ def fmu_cosim_command(
     Signals connect by equal names (controller inputs from plant outputs, plant inputs
     from controller outputs); each step runs the controller, then the plant.
     """
-    from dcsim.fmu.cosim import cosimulate, plot, write_csv
+    from dcsim.fmu.cosim import cosimulate, output_units, plot, write_csv
 
     results, coupling = cosimulate(plant, controller, stop, step, _start_values(settings))
     click.echo(f"connected to the controller: {', '.join(coupling.to_controller)}")
@@ -1509,7 +1509,7 @@ def fmu_cosim_command(
     if coupling.unfed:
         click.echo(f"left at their start values: {', '.join(coupling.unfed)}")
     write_csv(results, out / "results.csv")
-    plot(results, out / "results.png")
+    plot(results, out / "results.png", output_units(plant, controller))
     click.echo(f"results in {out}/results.csv and {out}/results.png")
 
 

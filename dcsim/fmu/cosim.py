@@ -16,13 +16,18 @@ held over the control period). Inputs that nothing feeds keep their start values
 from __future__ import annotations
 
 import csv
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from dcsim.fmu.instance import FmuError, FmuInstance
+from dcsim.fmu.instance import FmuDescription, FmuError, FmuInstance
+
+_BRACKETED_UNIT = re.compile(r"\[([^\[\]]+)\]\s*$")
+"""A unit at the end of a variable's description, as dcsim's FMUs write it: ``[N.m]``."""
 
 
 @dataclass(frozen=True)
@@ -174,8 +179,73 @@ def write_csv(results: dict[str, np.ndarray], path: Path) -> None:
         writer.writerows(zip(*(values.tolist() for values in results.values()), strict=True))
 
 
-def plot(results: dict[str, np.ndarray], path: Path) -> None:
-    """Plant position and velocity, and the controller's outputs, against time.
+def output_units(plant_path: str | Path, controller_path: str | Path) -> dict[str, str]:
+    """The unit of each output of the two FMUs, by its column name in the results.
+
+    A variable's unit is the one its model description declares, else one written in
+    brackets at the end of its description (``[N]``, as dcsim's FMUs give it). A
+    controller output without one takes the unit of the plant input it feeds.
+
+    Parameters
+    ----------
+    plant_path, controller_path : str or Path
+        The two FMUs, as given to :func:`cosimulate`.
+
+    Returns
+    -------
+    dict of str to str
+        ``plant.NAME`` and ``controller.NAME`` → unit; outputs without a known unit are
+        left out.
+    """
+    plant, controller = FmuDescription(plant_path), FmuDescription(controller_path)
+    fed = {name: _unit(plant.variables[name]) for name in plant.names("input")}
+    units = {f"plant.{name}": _unit(plant.variables[name]) for name in plant.names("output")}
+    for name in controller.names("output"):
+        units[f"controller.{name}"] = _unit(controller.variables[name]) or fed.get(name, "")
+    return {name: unit for name, unit in units.items() if unit}
+
+
+def plot_panels(
+    results: Mapping[str, np.ndarray], units: Mapping[str, str]
+) -> list[tuple[str, str, list[str]]]:
+    """The panels of :func:`plot`: plant position and velocity, controller outputs by unit.
+
+    Parameters
+    ----------
+    results : mapping of str to ndarray
+        ``time`` and the signals, as :func:`cosimulate` returns them.
+    units : mapping of str to str
+        Unit of each signal (:func:`output_units`).
+
+    Returns
+    -------
+    list of (str, str, list of str)
+        Per panel: its axis label (with the unit), the prefix left out of the legend,
+        and the columns drawn.
+    """
+    plant = [("plant position, m", "plant.position."), ("plant velocity, m/s", "plant.velocity.")]
+    panels = [
+        (label, prefix, [n for n in results if n.startswith(prefix)]) for label, prefix in plant
+    ]
+    controller = [name for name in results if name.startswith("controller.")]
+    for unit in dict.fromkeys(units.get(name, "") for name in controller):
+        label = f"controller outputs, {unit}" if unit else "controller outputs (no unit given)"
+        panels.append((label, "controller.", [n for n in controller if units.get(n, "") == unit]))
+    return panels
+
+
+def _unit(variable: Any) -> str:
+    """An fmpy variable's unit, declared or bracketed in its description; "" if none."""
+    if variable.unit:
+        return str(variable.unit)
+    found = _BRACKETED_UNIT.search(variable.description or "")
+    return found.group(1) if found else ""
+
+
+def plot(
+    results: dict[str, np.ndarray], path: Path, units: Mapping[str, str] | None = None
+) -> None:
+    """Plant position and velocity, and the controller's outputs by unit, against time.
 
     Parameters
     ----------
@@ -183,20 +253,18 @@ def plot(results: dict[str, np.ndarray], path: Path) -> None:
         ``time`` and the signals, as :func:`cosimulate` returns them.
     path : Path
         Image file to write (PNG).
+    units : mapping of str to str, optional
+        Unit of each signal (:func:`output_units`); the controller's outputs get one
+        panel per unit, those without a unit one of their own.
     """
     from dcsim.bench.figures import pyplot, save
 
     plt = pyplot()
-    panels = [
-        ("plant position, m", "plant.position."),
-        ("plant velocity, m/s", "plant.velocity."),
-        ("controller outputs", "controller."),
-    ]
-    figure, axes = plt.subplots(len(panels), 1, figsize=(8, 8), sharex=True)
-    for axis, (label, prefix) in zip(axes, panels, strict=True):
-        for name, values in results.items():
-            if name.startswith(prefix):
-                axis.plot(results["time"], values, label=name.removeprefix(prefix))
+    panels = plot_panels(results, units or {})
+    figure, axes = plt.subplots(len(panels), 1, figsize=(8, 2.7 * len(panels)), sharex=True)
+    for axis, (label, prefix, names) in zip(axes, panels, strict=True):
+        for name in names:
+            axis.plot(results["time"], results[name], label=name.removeprefix(prefix))
         axis.set_ylabel(label)
         axis.grid(alpha=0.3)
         if axis.lines:

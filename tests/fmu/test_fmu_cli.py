@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 from fmpy.validation import validate_fmu
 
+from dcsim.fmu.cosim import output_units, plot_panels
+
 
 def test_export_writes_a_valid_fmu_of_either_kind(dcsim_cli, tmp_path):
     for args, name in (([], "closed.fmu"), (["--plant-only", "--beacons", "2"], "plant.fmu")):
@@ -55,3 +57,19 @@ def test_cosim_refuses_fmus_that_share_no_signal(dcsim_cli, tmp_path, plant_fmu)
     done = dcsim_cli("fmu", "cosim", str(plant_fmu), "--controller", str(plant_fmu),
                      "--set", "nowhere=1")  # fmt: skip
     assert done.returncode == 2 and "plant:NAME=VALUE" in done.stderr
+
+
+def test_cosim_plot_gives_the_controller_outputs_the_unit_of_the_input_they_feed(plant_fmu, pd_fmu):
+    units = output_units(plant_fmu, pd_fmu)
+    assert units["plant.position.x"] == "m" and units["plant.velocity.z"] == "m/s"
+    assert units["controller.force.x"] == "N"  # the PD's own description gives none
+    time = np.zeros(2)
+    results = {"time": time, **{name: time for name in ["plant.position.x", "controller.force.x"]}}
+    results["controller.gain"] = time  # an output of no known unit
+    labels = [label for label, _, _ in plot_panels(results, units)]
+    assert labels == [
+        "plant position, m",
+        "plant velocity, m/s",
+        "controller outputs, N",
+        "controller outputs (no unit given)",
+    ]
