@@ -21,12 +21,18 @@ import yaml
 from dcsim.campaign.cases import Case
 from dcsim.campaign.spec import Campaign, NormalDispersion, UniformDispersion
 from dcsim.errors import CampaignError, Problem
+from dcsim.recording import column_name, column_unit
+from dcsim.scenario import parse_key_path
+from dcsim.scenario.loader import key_unit
 
 if TYPE_CHECKING:
     import pandas
 
 QUANTILES = {"p5": 0.05, "median": 0.5, "p95": 0.95}
 """The quantiles of ``statistics.csv``."""
+
+WORLD_VECTOR_UNITS = ("m", "m/s", "rad/s")
+"""Units of the scenario's vectors along the world's axes (positions, velocities, rates)."""
 
 MAX_SCATTER_COLUMNS = 6
 """Dispersed values plotted against the metrics at most (the first ones)."""
@@ -130,7 +136,7 @@ def plot_results(
     for axis, name in zip(axes.flat, shown, strict=False):
         for label, part in groups:
             axis.hist(part[name].dropna().astype(float), bins=20, alpha=0.6, label=label)
-        axis.set(xlabel=name, ylabel="cases")
+        axis.set(xlabel=axis_label(campaign, name), ylabel="cases")
         axis.grid(alpha=0.3)
     for axis in axes.flat[len(shown) :]:
         axis.set_visible(False)
@@ -166,12 +172,38 @@ def _scatter(
                 axis.scatter(part[value], part[name], s=10, alpha=0.7, label=label)
             axis.grid(alpha=0.3)
             if column == 0:
-                axis.set_ylabel(name)
+                axis.set_ylabel(axis_label(campaign, name))
             if row == len(metrics) - 1:
-                axis.set_xlabel(value)
+                axis.set_xlabel(axis_label(campaign, value))
     _legend(axes[0, 0], groups)
     figure.suptitle(f"{campaign.spec.name}: metrics against the dispersed values")
     save(figure, path)
+
+
+def axis_label(campaign: Campaign, column: str) -> str:
+    """A results column as an axis label: its name in words and its unit.
+
+    A summary metric's unit is its name's suffix (``delta_v_mps`` → ``delta v [m/s]``);
+    a dispersed key's is the scenario schema's, and an index into a 3-vector is named
+    after the base scenario's frame (``robot.initial.position[0]`` → ``robot initial
+    position, radial [m]`` in LVLH).
+    """
+    if column.split("[")[0] not in campaign.spec.dispersions:
+        unit = column_unit(column)
+        return column_name(column).replace("_", " ") + (f" [{unit}]" if unit else "")
+    from dcsim.plots import LVLH_AXES, XYZ_AXES  # loads matplotlib
+
+    path = parse_key_path(column)
+    key, index = (path[:-1], path[-1]) if isinstance(path[-1], int) else (path, None)
+    words = " ".join(str(part).replace("_", " ") for part in key)
+    unit = key_unit(campaign.base.data, key)
+    if index is not None and unit in WORLD_VECTOR_UNITS:
+        world = campaign.base.data.get("world")
+        frame = world.get("frame", "lvlh") if isinstance(world, dict) else "lvlh"
+        words += f", {(LVLH_AXES if frame == 'lvlh' else XYZ_AXES)[index]}"
+    elif index is not None:
+        words += f" [{index}]"
+    return words + (f" [{unit}]" if unit else "")
 
 
 def _grid_groups(table: Any, grid: list[str]) -> list[tuple[str, Any]]:

@@ -27,7 +27,7 @@ import yaml
 from pydantic import BaseModel, TypeAdapter, ValidationError
 
 from dcsim.errors import DcsimError, PluginParameterError, Problem, ScenarioError, did_you_mean
-from dcsim.params import describe_error, short_repr
+from dcsim.params import describe_error, field_unit, short_repr
 from dcsim.registry import PluginRegistry
 from dcsim.scenario.document import KeyPath, ScenarioDocument, format_key_path
 from dcsim.scenario.model import (
@@ -437,6 +437,44 @@ def _value(data: dict[str, Any], path: KeyPath, root: type[BaseModel]) -> Any:
     _Invalid
         If the value, or a section or list on the way to it, is invalid.
     """
+    model, section = _owner(data, path, root)
+    return _field_value(model, str(path[-1]), section)
+
+
+def key_unit(data: Mapping[str, Any], path: KeyPath) -> str:
+    """The unit of the scenario key at ``path`` (``m`` for ``robot.initial.position``).
+
+    Parameters
+    ----------
+    data : mapping
+        The raw scenario data, which selects the mission's settings and the sections'
+        types.
+    path : tuple of str and int
+        The key path, without an index into the key's own value.
+
+    Returns
+    -------
+    str
+        The unit the schema gives the key; empty when it has none or there is no such key.
+    """
+    doc = ScenarioDocument(MAPPING_NAME, dict(data))
+    try:
+        model, _ = _owner(doc.data, path, _scenario_model(doc))
+    except (_Invalid, ScenarioError):
+        return ""
+    return field_unit(model, str(path[-1]))
+
+
+def _owner(
+    data: dict[str, Any], path: KeyPath, root: type[BaseModel]
+) -> tuple[type[BaseModel], dict[str, Any]]:
+    """The model owning the last key of ``path`` and the raw section holding it.
+
+    Raises
+    ------
+    _Invalid
+        If there is no such key, or a section or list on the way to it is invalid.
+    """
     node: Any = data
     model: type[BaseModel] | None = root
     annotation: Any = None
@@ -450,7 +488,7 @@ def _value(data: dict[str, Any], path: KeyPath, root: type[BaseModel]) -> Any:
         if model is None or key not in model.model_fields or not isinstance(node, dict):
             raise _Invalid
         if position == len(path) - 1:
-            return _field_value(model, key, node)
+            return model, node
         annotation = model.model_fields[key].annotation
         node = node.get(key, {})
         model = _pick_model(annotation, node)

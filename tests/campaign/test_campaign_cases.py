@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from dcsim.campaign import campaign_cases, load_campaign
 from dcsim.campaign.cases import case_document, draw_seed, override_text
-from dcsim.campaign.results import metric_names
+from dcsim.campaign.results import axis_label, metric_names
 from dcsim.errors import CampaignError
 from dcsim.registry import PluginRegistry
 from dcsim.scenario import validate
@@ -44,6 +44,30 @@ def test_shipped_campaigns_give_valid_cases(path, registry):
     cases = campaign_cases(campaign, registry)
     assert len(cases) == campaign.spec.total_cases
     metric_names(campaign, validate(campaign.base).mission.type)
+
+
+def test_plot_axes_name_the_values_in_words_with_their_units(tmp_path):
+    campaign = load_campaign(SHIPPED[0])  # the default mission, in LVLH
+    assert axis_label(campaign, "robot.initial.position[0]") == "robot initial position, radial [m]"
+    assert axis_label(campaign, "robot.initial.velocity[2]") == (
+        "robot initial velocity, orbit-normal [m/s]"
+    )
+    assert axis_label(campaign, "beacons.noise_sigma") == "beacons noise sigma [m]"
+    assert axis_label(campaign, "delta_v_mps") == "delta v [m/s]"
+    assert axis_label(campaign, "delivered") == "delivered"
+    geocentric = write(
+        tmp_path,
+        """
+        name: g
+        scenario: THESIS
+        dispersions:
+          robot.initial.attitude: {type: uniform, low: 0, high: 1}
+          robot.initial.position: {type: uniform, low: 0, high: 1}
+        """.replace("THESIS", str(REPO / "scenarios" / "thesis_debris_field.yaml")),
+    )
+    campaign = load_campaign(geocentric)
+    assert axis_label(campaign, "robot.initial.position[1]") == "robot initial position, y [m]"
+    assert axis_label(campaign, "robot.initial.attitude[3]") == "robot initial attitude [3]"
 
 
 def test_case_seeds_come_from_spawn_by_index(tmp_path, registry):
