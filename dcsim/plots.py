@@ -46,16 +46,9 @@ from matplotlib.ticker import FuncFormatter  # noqa: E402
 from dcsim.messages import ObjectKind, Shape  # noqa: E402
 from dcsim.motion import MotionSet  # noqa: E402
 from dcsim.recording import SIGMA_COLUMNS  # noqa: E402
-from dcsim.scenario.model import Scenario  # noqa: E402
+from dcsim.scenario.model import XYZ_AXES, Scenario, frame_axes  # noqa: E402
 from dcsim.shape_outlines import outline  # noqa: E402
 from dcsim.world.objects import SpaceObject, build_objects  # noqa: E402
-
-LVLH_AXES = ("radial", "along-track", "orbit-normal")
-"""Names of the LVLH frame's x, y and z axes (x radial outward, y along-track, z along
-the orbit's normal)."""
-
-XYZ_AXES = ("x", "y", "z")
-"""Names of the axes of any other frame."""
 
 NAMED_OBSTACLES = 20
 """The trajectory picture names obstacles by id when there are at most this many
@@ -155,7 +148,7 @@ class FrameAxes:
     frame : str
         The scenario's ``world.frame``.
     names : tuple of str
-        Each world axis's name: :data:`LVLH_AXES` in ``lvlh``, else :data:`XYZ_AXES`.
+        Each world axis's name (:func:`dcsim.scenario.model.frame_axes`).
     unit : str
         ``km`` when the positions drawn lie :data:`KM_FROM` or further from the origin,
         else ``m``; the data stay in m, the tick labels say km.
@@ -170,8 +163,7 @@ class FrameAxes:
         """The axes of ``scenario``'s frame for pictures of ``positions`` (..., 3), m."""
         frame = scenario.world.frame
         farthest = float(np.max(np.abs(positions))) if np.size(positions) else 0.0
-        names = LVLH_AXES if frame == "lvlh" else XYZ_AXES
-        return cls(frame, names, "km" if farthest >= KM_FROM else "m")
+        return cls(frame, frame_axes(frame), "km" if farthest >= KM_FROM else "m")
 
     @property
     def description(self) -> str:

@@ -24,6 +24,7 @@ from dcsim.errors import CampaignError, Problem
 from dcsim.recording import column_name, column_unit
 from dcsim.scenario import parse_key_path
 from dcsim.scenario.loader import key_unit
+from dcsim.scenario.model import frame_axes
 
 if TYPE_CHECKING:
     import pandas
@@ -191,8 +192,6 @@ def axis_label(campaign: Campaign, column: str) -> str:
     if column.split("[")[0] not in campaign.spec.dispersions:
         unit = column_unit(column)
         return column_name(column).replace("_", " ") + (f" [{unit}]" if unit else "")
-    from dcsim.plots import LVLH_AXES, XYZ_AXES  # loads matplotlib
-
     path = parse_key_path(column)
     key, index = (path[:-1], path[-1]) if isinstance(path[-1], int) else (path, None)
     words = " ".join(str(part).replace("_", " ") for part in key)
@@ -200,7 +199,7 @@ def axis_label(campaign: Campaign, column: str) -> str:
     if index is not None and unit in WORLD_VECTOR_UNITS:
         world = campaign.base.data.get("world")
         frame = world.get("frame", "lvlh") if isinstance(world, dict) else "lvlh"
-        words += f", {(LVLH_AXES if frame == 'lvlh' else XYZ_AXES)[index]}"
+        words += f", {frame_axes(frame)[index]}"
     elif index is not None:
         words += f" [{index}]"
     return words + (f" [{unit}]" if unit else "")

@@ -60,6 +60,18 @@ MEAN_MOTION_RANGE = (1e-9, 0.1)
 MAX_SEED = 2**31 - 1
 """Largest seed: the range of an FMI Integer, as the FMU's ``seed`` parameter is one."""
 
+LVLH_AXES = ("radial", "along-track", "orbit-normal")
+"""Names of the LVLH frame's x, y and z axes (x radial outward, y along-track, z along
+the orbit's normal)."""
+
+XYZ_AXES = ("x", "y", "z")
+"""Names of the axes of any other frame."""
+
+
+def frame_axes(frame: str) -> tuple[str, str, str]:
+    """The names of world frame ``frame``'s x, y and z axes (``world.frame``'s value)."""
+    return LVLH_AXES if frame == "lvlh" else XYZ_AXES
+
 
 class Section(BaseModel):
     """Base of every scenario section: immutable, unknown keys and non-finite numbers rejected."""

@@ -15,7 +15,9 @@ strings, ready for JSON) that the page's script plays without knowing dcsim:
 - ``stages``: lines that change at given times (the debris mission's plans);
 - ``readouts``: the key numbers at every frame, formatted; ``events``: the event log
   (:mod:`~dcsim.viewer.readouts`);
-- ``extent``: boxes the views show; ``playback``: speeds offered.
+- ``extent``: boxes the views show; ``playback``: speeds offered;
+- ``axes``: the names of the world frame's x, y and z axes (radial, along-track and
+  orbit-normal in LVLH).
 
 Units: metres, seconds, world frame.
 """
@@ -28,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from dcsim.messages import ObjectKind, Shape, ShapeKind
-from dcsim.scenario.model import ManipulatorSection, point_to_cartesian
+from dcsim.scenario.model import ManipulatorSection, frame_axes, point_to_cartesian
 from dcsim.shape_outlines import wireframe
 from dcsim.viewer.meshes import Mesh, shape_mesh
 from dcsim.viewer.objects import Handling, ObjectTrack, Status, object_tracks
@@ -89,6 +91,7 @@ def build_scene(records: RunRecords, max_frames: int = MAX_FRAMES) -> dict[str, 
     return {
         "title": title(records.scenario),
         "subtitle": subtitle(records.summary),
+        "axes": list(frame_axes(records.scenario.world.frame)),
         "times": times,
         "static": _static_traces(context),
         "bodies": bodies,
@@ -371,7 +374,7 @@ def _goal(context: _Context) -> list[dict[str, Any]]:
     target = getattr(settings, "target", None)
     if target is not None:
         trace = _line_trace("reach target", _GOAL, mode="markers")
-        trace["marker"] = {"color": _GOAL, "size": 7, "symbol": "x"}
+        trace["marker"] = {"color": _GOAL, "size": 12, "symbol": "cross"}
         traces.append(_polyline(trace, np.asarray(target, dtype=float)[None]))
     return traces
 

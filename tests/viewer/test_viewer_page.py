@@ -174,6 +174,56 @@ def test_the_page_draws_the_robot_objects_plan_beacons_and_drop_point(visit):
     assert labels == ["T1", "T2", "T3", "T4"]
 
 
+def test_the_axes_are_named_after_the_frame(visit):
+    titles = visit.tab.evaluate(
+        "['xaxis', 'yaxis', 'zaxis'].map(a => "
+        "document.getElementById('plot').layout.scene[a].title.text)"
+    )
+    assert titles == ["radial [m]", "along-track [m]", "orbit-normal [m]"]  # default: LVLH
+
+
+@pytest.fixture(scope="module")
+def reach_visit(browser, tmp_path_factory):
+    """The reach scenario's first 2 s, run with ``dcsim run --view`` and open in a tab."""
+    import subprocess
+
+    from tests.conftest import DCSIM, REPO
+
+    out = tmp_path_factory.mktemp("viewed") / "reach"
+    scenario = REPO / "scenarios" / "space_manipulator_reach.yaml"
+    done = subprocess.run(
+        [str(DCSIM), "run", str(scenario), "--out", str(out), "--set", "world.duration=2"]
+        + ["--view"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    visit = Visit(browser, out / PAGE_NAME)
+    yield visit
+    visit.tab.close()
+
+
+def test_the_reach_target_draws_as_a_cross(reach_visit):
+    """Its marker is a glyph every font has: not a box standing for a missing one."""
+    reach_visit.tab.evaluate(
+        """() => {
+            const plot = document.getElementById('plot');
+            const others = plot.data.map((_, i) => i)
+                .filter(i => plot.data[i].name !== 'reach target');
+            return Plotly.update(plot, {visible: false}, {showlegend: false}, others);
+        }"""
+    )
+    pixels = reach_visit.plot_pixels()
+    green = pixels[..., 1] - np.maximum(pixels[..., 0], pixels[..., 2]) > 50
+    rows, columns = np.nonzero(green)
+    assert 8 <= np.ptp(rows) <= 40 and 8 <= np.ptp(columns) <= 40, (np.ptp(rows), np.ptp(columns))
+    middle_row = green[(rows.min() + rows.max()) // 2, columns.min() : columns.max() + 1]
+    middle_column = green[rows.min() : rows.max() + 1, (columns.min() + columns.max()) // 2]
+    assert middle_row.mean() > 0.8 and middle_column.mean() > 0.8  # the two bars of a "+"
+    assert reach_visit.errors == []
+
+
 def test_the_slider_moves_the_scene_and_the_readouts(visit):
     visit.show(0.0)
     early, early_time = visit.plot_pixels(), visit.readout("time")

@@ -154,9 +154,9 @@
       };
     };
     return {
-      xaxis: axis(0, "x"),
-      yaxis: axis(1, "y"),
-      zaxis: axis(2, "z"),
+      xaxis: axis(0, scene.axes[0]),
+      yaxis: axis(1, scene.axes[1]),
+      zaxis: axis(2, scene.axes[2]),
       aspectmode: "manual",
       aspectratio: { x: sizes[0] / largest, y: sizes[1] / largest, z: sizes[2] / largest },
     };
