@@ -1088,7 +1088,7 @@ def bench_ant_colony_command(
     click.echo("")
     click.echo(bench.time_table(runs))
     click.echo("")
-    click.echo("Issue 17's targets")
+    click.echo("Targets met")
     click.echo("")
     click.echo(bench.target_table(runs))
     notes = bench.unscored_lines(runs)

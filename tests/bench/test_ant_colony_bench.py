@@ -132,6 +132,7 @@ def test_the_command_prints_the_tables_and_writes_the_figures(tmp_path):
     assert "max_cycles=40" in result.stdout
     assert "| line | 6 | defaults | 1/1 |" in result.stdout
     assert "ffsr_obstacles (the paper's Fig. 2)" in result.stdout
+    assert "Targets met" in result.stdout
     assert "[1/1] static-spheres-0: " in result.stderr
     convergence = tmp_path / "img" / "fig2_convergence.png"
     for path in (figure, convergence, plot):
