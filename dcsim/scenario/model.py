@@ -185,7 +185,7 @@ class WorldSpec(Section):
     frame: Literal["lvlh", "geocentric"] = Field(
         "lvlh",
         description="lvlh: Clohessy–Wiltshire relative motion about the reference orbit; "
-        "geocentric: the thesis's force-free spherical world.",
+        "geocentric: the debris collector thesis's force-free spherical world.",
     )
     orbit: OrbitSpec = Field(
         default_factory=OrbitSpec,
@@ -631,7 +631,8 @@ class DebrisMissionSection(MissionSettings):
     """How the executer flies the debris-collection mission (the thesis's §5.2 and §5.4)."""
 
     type: Literal["debris"] = Field(
-        "debris", description="The mission type: debris collection (the source thesis)."
+        "debris",
+        description="The mission type: debris collection (the debris collector thesis).",
     )
 
     reach: float = quantity(
