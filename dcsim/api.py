@@ -40,7 +40,7 @@ Plan cost
     :func:`leg_delta_v`.
 Kinematics
     :func:`rest_to_rest_time`, :func:`shortest_leg`, :func:`cruise_speed`.
-Space manipulator model (DH kinematics and dynamics of the source thesis 004)
+Space manipulator model (DH kinematics and dynamics of the space manipulator thesis)
     :class:`ManipulatorModel` (forward kinematics, generalised and free-floating
     Jacobians, inverse kinematics, det(J Jᵀ), M(q), C(q, q̇)), built by
     :func:`manipulator_model` from a :class:`DHRobot` (a :class:`ManipulatorBase` and

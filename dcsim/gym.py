@@ -1,7 +1,7 @@
 """The space manipulator's reach as a Gymnasium environment (optional extra ``rl``).
 
 ``dcsim/ManipulatorReachCells-v0`` is the cell task of the ``q-learning`` planner (the
-source thesis 004, §5.5): the end effector moves one cell of a 3-D grid per step (six
+the space manipulator thesis, §5.5): the end effector moves one cell of a 3-D grid per step (six
 actions: +z, −z, −y, +y, +x, −x; no move past the grid's edge), entering the target's
 cell ends the episode with the target reward, entering a cell where the arm breaks a
 joint limit, meets a singularity or loses sight of the target ends it with the

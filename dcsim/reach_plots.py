@@ -1,4 +1,4 @@
-"""Pictures of a reach run, after the source thesis 004's Figs 7.5–7.10 and 7.14–7.20.
+"""Pictures of a reach run, after the space manipulator thesis's Figs 7.5–7.10 and 7.14–7.20.
 
 ``path.png``: the end effector's path in 3-D, flown and reference, from its start (blue)
 to the target (green), with the base's centre of mass drifting beside it, and the three

@@ -1,6 +1,6 @@
 """``dcsim bench ant-colony``: the ant colony planner scored against the exact optimum.
 
-The ``ant-colony`` path planner (source 003) searches a layered graph: one candidate
+The ``ant-colony`` path planner (after the ant colony paper) searches a layered graph: one candidate
 point per cross-section of the start-goal segment, objective ``F = L + δ Σ 1/d_min``.
 Because F is a sum of per-edge and per-node terms, the exact optimum of the same graph is
 a dynamic programme (:mod:`dcsim.bench.layered_optimum`); this bench runs the colony on

@@ -1,4 +1,4 @@
-"""The asteroid fields of the escape experiment (source 002) and their bench family.
+"""The asteroid fields of the escape experiment (the RRT course project) and their bench family.
 
 The course project modelled its asteroids in Blender and gives neither their number,
 sizes nor places. :func:`draw_field` draws them from a seed: ``COUNT`` spheres of radius
@@ -97,7 +97,7 @@ def escape_scenario(seed: int) -> dict[str, Any]:
     budget :data:`BUDGET`."""
     return {
         "name": f"asteroid-escape-{seed}",
-        "description": f"the escape experiment of source 002 through asteroid field {seed}",
+        "description": f"the RRT course project's escape through asteroid field {seed}",
         "world": {
             "frame": "geocentric",
             "physics_step": 0.01,

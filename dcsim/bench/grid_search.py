@@ -1,6 +1,6 @@
 """``dcsim bench grid-search``: the Boeing paper's Tables 3 and 4 regenerated on dcsim's station.
 
-The paper (source 001, §5) ran its grid A* from the start ⟨0, 0, 0⟩ to three goals
+The Boeing guidance paper (§5) ran its grid A* from the start ⟨0, 0, 0⟩ to three goals
 under five weightings of delta-v and distance, and reported the points searched
 (Table 3) and the total delta-v (Table 4), four runs unfinished after 6 hours; a
 hand-made three-burn path to the third goal cost 0.404 ft/s against the grid's 0.870.

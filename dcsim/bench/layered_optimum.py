@@ -1,6 +1,6 @@
 """The exact optimum of a layered path objective: the reference of the ant colony bench.
 
-The ant colony planner (source 003) chooses one node in each layer of a graph whose
+The ant colony planner (the ant colony paper) chooses one node in each layer of a graph whose
 layers are cross-sections of the start-goal segment, and scores a path by
 
     F = Σᵢ w_i(kᵢ, kᵢ₊₁) + Σᵢ c_i(kᵢ)

@@ -13,7 +13,7 @@ acceleration; a 1.5 m goal 60 m away, planning budget 1 s):
   about a 400 km orbit (σ = 0.02 m/s per axis), the transfer along-track;
 - ``shapes``: 16 boxes and cylinders of random size and orientation, at rest.
 
-and the escape experiment of the kinodynamic RRT course project (source 002):
+and the escape experiment of the kinodynamic RRT course project:
 
 - ``asteroid-escape``: ``scenarios/asteroid_escape.yaml`` (a 1 kg ship, 0.5 N thrust,
   up 19 m above a 40 m force field and out through its bottom) with 40 asteroids drawn

@@ -1,5 +1,5 @@
 """``dcsim bench q-learning``: the Q-learning planner against the exact answers of its
-own cell environment (the source thesis 004, §7.3–7.4).
+own cell environment (the space manipulator thesis, §7.3–7.4).
 
 The problems are the reach of a manipulator scenario (default
 ``scenarios/space_manipulator_reach.yaml``): its robot and start, its target, its

@@ -1,6 +1,6 @@
 """The ``reach`` mission: a space manipulator's end effector from its start to a target.
 
-The source thesis 004's experiment (its §7.4–7.5). Modes::
+The space manipulator thesis's experiment (its §7.4–7.5). Modes::
 
     PLAN ──end-effector path──► REACH ──path ended, end effector within tolerance──► ARRIVED
       │ no path

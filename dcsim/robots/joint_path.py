@@ -4,7 +4,7 @@ The end-effector path ``x_d(t)`` is the cubic Hermite curve through a trajectory
 samples (positions and velocities): its position and velocity are continuous, its
 acceleration is linear between samples (it may jump at a sample). It becomes joint
 angles by closed-loop inverse kinematics at the rate level (the velocity form of the
-source thesis 004's eqs 3.12–3.13):
+the space manipulator thesis's eqs 3.12–3.13):
 
     θ̇ = J⁺(θ) (ẋ_d(t) + K (x_d(t) − x(θ)))
 

@@ -2,7 +2,7 @@
 without the world.
 
 :func:`simulate` integrates the model's equation of motion ``M(q) q̈ + C(q, q̇) q̇ = τ``
-(the source thesis 004's eq. 4.3) with scipy's ``solve_ivp``, the controller's command
+(the space manipulator thesis's eq. 4.3) with scipy's ``solve_ivp``, the controller's command
 held over each control period; the base quaternion follows ``q̇ = ½ [ω, 0] ⊗ q`` (world
 frame ``ω``) and is renormalised after every period.
 """

@@ -1,5 +1,5 @@
 """``computed-torque`` controller: full control of a space manipulator by feedback
-linearisation (the source thesis 004, eqs 6.1–6.7).
+linearisation (the space manipulator thesis, eqs 6.1–6.7).
 
 With the robot's own model ``M(q)``, ``C(q, q̇)`` (on ``RobotSpec.model``, both from
 one call of its ``dynamics(q, q̇)`` per tick) the generalised force

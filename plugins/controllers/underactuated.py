@@ -1,5 +1,5 @@
 """``underactuated`` controller: partial base control of a space manipulator (the source
-thesis 004, eqs 6.8–6.25).
+the space manipulator thesis, eqs 6.8–6.25).
 
 Only the attitude control system and the joint motors act; the base's translation is
 left free (no thrust: the command's force is always exactly zero). The generalised

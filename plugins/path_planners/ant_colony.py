@@ -1,7 +1,7 @@
-"""``ant-colony`` path planner: ants choose one point on each of m cross-sections (source 003).
+"""``ant-colony`` path planner (the ant colony paper): ants choose one point per cross-section.
 
 The planner of the ant colony collision-avoidance paper (LI Hua-Zhong and Liang
-Yong-Sheng, source 003), for a free flyer among obstacles. A plan has three steps, each
+Yong-Sheng), for a free flyer among obstacles. A plan has three steps, each
 in a module of its own (their docstrings give the details):
 
 Candidate graph (:mod:`layered_graph`, eqs 4–9)
@@ -196,7 +196,7 @@ class AntColonyParams(PluginParams):
 
 
 class AntColonyPlanner(PathPlanner):
-    """Ant colony over points on cross-sections of the start-goal segment (source 003)."""
+    """Ant colony over points on cross-sections of the start-goal segment (the ant colony paper)."""
 
     name = "ant-colony"
     summary = (

@@ -1,5 +1,5 @@
 """The Q-learning planner's environment: a 3-D grid of end-effector cells with the
-source thesis 004's actions, constraints and rewards (§5.5.1), precomputed per problem.
+the space manipulator thesis's actions, constraints and rewards (§5.5.1), precomputed per problem.
 
 Cells are cubes of side ``cell_size`` centred on the lattice through the end effector's
 start; the grid spans the box holding the start cell and the target's cell plus

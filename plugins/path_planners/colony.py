@@ -1,5 +1,5 @@
 """The ants of ``ant-colony``: roulette walks over a layered graph and the pheromone they
-lay (eqs 10–13 of the ant colony paper, source 003).
+lay (eqs 10–13 of the ant colony paper).
 
 Not a plugin itself; :mod:`ant_colony` runs it on the graph of :mod:`layered_graph`.
 

@@ -8,7 +8,7 @@ derived from it. The move's duration is the shortest that keeps its peak speed a
 acceleration within the problem's limits (or the goal's time, when it sets one). The
 answer is "no path" when the target lies beyond the arm's reach from the shoulder (the
 base held where it is), when no model is given (a free flyer), or when the goal's time
-is too soon. This is the task-space straight line of the source thesis 004's reach
+is too soon. This is the task-space straight line of the space manipulator thesis's reach
 experiment, and the baseline of the learned planner.
 """
 

@@ -1,6 +1,6 @@
 """``grid-astar`` path planner: A* on a space-time grid with delta-v cost (Boeing paper).
 
-The planner of the Boeing guidance paper (source 001, §4–§5) for a free flyer in an
+The planner of the Boeing guidance paper (§4–§5) for a free flyer in an
 inertial or a Clohessy–Wiltshire (LVLH) frame.
 
 Grid

@@ -1,5 +1,5 @@
 """The candidate graph of ``ant-colony``: one point on each of m cross-sections of the
-start-goal segment (eqs 4–9 of the ant colony paper, source 003).
+start-goal segment (eqs 4–9 of the ant colony paper).
 
 Not a plugin itself; :mod:`ant_colony` builds it (:func:`build_graph`), :mod:`colony`
 searches it and ``dcsim.bench.layered_optimum`` solves it exactly.

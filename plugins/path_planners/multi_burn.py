@@ -1,6 +1,6 @@
 """``multi-burn`` path planner: the fewest-burn transfer that clears the obstacles (Boeing paper).
 
-The second experiment the Boeing guidance paper proposes (source 001, §6), for a free
+The second experiment the Boeing guidance paper proposes (its §6), for a free
 flyer in an inertial or a Clohessy–Wiltshire (LVLH) frame: solve the two-burn transfer,
 and when it does not clear the obstacles, move to successively more burns, looking for
 each new burn point on a grid scaled to the plan's legs, so that the grids grow finer as

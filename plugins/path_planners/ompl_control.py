@@ -1,6 +1,6 @@
 """``ompl-control`` path planner: the source's 12-DoF spacecraft on OMPL's control layer.
 
-The model is eq. 2 of the kinodynamic RRT course project (source 002): a rigid body with
+The model is eq. 2 of the kinodynamic RRT course project: a rigid body with
 state ``(p, q, v, ω)`` (position m, attitude ``[x, y, z, w]`` body to world, velocity
 m/s, angular velocity rad/s, all in the world frame) driven by a force ``F`` and a torque
 ``τ``::

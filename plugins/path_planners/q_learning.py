@@ -1,5 +1,5 @@
 """``q-learning`` path planner: a space manipulator's end-effector path learnt by tabular
-Q-learning on a grid of cells (the source thesis 004, chapter 5 and §7.3–7.4).
+Q-learning on a grid of cells (the space manipulator thesis, chapter 5 and §7.3–7.4).
 
 :mod:`cell_environment` builds the thesis's environment for the problem (cells, six
 actions, terminal cells for joint limits, singularities and the target out of sight, a
@@ -137,7 +137,7 @@ class QLearningPlanner(PathPlanner):
     """Tabular Q-learning of the end effector's path over a grid of cells."""
 
     name = "q-learning"
-    summary = "A manipulator's end-effector path by tabular Q-learning on a cell grid (thesis 004)"
+    summary = "A manipulator's end-effector path by tabular Q-learning on a cell grid"
     Params = QLearningParams
     params: QLearningParams
     robots = ("manipulator",)

@@ -1,4 +1,4 @@
-"""The source's 12-DoF rigid spacecraft (eq. 2 of source 002) as a plain-float model.
+"""The RRT course project's 12-DoF rigid spacecraft (its eq. 2) as a plain-float model.
 
 The state vector is ``(p, q, v, ω, t, Δv)``: position (m), attitude ``[x, y, z, w]``
 (body to world), velocity (m/s) and angular velocity (rad/s), all in the world frame,

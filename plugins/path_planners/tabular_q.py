@@ -1,4 +1,4 @@
-"""Tabular Q-learning on a cell environment (the source thesis 004, §5.4–5.5).
+"""Tabular Q-learning on a cell environment (the space manipulator thesis, §5.4–5.5).
 
 Each episode starts in a cell drawn uniformly from the non-terminal cells other than the
 target's (the agent must find its way from anywhere) and runs until it enters the
