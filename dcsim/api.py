@@ -321,6 +321,11 @@ def run_campaign(
     ------
     ValueError
         If ``connect_timeout`` is not positive, or given without ``scheduler``.
+    dcsim.errors.DcsimError
+        If the campaign file or its scenario is invalid, or the cluster cannot start or
+        be reached (a ``ClusterError``; among its causes, a script that calls this
+        without its ``if __name__ == "__main__":`` guard, whose worker processes import
+        it again).
     """
     from dcsim.campaign import ClusterOptions
     from dcsim.campaign import run_campaign as run
