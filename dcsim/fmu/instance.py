@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from dcsim.errors import DcsimError
+from dcsim.fmu.native import release_interpreter_state
 
 _STATUS = ("OK", "WARNING", "DISCARD", "ERROR", "FATAL", "PENDING")
 _TYPES = {"Real": float, "Integer": int, "Boolean": bool, "Enumeration": int}
@@ -305,6 +306,7 @@ class FmuInstance:
         """Free the instance and delete the unzipped FMU."""
         if self._instantiated:
             self._instantiated = False
+            release_interpreter_state(self._fmu.dll)  # a pythonfmu FMU's: see dcsim.fmu.native
             self._fmu.freeInstance()
             shutil.rmtree(self._unzipped, ignore_errors=True)
 

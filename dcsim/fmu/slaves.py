@@ -32,6 +32,7 @@ import numpy as np
 from pythonfmu import Boolean, DefaultExperiment, Fmi2Causality, Fmi2Slave, Integer, Real
 from pythonfmu.enums import Fmi2Initial, Fmi2Status, Fmi2Variability
 
+from dcsim.fmu.native import release_own_library
 from dcsim.fmu.variables import (
     AXES,
     DEFAULT_BEACONS,
@@ -98,6 +99,7 @@ class _ScenarioSlave(Fmi2Slave):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
+        release_own_library(self.resources, self.modelName)  # see dcsim.fmu.native
         self.scenario_path = Path(self.resources) / SCENARIO_RESOURCE
         self.scenario: Scenario = load_scenario(self.scenario_path)
         self.variables: list[FmuVariable] = self._declare()
