@@ -23,6 +23,7 @@ stepping (a plugin raising in the closed loop), are logged as errors and every l
 
 from __future__ import annotations
 
+import ctypes
 import gc
 import math
 from pathlib import Path
@@ -57,20 +58,23 @@ from dcsim.world import World, WorldInputs
 SCENARIO_RESOURCE = "scenario.yaml"
 """Name of the resolved scenario among an FMU's resources."""
 
-_NAMESPACES: list[dict[str, Any]] = []
-
 
 def keep_namespace(namespace: dict[str, Any]) -> None:
-    """Hold one more reference to an FMU slave module's namespace.
+    """Give an FMU slave module's namespace one reference that is never released.
 
     pythonfmu 0.7 runs the slave module's source again at every ``fmi2Instantiate`` and
-    then releases a reference to the module's namespace that it does not own. A module
-    whose namespace has few other references (a short generated script) is freed after
-    the first instance and the second one fails with a garbled error. A slave module
-    calls this at its top level, which those runs execute too, so every run leaves one
-    reference more and the namespace lives on.
+    then releases a reference to the module's namespace that it does not own (a
+    ``Py_DECREF`` of the borrowed ``PyModule_GetDict``). A slave module calls this at
+    its top level, which those runs execute too: each run adds the reference that
+    instantiation takes back, and the import's run one more, so the namespace outlives
+    every instance and the interpreter.
+
+    The reference must be one nothing gives back. Kept in a Python container, it is
+    released again when the interpreter clears modules at exit, and the namespace is
+    then released once per instantiation more than it was referenced: the last releases
+    write to a freed dict.
     """
-    _NAMESPACES.append(namespace)
+    ctypes.pythonapi.Py_IncRef(ctypes.py_object(namespace))
 
 
 class _RunFailed(Exception):

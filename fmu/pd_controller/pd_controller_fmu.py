@@ -20,16 +20,18 @@ output after the step, to be held over it.
 
 from __future__ import annotations
 
-import sys
+import ctypes
 
 import numpy as np
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
 from pythonfmu.enums import Fmi2Initial
 
 # pythonfmu 0.7 runs this file again at every instantiation and then releases a reference
-# to the module's namespace it does not own; keep one more reference per run (on the sys
-# module, which outlives every run) so the namespace is never freed under the FMU.
-sys.__dict__.setdefault("_pythonfmu_namespaces", []).append(globals())
+# to the module's namespace it does not own; add one reference per run that nothing ever
+# releases, so the namespace is never freed under the FMU. (Held in a Python list, they
+# would be released again when the interpreter clears modules at exit: once per
+# instantiation more than the namespace was referenced.)
+ctypes.pythonapi.Py_IncRef(ctypes.py_object(globals()))
 
 AXES = ("x", "y", "z")
 VECTOR_INPUTS = (
