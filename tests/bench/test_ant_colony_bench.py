@@ -172,7 +172,10 @@ def test_the_convergence_figure_sits_beside_the_paths_figure(tmp_path):
 def test_a_whole_plan_cut_short_by_its_budget_is_counted(registry, layouts):
     setting = SETTINGS[0]
     cls = bench.planner_class(registry)
-    run = bench.run_setting(cls, layouts[0], setting, 0, budget=0.06)
+    unhurried = bench.run_setting(cls, layouts[0], setting, 0)
+    # a third of what the whole plan took here: the cut holds however fast the machine,
+    # and the candidate graph (about an eighth of the plan) is still built in time
+    run = bench.run_setting(cls, layouts[0], setting, 0, budget=unhurried.plan_seconds / 3)
     assert run.scored and run.cycles > 1  # the measured colony has no deadline
     assert run.plan_cycles < run.cycles and run.cut_by_budget
     row = next(line for line in bench.time_table([run]).splitlines() if "| line |" in line)
