@@ -82,6 +82,7 @@ from dcsim.clearance import (
 from dcsim.errors import (
     DcsimError,
     DuplicatePluginError,
+    PlanOutlastsRunWarning,
     PluginError,
     PluginInterfaceError,
     PluginLoadWarning,
@@ -233,6 +234,7 @@ __all__ = [
     "PlanTask",
     "Plugin",
     "PLUGIN_KINDS",
+    "PlanOutlastsRunWarning",
     "PluginError",
     "RobotTypeError",
     "PluginInterfaceError",

@@ -249,7 +249,9 @@ def run_command(
         out = Path("runs") / f"{file_name_part(setup.scenario.name)}-{stamp}"
     prepare_run_directory(out, force)
     runner = Runner(setup, out, progress=terminal_progress())
-    summary = runner.run()
+    with warnings.catch_warnings():
+        warnings.showwarning = _show_run_warning
+        summary = runner.run()
     if sys.stderr.isatty():
         click.echo("", err=True)
     _print_plugin_traceback(runner)
@@ -272,12 +274,21 @@ def _print_plugin_traceback(runner: Runner) -> None:
         click.echo(failure.traceback.rstrip(), err=True)
 
 
+def _show_run_warning(message: Warning | str, category: type[Warning], *args: object) -> None:
+    """Print a warning issued during a run as ``warning: ...`` on stderr (on a line of
+    its own, below the progress line on a terminal)."""
+    start = "\n" if sys.stderr.isatty() else ""
+    click.echo(f"{start}warning: {message}", err=True)
+
+
 def _print_summary(summary: dict, out: Path) -> None:
     def number(key: str, unit: str, digits: int = 3) -> str:
         value = summary[key]
         return "n/a" if value is None else f"{value:.{digits}g} {unit}".rstrip()
 
     reason = f" ({summary['reason']})" if summary["reason"] else ""
+    if summary["goal_met"] is False:
+        reason += f" — goal not met: {summary['outcome']}"
     click.echo(f"{summary['scenario']} seed {summary['seed']}: {summary['status']}{reason}")
     outcome = f"{summary['outcome']}, " if summary["outcome"] else ""
     click.echo(f"  {outcome}collisions {summary['collisions']}")

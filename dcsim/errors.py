@@ -146,3 +146,8 @@ class PluginParameterError(PluginError):
 
 class PluginLoadWarning(UserWarning):
     """A plugin package could not be loaded; every other plugin still is."""
+
+
+class PlanOutlastsRunWarning(UserWarning):
+    """A plan made during a run ends after ``world.duration``: the run will stop before
+    the plan is flown to its end."""

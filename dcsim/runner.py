@@ -514,6 +514,7 @@ class Runner:
             "wall_time_s": wall,
             "real_time_factor": sim_time / wall if wall > 0 else None,
             "outcome": self.mission.progress(),
+            "goal_met": self.mission.goal_met(),
             **self.mission.summary_fields(),
             "collisions": len(world.collisions),
             "fuel_used_kg": world.fuel_used,

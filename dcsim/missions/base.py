@@ -11,6 +11,7 @@ fields it adds, and when it is finished.
 
 from __future__ import annotations
 
+import warnings
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
@@ -18,6 +19,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
+from dcsim.errors import PlanOutlastsRunWarning
 from dcsim.interfaces import Plugin
 from dcsim.messages import Observations, Reference, StateEstimate, Surroundings
 from dcsim.plugin_calls import call_plugin
@@ -103,6 +105,26 @@ class Mission(ABC):
     def tick(self, time: float, estimate: StateEstimate, observations: Observations) -> Reference:
         """Decide at ``time`` (s) and return the reference for the coming control period."""
 
+    def note_plan_end(self, time: float, end: float) -> None:
+        """Say so when a plan made at ``time`` (s) ends at ``end`` (s), after the run does.
+
+        A plan that ends after ``world.duration`` would be cut short in silence: this
+        records a ``plan_outlasts_run`` event (the plan's end and the duration, s) and
+        issues a :class:`~dcsim.errors.PlanOutlastsRunWarning` (``dcsim run`` prints it
+        on stderr). Nothing is said for a plan that ends within the run.
+        """
+        duration = self.scenario.world.duration
+        if end <= duration + 1e-9:
+            return
+        self.emit("plan_outlasts_run", plan_end=end, duration=duration)
+        warnings.warn(
+            f"the plan made at t = {time:.1f} s ends at t = {end:.1f} s, after the run's "
+            f"world.duration of {duration:g} s: the run stops before the plan is flown to "
+            f"its end; lengthen world.duration beyond {end:.0f} s to fly it",
+            PlanOutlastsRunWarning,
+            stacklevel=2,
+        )
+
     def call(self, role: str, method: str, *args: Any) -> Any:
         """Call the plugin of ``role``; an exception becomes a recorded plugin failure."""
         return call_plugin(self.plugins, role, method, *args)
@@ -164,6 +186,12 @@ class Mission(ABC):
 
     def finished(self) -> tuple[str, str] | None:
         """``(status, reason)`` once the mission is over (``completed`` or ``stopped``)."""
+        return None
+
+    def goal_met(self) -> bool | None:
+        """Whether the mission's goal was met so far: True or False, or None for a
+        mission that has no goal to meet (``hold``: its errors, in the summary's
+        figures, say how well it held)."""
         return None
 
     def summary_fields(self) -> dict[str, Any]:

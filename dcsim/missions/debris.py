@@ -165,6 +165,11 @@ class DebrisMission(Mission):
             return "completed", "all targets delivered"
         return None
 
+    def goal_met(self) -> bool:
+        """Whether every target was delivered."""
+        field = self.world.field
+        return field.count(ObjectStatus.DELIVERED) == int(field.is_target.sum())
+
     def summary_fields(self) -> dict[str, Any]:
         """Targets, and how many were captured and delivered."""
         field = self.world.field

@@ -184,6 +184,7 @@ class ReachMission(Mission):
             return
         self.trajectory = result
         self.emit("path", duration=result.duration, length=result.length)
+        self.note_plan_end(start.time, float(result.times[-1]))
         self._go("REACH")
 
     def _problem(self, start: RobotState) -> PathProblem:
@@ -281,6 +282,10 @@ class ReachMission(Mission):
         if self.reached_at is not None:
             return f"target reached at t = {self.reached_at:.2f} s"
         return f"end effector {self.figures.target_distance:.4f} m from the target"
+
+    def goal_met(self) -> bool:
+        """Whether the end effector reached the target."""
+        return self.reached_at is not None
 
     def summary_fields(self) -> dict[str, Any]:
         """Arrival, tracking errors and the thesis's path criteria."""

@@ -179,6 +179,7 @@ class TransferMission(Mission):
             delta_v=result.delta_v,
             statistics=dict(result.statistics),
         )
+        self.note_plan_end(start.time, float(result.times[-1]))
         self._go("FLY")
 
     # ------------------------------------------------------------------ references
@@ -284,6 +285,10 @@ class TransferMission(Mission):
         if self.reached_at is not None:
             return f"goal reached at t = {self.reached_at:.1f} s"
         return f"{len(self.planned)} plan(s), goal not reached"
+
+    def goal_met(self) -> bool:
+        """Whether the goal region was reached."""
+        return self.reached_at is not None
 
     def summary_fields(self) -> dict[str, Any]:
         """Arrival, planning effort and tracking figures."""
