@@ -11,9 +11,10 @@ Modes (the thesis's §2.2.1 and §5.2)::
 When a plan is done (the last drop of the plan made), the executer goes back to
 LOCALIZE to plan afresh, or to IDLE when nothing is left to do: no target in sight and
 no cargo on board (after the last delivery, say). Replanning happens when a new target
-enters sensor range, a grab fails, or a pickup can no longer be met. Every mode change,
-plan, grab, release and path failure is reported through the ``emit`` callback as an
-event.
+enters sensor range, a grab fails, or a pickup can no longer be met. After
+``max_plan_attempts`` "no path" answers of the path planner in a row the executer gives
+up and the run ends ``stopped`` with the planner's reason. Every mode change, plan,
+grab, release and path failure is reported through the ``emit`` callback as an event.
 """
 
 from __future__ import annotations
@@ -107,6 +108,8 @@ class DebrisMission(Mission):
         self.hold: np.ndarray | None = None
         self.retry_at = -np.inf
         self.release_refused = False
+        self.refusals = 0
+        self.refusal = ""
         self.time = 0.0
         self._handlers: dict[Mode, Callable[[], Reference]] = {
             Mode.LOCALIZE: self._localize,
@@ -154,7 +157,10 @@ class DebrisMission(Mission):
         return f"delivered {delivered}/{int(field.is_target.sum())}, captured {captured}"
 
     def finished(self) -> tuple[str, str] | None:
-        """Completed once every target is delivered, if the stop rules say so."""
+        """Completed once every target is delivered, if the stop rules say so; stopped
+        once the path planner has said "no path" ``max_plan_attempts`` times in a row."""
+        if self.refusals >= self.settings.max_plan_attempts:
+            return "stopped", f"no path after {self.refusals} attempts: {self.refusal}"
         field = self.world.field
         targets = int(field.is_target.sum())
         if (
@@ -224,8 +230,11 @@ class DebrisMission(Mission):
         result = self.call("path_planner", "plan", problem)
         if isinstance(result, NoPath):
             self.emit("no_path", reason=result.reason)
+            self.refusals += 1
+            self.refusal = result.reason
             self.retry_at = self.time + self.settings.path_retry
             return None
+        self.refusals = 0
         self.emit("path", duration=result.duration, length=result.length, delta_v=result.delta_v)
         return result
 

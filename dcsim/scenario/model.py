@@ -675,6 +675,11 @@ class DebrisMissionSection(MissionSettings):
         gt=0,
         description="Wait before asking again after the path planner found no path.",
     )
+    max_plan_attempts: int = quantity(
+        3,
+        ge=1,
+        description='"No path" answers in a row after which the run ends stopped.',
+    )
     release_fraction: float = quantity(
         0.5,
         gt=0,

@@ -1,0 +1,33 @@
+"""The debris mission gives up after ``max_plan_attempts`` "no path" answers in a row."""
+
+from __future__ import annotations
+
+import pytest
+
+from dcsim.registry import PluginRegistry
+from dcsim.runner import Runner
+from dcsim.runsetup import prepare_run
+
+REFUSAL = "no path: moving obstacles need ompl-control or a time-aware planner"
+"""ompl-geometric's answer among the default scenario's drifting obstacles."""
+
+
+@pytest.fixture(scope="module")
+def registry():
+    return PluginRegistry.discover()
+
+
+@pytest.mark.parametrize("attempts", [1, 3])
+def test_the_run_stops_with_the_planners_reason(registry, attempts):
+    overrides = ["path_planner={plugin: ompl-geometric}", f"mission.max_plan_attempts={attempts}"]
+    runner = Runner(prepare_run(None, overrides, registry=registry))
+    summary = runner.run()
+    refusals = [e for e in runner.recorder.events if e["event"] == "no_path"]
+    assert [e["reason"] for e in refusals] == [REFUSAL] * attempts
+    assert (summary["status"], summary["reason"]) == (
+        "stopped",
+        f"no path after {attempts} attempts: {REFUSAL}",
+    )
+    assert summary["goal_met"] is False
+    retry = runner.scenario.mission.path_retry
+    assert summary["sim_time_s"] < attempts * retry + 1.0
