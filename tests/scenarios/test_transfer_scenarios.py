@@ -1,8 +1,10 @@
-"""The packaged transfer scenarios: they validate, end clearly with the straight-line
-baseline, and hold the geometry they were designed with."""
+"""The packaged transfer scenarios: they validate, fly their source's planner to the
+goal, end clearly with the straight-line baseline, and hold the geometry they were
+designed with."""
 
 from __future__ import annotations
 
+import re
 import runpy
 
 import numpy as np
@@ -26,6 +28,16 @@ ASTEROIDS = SCENARIOS / "asteroid_escape.yaml"
 FFSR = SCENARIOS / "ffsr_obstacles.yaml"
 FFSR_PLANAR = SCENARIOS / "ffsr_obstacles_planar.yaml"
 TRANSFER_FILES = (STATION, ASTEROIDS, FFSR, FFSR_PLANAR)
+SOURCE_PLANNERS = {
+    STATION: "grid-astar",
+    ASTEROIDS: "ompl-control",
+    FFSR: "ant-colony",
+    FFSR_PLANAR: "ant-colony",
+}
+"""The planner of each file's source: the Boeing paper's grid A*, the course project's
+kinodynamic RRT, the ant colony paper's colony."""
+STRAIGHT_LINE = "path_planner.plugin=straight-line"
+"""The override each file documents for the straight-line baseline."""
 
 GRID = 6 * 0.3048
 """The Boeing paper's grid spacing, 6 ft in m."""
@@ -80,6 +92,44 @@ def test_every_transfer_scenario_validates():
 
 
 @pytest.mark.parametrize(
+    "path", TRANSFER_FILES, ids=["station", "asteroids", "ffsr", "ffsr-planar"]
+)
+def test_each_file_flies_its_sources_planner_to_the_goal(path, registry):
+    setup = prepare_run(path, registry=registry)
+    assert setup.scenario.path_planner.plugin == SOURCE_PLANNERS[path]
+    assert setup.scenario.controller.plugin == "pd"
+    runner = Runner(setup, None)
+    summary = runner.run()
+    assert (summary["status"], summary["reason"]) == ("completed", "goal reached")
+    assert summary["goal_met"] is True and summary["collisions"] == 0
+    assert [e for e in runner.recorder.events if e["event"] == "no_path"] == []
+    assert summary["sim_time_s"] < setup.scenario.world.duration
+
+
+@pytest.mark.parametrize(
+    "path", TRANSFER_FILES, ids=["station", "asteroids", "ffsr", "ffsr-planar"]
+)
+def test_each_header_names_its_planner_and_the_straight_line_override(path):
+    header = "".join(line for line in path.read_text().splitlines(True) if line.startswith("#"))
+    flies = rf"The file flies the (paper|source)'s planner, [^.]*\b{SOURCE_PLANNERS[path]}\b"
+    assert re.search(flies, header.replace("\n#", ""))
+    assert f"dcsim run scenarios/{path.name} --set {STRAIGHT_LINE}" in header
+
+
+def test_the_asteroid_escape_repeats_exactly(registry):
+    """ompl-control is seeded from the scenario and stops at its first solution."""
+
+    def records():
+        runner = Runner(prepare_run(ASTEROIDS, registry=registry), None)
+        runner.run()
+        return runner.recorder.events, runner.recorder.rows
+
+    first, second = records(), records()
+    assert any(e["event"] == "path" for e in first[0])
+    assert first == second
+
+
+@pytest.mark.parametrize(
     ("path", "overrides", "status", "reason"),
     [
         (STATION, (), "stopped", "no path after 3 attempts: the straight path passes"),
@@ -92,14 +142,25 @@ def test_every_transfer_scenario_validates():
     ids=["station-goal3", "station-goal1", "station-goal2", "asteroids", "ffsr", "ffsr-planar"],
 )
 def test_straight_line_ends_clearly(path, overrides, status, reason, registry):
-    setup = prepare_run(path, overrides, registry=registry)
-    assert setup.scenario.path_planner.plugin == "straight-line"
+    setup = prepare_run(path, (STRAIGHT_LINE, *overrides), registry=registry)
     assert setup.scenario.controller.plugin == "pd"
     summary = Runner(setup, None).run()
     assert (summary["status"], summary["reason"][: len(reason)]) == (status, reason)
     assert summary["collisions"] == 0
-    assert summary["reached"] is (status == "completed")
+    assert summary["reached"] is summary["goal_met"] is (status == "completed")
     assert summary["sim_time_s"] < setup.scenario.world.duration
+
+
+@pytest.mark.parametrize("planner", ["grid-astar", "multi-burn"])
+@pytest.mark.parametrize("goal", [1, 2], ids=["goal1", "goal2"])
+def test_the_papers_planners_reach_goals_1_and_2_within_the_run(planner, goal, registry):
+    overrides = (f"path_planner.plugin={planner}", GOAL_OVERRIDES[goal])
+    summary = Runner(prepare_run(STATION, overrides, registry=registry), None).run()
+    assert (summary["reason"], summary["goal_met"], summary["collisions"]) == (
+        "goal reached",
+        True,
+        0,
+    )
 
 
 def test_station_goals_are_the_papers_in_metres():
