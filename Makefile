@@ -5,7 +5,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: test run docs clean
+.PHONY: test test-slow run docs clean
 
 $(STAMP): pyproject.toml setup.cfg
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -17,10 +17,15 @@ $(STAMP): pyproject.toml setup.cfg
 # (and the set-up they share). `.venv/bin/pytest` alone runs the suite in one process.
 # dcsim's and the plugins' bytecode is compiled first: where PYTHONDONTWRITEBYTECODE is
 # set, every process the suite starts (`dcsim` commands, Dask workers) would otherwise
-# compile them again, about 1.3 s each.
+# compile them again, about 1.3 s each. The tests marked `slow` (every shipped scenario
+# with every planner and controller that can fly it) are left out: `make test-slow`.
 test: $(STAMP)
 	$(BIN)/python -m compileall -q dcsim plugins
-	$(BIN)/python -m pytest -n auto --dist loadgroup
+	$(BIN)/python -m pytest -n auto --dist loadgroup -m "not slow"
+
+test-slow: $(STAMP)
+	$(BIN)/python -m compileall -q dcsim plugins
+	$(BIN)/python -m pytest -n auto --dist loadgroup -m slow
 
 run: $(STAMP)
 	$(BIN)/dcsim run
