@@ -123,7 +123,7 @@ def escape_scenario(seed: int) -> dict[str, Any]:
         },
         "obstacles": obstacle_entries(draw_field(seed)),
         "mission": {"type": "transfer", "goal": GOAL, "bounds": BOUNDS, "planning_budget": BUDGET},
-        "path_planner": {"plugin": "straight-line"},
+        "path_planner": {"plugin": "ompl-control"},
         "controller": {"plugin": "pd"},
         "stop": {"on_collision": True},
     }
