@@ -11,6 +11,7 @@ fields it adds, and when it is finished.
 
 from __future__ import annotations
 
+import math
 import warnings
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping, Sequence
@@ -120,7 +121,7 @@ class Mission(ABC):
         warnings.warn(
             f"the plan made at t = {time:.1f} s ends at t = {end:.1f} s, after the run's "
             f"world.duration of {duration:g} s: the run stops before the plan is flown to "
-            f"its end; lengthen world.duration beyond {end:.0f} s to fly it",
+            f"its end; lengthen world.duration to {math.ceil(end)} s or more to fly it",
             PlanOutlastsRunWarning,
             stacklevel=2,
         )

@@ -102,8 +102,8 @@ def test_run_warns_on_stderr_when_a_plan_outlasts_the_run(dcsim_cli, tmp_path):
     assert result.stderr == textwrap.dedent(
         """\
         warning: the plan made at t = 0.0 s ends at t = 71.3 s, after the run's world.duration \
-of 50 s: the run stops before the plan is flown to its end; lengthen world.duration beyond \
-71 s to fly it
+of 50 s: the run stops before the plan is flown to its end; lengthen world.duration to 72 s \
+or more to fly it
         """
     )
     assert "goal not met: 1 plan(s), goal not reached" in result.stdout.splitlines()[0]
