@@ -18,7 +18,8 @@ $(STAMP): pyproject.toml setup.cfg
 # dcsim's and the plugins' bytecode is compiled first: where PYTHONDONTWRITEBYTECODE is
 # set, every process the suite starts (`dcsim` commands, Dask workers) would otherwise
 # compile them again, about 1.3 s each. The tests marked `slow` (every shipped scenario
-# with every planner and controller that can fly it) are left out: `make test-slow`.
+# with every planner and controller that can fly it, the FMU examples' exits in 40 fresh
+# processes) are left out: `make test-slow`.
 test: $(STAMP)
 	$(BIN)/python -m compileall -q dcsim plugins
 	$(BIN)/python -m pytest -n auto --dist loadgroup -m "not slow"

@@ -17,6 +17,8 @@ import pytest
 
 from tests.conftest import REPO
 
+pytestmark = pytest.mark.slow  # 40 fresh processes, about 2 minutes
+
 RUNS = 20  # fresh processes per example
 AT_ONCE = 2
 EXAMPLE = re.compile(r"```python\n(.*?)```", re.S)
