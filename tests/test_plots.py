@@ -16,13 +16,8 @@ from matplotlib.collections import PolyCollection
 
 from dcsim.api import Shape, ShapeKind
 from dcsim.missions.debris import DebrisMission
-from dcsim.plots import (
-    FrameAxes,
-    estimation_figure,
-    motion_figure,
-    timeline_figure,
-    trajectory_figure,
-)
+from dcsim.missions.debris.plots import timeline_figure, trajectory_figure
+from dcsim.plots import FrameAxes, estimation_figure, motion_figure
 from dcsim.recording import SIGMA_COLUMNS, read_telemetry
 from dcsim.registry import PluginRegistry
 from dcsim.runner import PLOT_POINTS, Runner

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from dcsim.missions.transfer import TransferMission
+from dcsim.missions.transfer.plots import build_scene, path_figure, read_planned, timeline_figure
 from dcsim.recording import read_telemetry
 from dcsim.registry import PluginRegistry
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
-from dcsim.transfer_plots import build_scene, path_figure, read_planned, timeline_figure
 from tests.conftest import REPO
 
 STATION = REPO / "scenarios" / "station_inspection.yaml"

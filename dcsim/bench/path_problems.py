@@ -2,7 +2,7 @@
 
 Every problem is a transfer scenario, so that it can also be flown: a random family
 writes one from its seed, a scenario file is one. The path problem is the one the
-transfer mission poses at t = 0 (:func:`dcsim.missions.transfer.transfer_problem`), from
+transfer mission poses at t = 0 (:func:`dcsim.missions.transfer.mission.transfer_problem`), from
 the robot's true initial state, with the obstacles in sensor range.
 
 Families (the robot: the scenario default, 1 m radius, 1 m/s, 0.05 m/s² usable
@@ -36,7 +36,7 @@ import numpy as np
 from dcsim.bench.asteroids import escape_scenario
 from dcsim.errors import DcsimError
 from dcsim.messages import PathProblem, RobotState
-from dcsim.missions.transfer import transfer_problem
+from dcsim.missions.transfer.mission import transfer_problem
 from dcsim.scenario import Scenario, ScenarioDocument, validate
 from dcsim.seeding import component_rng
 from dcsim.world import World

@@ -54,10 +54,11 @@ from dcsim.geometry import (
     quaternion_multiply,
     rotation_vector,
 )
+from dcsim.missions.hold.settings import HoldMissionSection
 from dcsim.registry import PluginRegistry
 from dcsim.runner import Runner
 from dcsim.runsetup import build_run
-from dcsim.scenario.model import HoldMissionSection, Scenario, scenario_model
+from dcsim.scenario.model import Scenario, scenario_model
 from dcsim.seeding import component_rng
 from dcsim.world import World
 

@@ -35,6 +35,7 @@ from dcsim.motion import mean_motion
 from dcsim.registry import PluginRegistry
 from dcsim.runner import Runner
 from dcsim.runsetup import build_run, prepare_run
+from dcsim.scenario import load_scenario
 from dcsim.scenario.model import Scenario
 from dcsim.seeding import component_rng
 from dcsim.world import World
@@ -95,7 +96,7 @@ def field_scenario(objects: int, duration: float, seed: int = 0) -> Scenario:
         obstacles.append(
             {"id": i, "radius": 1.0, "motion": cw(position.tolist(), rng.normal(0, 0.01))}
         )
-    return Scenario.model_validate(
+    return load_scenario(
         {
             "name": f"bench-{objects}",
             "world": {"frame": "lvlh", "orbit": {"radius": ORBIT_RADIUS}, "duration": duration},

@@ -1,51 +1,101 @@
-"""Mission types, selected in a scenario by ``mission.type``.
+"""Mission types, selected in a scenario by ``mission.type``, found as plugins are.
 
-Built in: ``debris`` (:class:`~dcsim.missions.debris.DebrisMission`), ``transfer``
-(:class:`~dcsim.missions.transfer.TransferMission`), ``reach``
-(:class:`~dcsim.missions.reach.ReachMission`) and ``hold``
-(:class:`~dcsim.missions.hold.HoldMission`). A new mission
-derives from :class:`~dcsim.missions.base.Mission`, declares its ``Settings`` section,
-and is added with :func:`register_mission`.
+A mission is a package: its scenario section (a
+:class:`~dcsim.scenario.model.MissionSettings` subclass, with its rules across keys),
+its :class:`~dcsim.missions.base.Mission` subclass (roles, modes, telemetry columns and
+units, summary fields, plots, end) and its docs. Missions are found through the entry
+point group ``dcsim.missions``: the entry point's name is the mission type and its value
+the mission class, so a third party adds a mission in its own distribution::
+
+    [project.entry-points."dcsim.missions"]
+    capture = "my_package.capture:CaptureMission"
+
+dcsim's own missions are found the same way: ``debris``
+(:mod:`dcsim.missions.debris`), ``transfer`` (:mod:`dcsim.missions.transfer`), ``reach``
+(:mod:`dcsim.missions.reach`) and ``hold`` (:mod:`dcsim.missions.hold`). A mission class
+defined at run time (a test, a notebook) is added with :func:`register_mission`.
 """
 
 from __future__ import annotations
 
+import functools
+import importlib.metadata as md
+import warnings
+
+from dcsim.errors import PluginLoadWarning
 from dcsim.interfaces import PLUGIN_KINDS
 from dcsim.missions.base import Mission
-from dcsim.missions.debris import DebrisMission
-from dcsim.missions.hold import HoldMission
-from dcsim.missions.reach import ReachMission
-from dcsim.missions.transfer import TransferMission
+from dcsim.registry import BUILTIN_DISTRIBUTION
 from dcsim.scenario.model import Scenario
 
-_MISSIONS: dict[str, type[Mission]] = {
-    DebrisMission.type: DebrisMission,
-    TransferMission.type: TransferMission,
-    ReachMission.type: ReachMission,
-    HoldMission.type: HoldMission,
-}
+MISSION_GROUP = "dcsim.missions"
+"""The entry point group missions are found in."""
+
+_REGISTERED: dict[str, type[Mission]] = {}
+
+
+@functools.cache
+def _installed() -> dict[str, type[Mission]]:
+    """The missions of every installed distribution's ``dcsim.missions`` entry points
+    (dcsim's own first); one that fails to load, or names no mission class of its own
+    type, is skipped with a :class:`~dcsim.errors.PluginLoadWarning`."""
+    found: dict[str, type[Mission]] = {}
+    entry_points = sorted(
+        md.entry_points(group=MISSION_GROUP),
+        key=lambda e: e.dist is None or e.dist.name != BUILTIN_DISTRIBUTION,
+    )
+    for ep in entry_points:
+        where = f"entry point '{ep.name}' = {ep.value}" + (f" of {ep.dist.name}" if ep.dist else "")
+        try:
+            cls = ep.load()
+        except Exception as error:  # any import failure of a third-party package
+            _skip(f"mission {where} failed to load: {type(error).__name__}: {error}")
+            continue
+        problem = _class_problem(cls, ep.name)
+        if problem is None and ep.name in found:
+            problem = f"type '{ep.name}' is already taken by {found[ep.name].__qualname__}"
+        if problem is not None:
+            _skip(f"mission {where} was skipped: {problem}")
+            continue
+        found[ep.name] = cls
+    return found
+
+
+def _class_problem(cls: object, mission_type: str) -> str | None:
+    """Why ``cls`` cannot be the mission of ``mission_type`` (None if it can)."""
+    if not (isinstance(cls, type) and issubclass(cls, Mission)):
+        return f"{cls!r} is not a subclass of dcsim.api.Mission"
+    if getattr(cls, "type", None) != mission_type:
+        return f"{cls.__qualname__}.type is {getattr(cls, 'type', None)!r}, not '{mission_type}'"
+    return None
+
+
+def _skip(message: str) -> None:
+    warnings.warn(message, PluginLoadWarning, stacklevel=3)
 
 
 def register_mission(cls: type[Mission]) -> type[Mission]:
-    """Make mission class ``cls`` selectable as ``mission.type: <cls.type>``.
+    """Make mission class ``cls`` selectable as ``mission.type: <cls.type>`` in this process.
 
-    Returns ``cls``, so that it can be used as a class decorator.
+    For a class made at run time; a distribution declares its missions in the
+    ``dcsim.missions`` entry point group instead. Returns ``cls``, so that it can be
+    used as a class decorator.
 
     Raises
     ------
     ValueError
         If another class already has that type.
     """
-    known = _MISSIONS.get(cls.type)
+    known = mission_types().get(cls.type)
     if known is not None and known is not cls:
         raise ValueError(f"mission type '{cls.type}' is already taken by {known.__qualname__}")
-    _MISSIONS[cls.type] = cls
+    _REGISTERED[cls.type] = cls
     return cls
 
 
 def mission_types() -> dict[str, type[Mission]]:
-    """Every mission class by its type."""
-    return dict(_MISSIONS)
+    """Every mission class by its type: the installed ones, then those registered."""
+    return {**_installed(), **_REGISTERED}
 
 
 def scenario_roles(scenario: Scenario) -> tuple[str, ...]:
@@ -68,15 +118,12 @@ def mission_class(mission_type: str) -> type[Mission]:
     KeyError
         If no mission has that type.
     """
-    return _MISSIONS[mission_type]
+    return mission_types()[mission_type]
 
 
 __all__ = [
-    "DebrisMission",
-    "HoldMission",
+    "MISSION_GROUP",
     "Mission",
-    "ReachMission",
-    "TransferMission",
     "mission_class",
     "mission_types",
     "register_mission",

@@ -165,17 +165,14 @@ class Mission(ABC):
     ) -> list[Path]:
         """Draw the run's pictures into ``out_dir/plots``; return the files written.
 
-        The default draws the trajectory with every object's path, the timeline of
-        modes (grabs and releases marked), propellant, delta-v and obstacle gap, the
-        motion (speed, thrust, attitude, angular rate) and the estimation error with
-        its ±3σ envelope (:func:`dcsim.plots.write_plots`). ``telemetry`` is thinned
-        for plotting.
+        The default draws what every run shows: the motion (speed, thrust, attitude,
+        angular rate) and the estimation error with its ±3σ envelope
+        (:func:`dcsim.plots.write_plots`); a mission adds its own pictures by overriding
+        this. ``telemetry`` is thinned for plotting.
         """
         from dcsim.plots import write_plots  # on use: it loads matplotlib
 
-        return write_plots(
-            out_dir, self.scenario, telemetry, events, self.modes, self.safety_distance
-        )
+        return write_plots(out_dir, self.scenario, telemetry)
 
     def records(self) -> dict[str, str]:
         """Further files for the run directory, by name (written when the run ends)."""

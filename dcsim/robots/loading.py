@@ -78,7 +78,7 @@ def load_reach_problem(
         If its mission is not a reach, or the end effector cannot start at
         ``end_effector``.
     """
-    from dcsim.missions.reach import reach_problem  # the missions load the world engine
+    from dcsim.missions.reach.mission import reach_problem  # the missions load the world engine
 
     scenario = load_scenario(path, overrides)
     model = load_robot_model(path, overrides)

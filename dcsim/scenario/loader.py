@@ -227,8 +227,9 @@ class _Invalid(Exception):
     """A value a rule reads is itself invalid (the schema reports it); the rule is skipped."""
 
 
-class _Values:
-    """Validated values of single keys of raw scenario data, for the rules across keys.
+class ScenarioValues:
+    """Validated values of single keys of raw scenario data, for the rules across keys
+    (the schema's, and a mission's: :attr:`MissionSettings.rules`).
 
     ``get("world", "physics_step")`` is the key's value validated on its own (its
     default if absent); :class:`_Invalid` is raised when it cannot be known.
@@ -258,18 +259,20 @@ class _Values:
 
 
 Rule = Callable[..., list[tuple[KeyPath, str]]]
-"""A rule across keys: takes :class:`_Values` (and more), gives (key path, message) pairs."""
+"""A rule across keys: takes :class:`ScenarioValues` (and more), gives (key path, message) pairs."""
 
 
 def _rule_violations(data: dict[str, Any], model: type[Scenario]) -> list[tuple[KeyPath, str]]:
     """Rules that span fields or sections, as (key path, message) pairs.
 
-    A rule is checked whenever the values it reads are valid, whatever other keys of
-    the document are invalid, so that its violations are reported with the schema's.
-    A rule reading a key the scenario's mission does not have is skipped.
+    The schema's own rules, then those of the scenario's mission (its section's
+    ``rules``). A rule is checked whenever the values it reads are valid, whatever
+    other keys of the document are invalid, so that its violations are reported with
+    the schema's. A rule reading a key the scenario's mission does not have is skipped.
     """
-    get = _Values(data, model)
-    return [found for rule in _RULES for found in _checked(rule, get)]
+    get = ScenarioValues(data, model)
+    rules = [*_RULES, *model.model_fields["mission"].annotation.rules]
+    return [found for rule in rules for found in _checked(rule, get)]
 
 
 def _checked(rule: Rule, *args: Any) -> list[tuple[KeyPath, str]]:
@@ -280,7 +283,7 @@ def _checked(rule: Rule, *args: Any) -> list[tuple[KeyPath, str]]:
         return []
 
 
-def _control_period_rule(get: _Values) -> list[tuple[KeyPath, str]]:
+def _control_period_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
     step, period = get("world", "physics_step"), get("world", "control_period")
     ratio = period / step
     if ratio > MAX_STEPS_PER_CONTROL_PERIOD:
@@ -295,7 +298,7 @@ def _control_period_rule(get: _Values) -> list[tuple[KeyPath, str]]:
     return [(("world", "control_period"), message)]
 
 
-def _duration_rule(get: _Values) -> list[tuple[KeyPath, str]]:
+def _duration_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
     step, duration = get("world", "physics_step"), get("world", "duration")
     if duration / step <= MAX_PHYSICS_STEPS:
         return []
@@ -306,7 +309,7 @@ def _duration_rule(get: _Values) -> list[tuple[KeyPath, str]]:
     return [(("world", "duration"), message)]
 
 
-def _orbit_rule(get: _Values) -> list[tuple[KeyPath, str]]:
+def _orbit_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
     if get("world", "frame") != "lvlh":
         return []
     radius, mu = get("world", "orbit", "radius"), get("world", "orbit", "mu")
@@ -322,7 +325,7 @@ def _orbit_rule(get: _Values) -> list[tuple[KeyPath, str]]:
     return [(("world", "orbit"), message)]
 
 
-def _propellant_rule(get: _Values) -> list[tuple[KeyPath, str]]:
+def _propellant_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
     propellant, mass = get("robot", "propellant_mass"), get("robot", "mass")
     if propellant < mass:
         return []
@@ -330,7 +333,7 @@ def _propellant_rule(get: _Values) -> list[tuple[KeyPath, str]]:
     return [(("robot", "propellant_mass"), message)]
 
 
-def _joint_count_rule(get: _Values) -> list[tuple[KeyPath, str]]:
+def _joint_count_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
     """A manipulator's initial joint angles and rates: one per link."""
     if get("robot", "type") != "manipulator":
         return []
@@ -347,32 +350,25 @@ def _joint_count_rule(get: _Values) -> list[tuple[KeyPath, str]]:
     return found
 
 
-def _reach_rule(get: _Values) -> list[tuple[KeyPath, str]]:
-    reach, grab = get("mission", "reach"), get("robot", "grab_distance")
-    if reach <= grab:
-        return []
-    return [(("mission", "reach"), f"{reach:g} m is beyond robot.grab_distance ({grab:g} m)")]
-
-
-def _attitude_rule(get: _Values) -> list[tuple[KeyPath, str]]:
+def _attitude_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
     if sum(q * q for q in get("robot", "initial", "attitude")) >= 1e-12:
         return []
     return [(("robot", "initial", "attitude"), "the quaternion must not be zero")]
 
 
-def _object_rules(get: _Values) -> list[tuple[KeyPath, str]]:
+def _object_rules(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
     found: list[tuple[KeyPath, str]] = []
     owners: dict[int, str] = {}
     for section in ("targets", "obstacles"):
         for index in get.items(section):
             found += _checked(_unique_id_rule, get, (section, index), owners)
-            found += _checked(_cw_rule, get, (section, index, "motion", "type"))
+            found += _checked(cw_motion_rule, get, (section, index, "motion", "type"))
             found += _checked(_shape_radius_rule, get, (section, index))
     return found
 
 
 def _unique_id_rule(
-    get: _Values, item: KeyPath, owners: dict[int, str]
+    get: ScenarioValues, item: KeyPath, owners: dict[int, str]
 ) -> list[tuple[KeyPath, str]]:
     obj_id = get(*item, "id")
     if obj_id in owners:
@@ -381,7 +377,7 @@ def _unique_id_rule(
     return []
 
 
-def _shape_radius_rule(get: _Values, item: KeyPath) -> list[tuple[KeyPath, str]]:
+def _shape_radius_rule(get: ScenarioValues, item: KeyPath) -> list[tuple[KeyPath, str]]:
     """A radius given beside a shape must be the shape's bounding radius."""
     if not get.given(*item, "radius") or get(*item, "shape") is None:
         return []
@@ -395,20 +391,11 @@ def _shape_radius_rule(get: _Values, item: KeyPath) -> list[tuple[KeyPath, str]]
     return [((*item, "radius"), message)]
 
 
-def _cw_rule(get: _Values, path: KeyPath) -> list[tuple[KeyPath, str]]:
+def cw_motion_rule(get: ScenarioValues, path: KeyPath) -> list[tuple[KeyPath, str]]:
+    """A ``cw`` motion type at ``path`` needs the LVLH frame."""
     if get(*path) == "cw" and get("world", "frame") != "lvlh":
         return [(path, "'cw' motion needs world.frame: lvlh")]
     return []
-
-
-def _drop_point_rule(get: _Values) -> list[tuple[KeyPath, str]]:
-    if get("drop_point", "position") is not None and get("drop_point", "motion") is not None:
-        return [(("drop_point", "motion"), "give either position or motion, not both")]
-    return []
-
-
-def _drop_point_cw_rule(get: _Values) -> list[tuple[KeyPath, str]]:
-    return _cw_rule(get, ("drop_point", "motion", "type"))
 
 
 _RULES: list[Rule] = [
@@ -417,11 +404,8 @@ _RULES: list[Rule] = [
     _orbit_rule,
     _propellant_rule,
     _joint_count_rule,
-    _reach_rule,
     _attitude_rule,
     _object_rules,
-    _drop_point_rule,
-    _drop_point_cw_rule,
 ]
 """Every rule across keys, in the order their messages are listed."""
 

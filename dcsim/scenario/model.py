@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
@@ -22,12 +23,11 @@ from pydantic import (
     ModelWrapValidatorHandler,
     Tag,
     create_model,
-    field_validator,
     model_validator,
 )
 
 from dcsim.geometry import Vector, spherical_to_cartesian
-from dcsim.messages.planning import FrameDynamics, FrameKind, GoalRegion
+from dcsim.messages.planning import FrameDynamics, FrameKind
 from dcsim.messages.sensing import Shape, ShapeKind
 from dcsim.motion import (
     STANDARD_GRAVITATIONAL_PARAMETER_EARTH,
@@ -616,265 +616,22 @@ class PluginChoice(Section):
 class MissionSettings(Section):
     """Base of every mission type's section: ``type`` selects the mission.
 
-    ``role_defaults`` replaces the scenario's default plugin choice of a role for this
-    mission; ``None`` makes the role optional (absent unless the file names a plugin).
+    A mission's package declares its section as a subclass, with ``type`` a ``Literal``
+    of its own name. ``role_defaults`` replaces the scenario's default plugin choice of
+    a role for this mission; ``None`` makes the role optional (absent unless the file
+    names a plugin). ``rules`` are the mission's checks across keys, run with the
+    schema's (:data:`dcsim.scenario.loader.Rule`: each takes the scenario's
+    :class:`~dcsim.scenario.loader.ScenarioValues` and gives ``(key path, message)``
+    pairs).
     """
 
     role_defaults: ClassVar[dict[str, PluginChoice | None]] = {}
+    rules: ClassVar[tuple[Callable[..., list[tuple[tuple[str | int, ...], str]]], ...]] = ()
 
     type: str = Field(
-        "debris", description="The mission type (`debris`, `transfer`, `reach` or `hold`)."
-    )
-
-
-class DebrisMissionSection(MissionSettings):
-    """How the executer flies the debris-collection mission (the thesis's §5.2 and §5.4)."""
-
-    type: Literal["debris"] = Field(
         "debris",
-        description="The mission type: debris collection (the debris collector thesis).",
-    )
-
-    reach: float = quantity(
-        0.5,
-        unit="m",
-        gt=0,
-        description="Surface gap to a target at which GRAB is entered with an empty hold "
-        "(REACH; the collector holds at half of it); at most robot.grab_distance. With cargo "
-        "on board the collector holds clear of the cargo (docs/architecture.md, Mission).",
-    )
-    safety_distance: float = quantity(
-        2.0,
-        unit="m",
-        ge=0,
-        description="Least surface gap to keep from obstacles (SAFETY_DISTANCE), given to the "
-        "controller and marked on the run's plots.",
-    )
-    drop_speed: float = quantity(
-        0.0,
-        unit="m/s",
-        ge=0,
-        description="Speed limit on the way to the drop point (DROP_SPEED); 0 for robot.max_speed.",
-    )
-    pickup_slack: float = quantity(
-        30.0, unit="s", ge=0, description="How late a pickup may be before the plan is remade."
-    )
-    acceleration_fraction: float = quantity(
-        0.5,
-        gt=0,
-        le=1,
-        description="Fraction of the thrust-limited acceleration that plans may use; "
-        "the rest is left to the controller.",
-    )
-    planning_budget: float = quantity(
-        1.0, unit="s", gt=0, description="Wall time given to a planner call."
-    )
-    path_retry: float = quantity(
-        5.0,
-        unit="s",
-        gt=0,
-        description="Wait before asking again after the path planner found no path.",
-    )
-    max_plan_attempts: int = quantity(
-        3,
-        ge=1,
-        description='"No path" answers in a row after which the run ends stopped.',
-    )
-    release_fraction: float = quantity(
-        0.5,
-        gt=0,
-        le=1,
-        description="Fraction of the drop tolerance within which the collector releases its cargo.",
-    )
-
-
-class GoalSection(Section):
-    """The goal region of a transfer: a sphere or a box, and what must hold on arrival."""
-
-    position: Vec3 = quantity(unit="m", description="Centre of the goal region.")
-    radius: float | None = quantity(
-        None, unit="m", gt=0, description="Radius of a spherical region (or give `half_extents`)."
-    )
-    half_extents: Vec3 | None = quantity(
-        None,
-        unit="m",
-        description="Half side lengths of an axis-aligned box region (instead of `radius`).",
-    )
-    velocity: Vec3 = quantity((0.0, 0.0, 0.0), unit="m/s", description="Velocity to arrive with.")
-    velocity_tolerance: float | None = quantity(
-        None,
-        unit="m/s",
-        ge=0,
-        description="Largest arrival velocity error; null: not checked.",
-    )
-    attitude: tuple[float, float, float, float] | None = quantity(
-        None, description="Attitude quaternion [x, y, z, w] to arrive at; null: any."
-    )
-    attitude_tolerance_deg: float = quantity(
-        5.0, unit="deg", gt=0, le=180, description="Largest arrival attitude error."
-    )
-    arrival_time: float | None = quantity(
-        None, unit="s", ge=0, description="Time to arrive at; null: as soon as allowed."
-    )
-    time_tolerance: float | None = quantity(
-        None, unit="s", ge=0, description="Largest arrival time error; null: not checked."
-    )
-
-    @model_validator(mode="after")
-    def _one_region(self) -> GoalSection:
-        """A region is a sphere or a box: exactly one of the two is given."""
-        if (self.radius is None) == (self.half_extents is None):
-            raise ValueError("give either radius (a sphere) or half_extents (a box)")
-        return self
-
-    def build(self) -> GoalRegion:
-        """The goal region message."""
-        return GoalRegion(
-            position=self.position,
-            tolerance=0.0 if self.radius is None else self.radius,
-            velocity=self.velocity,
-            time=self.arrival_time,
-            half_extents=self.half_extents,
-            attitude=None
-            if self.attitude is None
-            else np.asarray(self.attitude) / np.linalg.norm(self.attitude),
-            attitude_tolerance=np.radians(self.attitude_tolerance_deg),
-            velocity_tolerance=np.inf
-            if self.velocity_tolerance is None
-            else self.velocity_tolerance,
-            time_tolerance=np.inf if self.time_tolerance is None else self.time_tolerance,
-        )
-
-
-class BoundsSection(Section):
-    """An axis-aligned box the path must stay in."""
-
-    lower: Vec3 = quantity(unit="m", description="Lowest corner.")
-    upper: Vec3 = quantity(unit="m", description="Highest corner.")
-
-
-class WeightsSection(Section):
-    """Weights of a path's cost J = w_dv Δv + w_L L + w_T T."""
-
-    delta_v: float = quantity(1.0, unit="s/m", ge=0, description="Weight on delta-v.")
-    length: float = quantity(0.0, unit="1/m", ge=0, description="Weight on path length.")
-    time: float = quantity(0.0, unit="1/s", ge=0, description="Weight on duration.")
-
-
-class TransferMissionSection(MissionSettings):
-    """A transfer: from the robot's initial state to a goal region among obstacles."""
-
-    role_defaults: ClassVar[dict[str, PluginChoice | None]] = {"localiser": None}
-
-    type: Literal["transfer"] = Field(
-        "transfer", description="The mission type: a transfer to a goal region."
-    )
-    goal: GoalSection = Field(description="The goal region and what must hold on arrival.")
-    bounds: BoundsSection | None = Field(None, description="Box the path must stay in; null: none.")
-    weights: WeightsSection = Field(
-        default_factory=WeightsSection, description="Path cost weights given to the planner."
-    )
-    max_delta_v: float | None = quantity(
-        None, unit="m/s", gt=0, description="Largest total delta-v of a plan; null: none."
-    )
-    acceleration_fraction: float = quantity(
-        0.5,
-        gt=0,
-        le=1,
-        description="Fraction of the thrust-limited acceleration that plans may use.",
-    )
-    planning_budget: float = quantity(
-        5.0, unit="s", gt=0, description="Wall time given to a planner call."
-    )
-    retry: float = quantity(
-        5.0, unit="s", gt=0, description='Wait before planning again after "no path".'
-    )
-    tracking_tolerance: float = quantity(
-        2.0,
-        unit="m",
-        gt=0,
-        description="Re-plan from the estimate when it strays this far from the trajectory.",
-    )
-    safety_distance: float = quantity(
-        0.0, unit="m", ge=0, description="Least surface gap to obstacles, given to the controller."
-    )
-    max_plan_attempts: int = quantity(
-        3,
-        ge=1,
-        description='"No path" answers in a row after which the run ends stopped.',
-    )
-
-
-class ReachMissionSection(MissionSettings):
-    """A reach: a manipulator's end effector from where it starts to a target."""
-
-    role_defaults: ClassVar[dict[str, PluginChoice | None]] = {
-        "localiser": None,
-        "path_planner": PluginChoice(plugin="end-effector-line"),
-        "controller": PluginChoice(plugin="computed-torque"),
-    }
-
-    type: Literal["reach"] = Field(
-        "reach", description="The mission type: a manipulator's end effector to a target."
-    )
-    target: Vec3 = quantity(unit="m", description="End-effector target, world frame.")
-    tolerance: float = quantity(
-        1e-3,
-        unit="m",
-        gt=0,
-        description="End-effector distance to the target that counts as "
-        "reached, once the path has ended.",
-    )
-    max_speed: float = quantity(
-        0.1, unit="m/s", gt=0, description="End-effector speed the path may reach."
-    )
-    max_acceleration: float = quantity(
-        0.1, unit="m/s^2", gt=0, description="End-effector acceleration the path may reach."
-    )
-    facing_axis: Vec3 | None = quantity(
-        None,
-        description="Base-frame direction of the base's side that must face the target; "
-        "null: the base axis (±x, ±y, ±z) nearest the target's direction at the start.",
-    )
-    ik_gain: float = quantity(
-        20.0,
-        unit="1/s",
-        gt=0,
-        description="Gain pulling the joint references' inverse kinematics back onto the "
-        "end-effector path.",
-    )
-    planning_budget: float = quantity(
-        5.0, unit="s", gt=0, description="Wall time given to the path planner."
-    )
-
-    @field_validator("facing_axis")
-    @classmethod
-    def _nonzero_axis(cls, axis: Vec3 | None) -> Vec3 | None:
-        if axis is not None and math.hypot(*axis) < 1e-12:
-            raise ValueError("the facing axis must not be zero")
-        return axis
-
-
-class HoldMissionSection(MissionSettings):
-    """A hold: keep a position and an attitude for the whole run (station keeping)."""
-
-    role_defaults: ClassVar[dict[str, PluginChoice | None]] = {"localiser": None}
-
-    type: Literal["hold"] = Field(
-        "hold", description="The mission type: hold a position and an attitude."
-    )
-    position: Vec3 | None = quantity(
-        None, unit="m", description="Position held, world frame; null: the initial position."
-    )
-    attitude: Quaternion | None = quantity(
-        None,
-        description="Attitude held [x, y, z, w] (normalised; not zero); null: the initial "
-        "attitude.",
-    )
-    hold_position: bool = Field(
-        True,
-        description="Hold the position; false leaves translation free (the reference "
-        "follows the estimate, so no force is asked for) and holds the attitude only.",
+        description="The mission type: a built-in one (`debris`, `transfer`, `reach`, "
+        "`hold`) or one an installed package adds.",
     )
 
 
@@ -923,8 +680,8 @@ class Scenario(Section):
     controller: PluginChoice = Field(
         default_factory=lambda: PluginChoice(plugin="pd"), description="Controller plugin."
     )
-    mission: DebrisMissionSection = Field(
-        default_factory=DebrisMissionSection,
+    mission: MissionSettings = Field(
+        default_factory=MissionSettings,
         description="The mission and its settings; `type` selects it (default `debris`).",
     )
     stop: StopSection = Field(default_factory=StopSection, description="Stop rules.")
@@ -946,14 +703,16 @@ class Scenario(Section):
 def scenario_model(settings: type[MissionSettings]) -> type[Scenario]:
     """The scenario model whose ``mission`` section is ``settings``.
 
+    :class:`Scenario` is generic in its mission; a scenario is validated with the model
+    of its mission's section (the loader picks it by ``mission.type``).
+
     Parameters
     ----------
     settings : type of MissionSettings
-        A mission type's section (``DebrisMissionSection`` gives :class:`Scenario`);
-        its ``role_defaults`` replace the roles' default plugins.
+        A mission type's section; its ``role_defaults`` replace the roles' default
+        plugins. A section whose every key has a default is the scenario's default
+        when the file has no ``mission``.
     """
-    if settings is DebrisMissionSection:
-        return Scenario
     roles: dict[str, Any] = {
         role: (
             PluginChoice | None,
@@ -963,10 +722,15 @@ def scenario_model(settings: type[MissionSettings]) -> type[Scenario]:
         )
         for role, default in settings.role_defaults.items()
     }
+    description = Scenario.model_fields["mission"].description
+    if any(field.is_required() for field in settings.model_fields.values()):
+        mission = Field(description=description)
+    else:
+        mission = Field(default_factory=settings, description=description)
     return create_model(
         "Scenario",
         __base__=Scenario,
         __doc__=Scenario.__doc__,
-        mission=(settings, Field(description="The mission and its settings.")),
+        mission=(settings, mission),
         **roles,
     )

@@ -19,14 +19,12 @@ from pydantic_core import PydanticUndefined
 from dcsim.docgen import update_block
 from dcsim.params import field_bounds, field_unit
 from dcsim.scenario.model import (
-    HoldMissionSection,
+    MissionSettings,
     MotionSpec,
     PluginChoice,
-    ReachMissionSection,
-    Scenario,
     SphericalPoint,
-    TransferMissionSection,
     Vec3,
+    scenario_model,
 )
 
 BEGIN = "<!-- BEGIN GENERATED KEY REFERENCE (make docs) -->"
@@ -87,13 +85,26 @@ def _child_path(prefix: str, name: str, annotation: Any) -> str:
     return path + "[i]" if get_origin(annotation) is list else path
 
 
+def _builtin_missions() -> list[type[MissionSettings]]:
+    """The sections of dcsim's own missions, the default's (``debris``) first."""
+    from dcsim.missions import mission_types  # the missions load the world engine
+
+    sections = {
+        name: cls.Settings
+        for name, cls in mission_types().items()
+        if cls.__module__.startswith("dcsim.")
+    }
+    return [sections.pop("debris"), *sections.values()]
+
+
 def _sections() -> dict[type[BaseModel], list[str]]:
-    """Every model class reachable from Scenario and the mission sections, with the key
-    paths it appears at."""
-    missions = (TransferMissionSection, ReachMissionSection, HoldMissionSection)
-    paths: dict[type[BaseModel], list[str]] = {Scenario: [""]}
+    """Every model class reachable from the default scenario and the other built-in
+    missions' sections, with the key paths it appears at."""
+    default, *missions = _builtin_missions()
+    root = scenario_model(default)
+    paths: dict[type[BaseModel], list[str]] = {root: [""]}
     paths.update({section: ["mission"] for section in missions})
-    queue: list[tuple[str, type[BaseModel]]] = [("", Scenario)]
+    queue: list[tuple[str, type[BaseModel]]] = [("", root)]
     queue += [("mission", section) for section in missions]
     while queue:
         prefix, model = queue.pop(0)

@@ -14,7 +14,7 @@ from dcsim.errors import ScenarioError
 from dcsim.fmu.export import export_fmu
 from dcsim.fmu.instance import FmuCallError, FmuError, FmuInstance
 from dcsim.fmu.variables import closed_loop_variables, plant_variables
-from dcsim.missions import DebrisMission
+from dcsim.missions.debris import DebrisMission
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
 from dcsim.scenario import load_scenario

@@ -17,7 +17,7 @@ from dcsim.fmu.variables import (
     closed_loop_variables,
     plant_variables,
 )
-from dcsim.missions import ReachMission
+from dcsim.missions.reach import ReachMission
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
 from dcsim.scenario import load_scenario

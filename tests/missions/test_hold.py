@@ -14,8 +14,8 @@ from dcsim.geometry import (
     quaternion_multiply,
     rotation_vector,
 )
-from dcsim.missions import HoldMission
-from dcsim.missions.hold import attitude_error
+from dcsim.missions.hold import HoldMission
+from dcsim.missions.hold.mission import attitude_error
 from dcsim.registry import PluginRegistry
 from dcsim.runner import Runner
 from dcsim.runsetup import prepare_run
@@ -111,3 +111,11 @@ def test_attitude_error_is_the_rotation_angle_for_either_sign():
         assert attitude_error(-a, b) == pytest.approx(expected, abs=1e-12)
     tiny = quaternion_from_rotation_vector([1e-10, 0.0, 0.0])
     assert attitude_error(tiny, [0.0, 0.0, 0.0, 1.0]) == pytest.approx(1e-10, rel=1e-6)
+
+
+def test_a_hold_run_draws_the_pictures_every_run_has_and_no_debris_ones(tmp_path, registry):
+    path = tmp_path / "slew.yaml"
+    path.write_text(textwrap.dedent(SLEW.format(duration=2.0, goal=GOAL, hold="true")))
+    out = tmp_path / "run"
+    Runner(prepare_run(path, registry=registry), out).run()
+    assert sorted(p.name for p in (out / "plots").iterdir()) == ["estimation.png", "motion.png"]

@@ -22,7 +22,8 @@ from dcsim.geometry import length
 from dcsim.interfaces import Plugin
 from dcsim.messages import Observations, Reference, StateEstimate
 from dcsim.missions.base import Emit, Mission
-from dcsim.scenario.model import HoldMissionSection, Scenario, point_to_cartesian
+from dcsim.missions.hold.settings import HoldMissionSection
+from dcsim.scenario.model import Scenario, point_to_cartesian
 from dcsim.world import World
 
 

@@ -48,8 +48,9 @@ from dcsim.messages import (
     Trajectory,
 )
 from dcsim.missions.base import Emit, Mission
+from dcsim.missions.reach.settings import ReachMissionSection
 from dcsim.robots.joint_path import JointPath, SingularPath
-from dcsim.scenario.model import ReachMissionSection, Scenario
+from dcsim.scenario.model import Scenario
 from dcsim.world import World
 
 
@@ -272,8 +273,8 @@ class ReachMission(Mission):
         events: Sequence[Mapping[str, Any]],
     ) -> list[Path]:
         """Draw ``path.png``, ``timeline.png`` and ``joints.png`` into ``out_dir/plots``
-        (:func:`dcsim.reach_plots.write_reach_plots`)."""
-        from dcsim.reach_plots import write_reach_plots  # on use: it loads matplotlib
+        (:func:`dcsim.missions.reach.plots.write_reach_plots`)."""
+        from dcsim.missions.reach.plots import write_reach_plots  # on use: it loads matplotlib
 
         return write_reach_plots(out_dir, self.scenario, telemetry, events)
 

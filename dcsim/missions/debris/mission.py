@@ -22,7 +22,8 @@ from __future__ import annotations
 import dataclasses
 import enum
 from collections import deque
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -45,7 +46,8 @@ from dcsim.messages import (
     Trajectory,
 )
 from dcsim.missions.base import Emit, Mission
-from dcsim.scenario.model import DebrisMissionSection, Scenario
+from dcsim.missions.debris.settings import DebrisMissionSection
+from dcsim.scenario.model import Scenario
 from dcsim.world import World
 from dcsim.world.objects import ObjectStatus
 
@@ -148,6 +150,21 @@ class DebrisMission(Mission):
     def telemetry(self, outputs: Mapping[str, Any]) -> dict[str, Any]:
         """Targets carried and delivered now."""
         return {"carried": outputs["carried"], "delivered": outputs["delivered"]}
+
+    def plot(
+        self,
+        out_dir: Path,
+        telemetry: Mapping[str, np.ndarray],
+        events: Sequence[Mapping[str, Any]],
+    ) -> list[Path]:
+        """Draw the trajectory with every object's path, the timeline of modes (grabs
+        and releases marked), then the motion and the estimation error
+        (:func:`dcsim.missions.debris.plots.write_debris_plots`)."""
+        from dcsim.missions.debris.plots import write_debris_plots  # loads matplotlib
+
+        return write_debris_plots(
+            out_dir, self.scenario, telemetry, events, self.modes, self.safety_distance
+        )
 
     def progress(self) -> str:
         """Targets delivered out of all, and captured."""

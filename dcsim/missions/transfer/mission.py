@@ -43,7 +43,8 @@ from dcsim.messages import (
     Trajectory,
 )
 from dcsim.missions.base import Emit, Mission
-from dcsim.scenario.model import Scenario, TransferMissionSection
+from dcsim.missions.transfer.settings import TransferMissionSection
+from dcsim.scenario.model import Scenario
 from dcsim.world import World
 
 _TRAJECTORY_HEADER = (
@@ -269,12 +270,12 @@ class TransferMission(Mission):
     ) -> list[Path]:
         """Draw ``path.png`` and ``timeline.png`` into ``out_dir/plots``.
 
-        See :func:`dcsim.transfer_plots.write_transfer_plots`: the path with every
+        See :func:`dcsim.missions.transfer.plots.write_transfer_plots`: the path with every
         obstacle in its true shape and the last planned trajectory (``trajectory.csv``,
         written before the plots), and a timeline marked with the events' mode changes
         and planner answers.
         """
-        from dcsim.transfer_plots import write_transfer_plots  # on use: it loads matplotlib
+        from dcsim.missions.transfer.plots import write_transfer_plots  # loads matplotlib
 
         return write_transfer_plots(
             out_dir, self.scenario, telemetry, events, self.modes, self.safety_distance
