@@ -18,6 +18,10 @@ Plugin kinds
     (and their common base :class:`Plugin`).
 Parameters
     :class:`PluginParams`, :func:`quantity`.
+Missions (docs/plugins.md, "Writing a mission")
+    :class:`Mission` (the task side of a run), :class:`MissionSettings` (its scenario
+    section), :func:`register_mission` (a mission class made at run time; a
+    distribution declares its missions in the ``dcsim.missions`` entry point group).
 Messages
     The robot: :class:`RobotState`, :class:`StateEstimate`, :class:`Prior`,
     :class:`MotionInput`, :class:`Reference`, :class:`Command`, :class:`RobotSpec`.
@@ -144,6 +148,7 @@ from dcsim.messages import (
     array_field,
     message,
 )
+from dcsim.missions import Mission, register_mission
 from dcsim.motion import (
     ClohessyWiltshireMotion,
     LinearMotion,
@@ -165,6 +170,7 @@ from dcsim.robots.manipulator import (
 )
 from dcsim.robots.urdf import urdf_text as manipulator_urdf
 from dcsim.runs import RunResult, close_run, load_scenario, open_run, read_run, run
+from dcsim.scenario.model import MissionSettings
 
 if TYPE_CHECKING:
     import pandas
@@ -218,6 +224,8 @@ __all__ = [
     "Message",
     "message",
     "min_clearance",
+    "Mission",
+    "MissionSettings",
     "MotionInput",
     "MotionModel",
     "NoPath",
@@ -250,6 +258,7 @@ __all__ = [
     "quaternion_from_rotation_vector",
     "quaternion_multiply",
     "Reference",
+    "register_mission",
     "resolution_step",
     "rest_to_rest_time",
     "RobotSpec",

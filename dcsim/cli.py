@@ -361,7 +361,7 @@ def _plugins_flown(plugins: dict[str, dict[str, str]]) -> str:
 
 
 @cli.command("new-plugin")
-@click.argument("kind", type=click.Choice(list(PLUGIN_KINDS)))
+@click.argument("kind", type=click.Choice([*PLUGIN_KINDS, "mission"]))
 @click.argument("name")
 @click.option(
     "--dir",
@@ -372,13 +372,16 @@ def _plugins_flown(plugins: dict[str, dict[str, str]]) -> str:
     help="Folder to create the package in.",
 )
 def new_plugin_command(kind: str, name: str, directory: Path) -> None:
-    """Write an out-of-tree plugin package of KIND called NAME.
+    """Write an out-of-tree plugin package of KIND called NAME, or a mission package.
 
     The package (DIR/dcsim-NAME) has a pyproject.toml with the dcsim entry point, the
     plugin class with its parameter model and a simple working algorithm, a test file
-    that runs the conformance suite, and a README. Install it with
+    that runs the conformance suite, and a README. KIND `mission` writes a mission
+    instead (mission.type NAME, found through the dcsim.missions entry point: its
+    settings and a mission that flies to a point and holds it), with an example
+    scenario its tests fly through the mission conformance suite. Install it with
     `pip install -e DIR/dcsim-NAME` and run `pytest` inside it. A NAME an installed
-    plugin of KIND already has is refused.
+    plugin of KIND (or an installed mission) already has is refused.
     """
     from dcsim.scaffold import new_plugin
 

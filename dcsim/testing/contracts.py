@@ -15,7 +15,7 @@ import inspect
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NoReturn
 
 import numpy as np
 
@@ -138,7 +138,7 @@ def make(plugin_class: type[Plugin], params: Any = None, seed: int = SEED) -> Pl
     return plugin_class(params, np.random.default_rng(seed))
 
 
-def fail(message: str) -> None:
+def fail(message: str) -> NoReturn:
     """Raise a :class:`ContractViolation` saying what the plugin did."""
     raise ContractViolation(message)
 

@@ -14,7 +14,10 @@ END = "<!-- END GENERATED CHECK LIST -->"
 
 
 def render_checks() -> str:
-    """Every check, the kinds it applies to and its contract, as a Markdown table."""
+    """Every check, the kinds it applies to and its contract, as a Markdown table (the
+    mission contract's checks last, for the kind ``mission``)."""
+    from dcsim.testing.missions import MISSION_CHECKS  # the missions load the world engine
+
     seen: dict[str, tuple[list[str], str]] = {}
     for kind in PLUGIN_KINDS:
         for check in checks_for(kind):
@@ -23,6 +26,7 @@ def render_checks() -> str:
     for name, (kinds, text) in seen.items():
         applies = "all" if len(kinds) == len(PLUGIN_KINDS) else ", ".join(kinds)
         rows.append(f"| `{name}` | {applies} | {text} |")
+    rows += [f"| `{check.name}` | mission | {check.contract} |" for check in MISSION_CHECKS]
     return "\n".join(rows) + "\n"
 
 

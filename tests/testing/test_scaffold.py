@@ -1,4 +1,5 @@
-"""``dcsim new-plugin``: every kind's generated plugin passes the conformance suite."""
+"""``dcsim new-plugin``: every kind's generated plugin, and a generated mission, passes
+its conformance suite."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import pytest
 
 from dcsim.scaffold import ScaffoldError, new_plugin
 from dcsim.testing import check_plugin
+from dcsim.testing.missions import check_mission
 
 
 @pytest.mark.parametrize("kind", ["localiser", "task_planner", "path_planner", "controller"])
@@ -38,3 +40,26 @@ def test_generated_plugin_of_every_kind_conforms(kind, tmp_path, monkeypatch):
 def test_bad_requests_are_refused(kind, name, message, tmp_path):
     with pytest.raises(ScaffoldError, match=message):
         new_plugin(kind, name, tmp_path)
+
+
+def test_a_generated_mission_flies_its_scenario_and_conforms(tmp_path, monkeypatch):
+    root = new_plugin("mission", "fresh-mission", tmp_path)
+    monkeypatch.syspath_prepend(str(root))
+    module = importlib.import_module("dcsim_fresh_mission")
+    try:
+        mission = module.FreshMissionMission
+        assert mission.type == "fresh-mission"
+        scenario = root / "tests" / "scenario.yaml"
+        failures = [str(r) for r in check_mission(mission, scenario) if not r.passed]
+        assert failures == []
+        pyproject = (root / "pyproject.toml").read_text()
+        assert '[project.entry-points."dcsim.missions"]' in pyproject
+        assert 'fresh-mission = "dcsim_fresh_mission:FreshMissionMission"' in pyproject
+        assert "MissionContract" in (root / "tests" / "test_dcsim_fresh_mission.py").read_text()
+    finally:
+        sys.modules.pop("dcsim_fresh_mission", None)
+
+
+def test_a_mission_type_already_installed_is_refused(tmp_path):
+    with pytest.raises(ScaffoldError, match="an installed mission already has the type 'hold'"):
+        new_plugin("mission", "hold", tmp_path)
