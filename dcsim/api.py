@@ -66,15 +66,31 @@ Campaigns (many cases of a scenario on Dask; docs/campaigns.md)
     :func:`run_campaign`.
 Registry and hooks
     :data:`hookimpl`, :class:`PluginRegistry`.
+Benches (a plugin's own ``dcsim bench`` command, added through the
+``dcsim_register_commands`` hook; docs/plugins.md)
+    Exact yardsticks on plain arrays: :func:`layered_optimum` (the cheapest path
+    through a layered graph, a :class:`LayeredOptimum`), :func:`optimality_gap`;
+    :func:`optimal_values`, :func:`reachable_cells` and :func:`working_cells` on a
+    deterministic cell task. Problems: :class:`BenchProblem`, :func:`load_bench_problem`
+    (a seeded obstacle field or a transfer scenario file), :func:`expand_bench_specs`,
+    :func:`packaged_scenario_path`. Options: :func:`comma_words`,
+    :func:`comma_numbers`, :func:`plugin_spec`. Figures: :func:`pyplot` (Agg),
+    :func:`save_figure`, :func:`shape_outline`, :func:`shape_wireframe`.
 Errors
     :class:`DcsimError` and its subclasses.
 """
 
 from __future__ import annotations
 
+import importlib
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
+from dcsim.bench.cell_optimum import optimal_values, reachable_cells, working_cells
+from dcsim.bench.figures import pyplot
+from dcsim.bench.figures import save as save_figure
+from dcsim.bench.layered_optimum import LayeredOptimum, layered_optimum, optimality_gap
+from dcsim.bench.options import comma_numbers, comma_words, plugin_spec
 from dcsim.clearance import (
     Clearance,
     body_surface_distance,
@@ -170,12 +186,57 @@ from dcsim.robots.manipulator import (
 )
 from dcsim.robots.urdf import urdf_text as manipulator_urdf
 from dcsim.runs import RunResult, close_run, load_scenario, open_run, read_run, run
+from dcsim.scenario.loader import packaged_scenario_path
 from dcsim.scenario.model import MissionSettings
 
 if TYPE_CHECKING:
     import pandas
 
+    from dcsim.bench.path_problems import BenchProblem
+    from dcsim.bench.path_problems import expand_specs as expand_bench_specs
+    from dcsim.bench.path_problems import load_problem as load_bench_problem
+    from dcsim.shape_outlines import outline as shape_outline
+    from dcsim.shape_outlines import wireframe as shape_wireframe
+
+_LAZY = {
+    "BenchProblem": ("dcsim.bench.path_problems", "BenchProblem"),
+    "expand_bench_specs": ("dcsim.bench.path_problems", "expand_specs"),
+    "load_bench_problem": ("dcsim.bench.path_problems", "load_problem"),
+    "shape_outline": ("dcsim.shape_outlines", "outline"),
+    "shape_wireframe": ("dcsim.shape_outlines", "wireframe"),
+}
+"""Names loaded on first use: their modules load the missions and the world engine, or
+SciPy's spatial algorithms, which a plugin that does not use them need not wait for."""
+
+
+def __getattr__(name: str) -> Any:
+    """The names of :data:`_LAZY`, imported when first asked for."""
+    if name not in _LAZY:
+        raise AttributeError(f"module 'dcsim.api' has no attribute '{name}'")
+    module, attribute = _LAZY[name]
+    value = getattr(importlib.import_module(module), attribute)
+    globals()[name] = value
+    return value
+
+
 __all__ = [
+    "BenchProblem",
+    "comma_numbers",
+    "comma_words",
+    "expand_bench_specs",
+    "layered_optimum",
+    "LayeredOptimum",
+    "load_bench_problem",
+    "optimal_values",
+    "optimality_gap",
+    "packaged_scenario_path",
+    "plugin_spec",
+    "pyplot",
+    "reachable_cells",
+    "save_figure",
+    "shape_outline",
+    "shape_wireframe",
+    "working_cells",
     "close_run",
     "load_scenario",
     "open_run",

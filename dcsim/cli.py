@@ -7,9 +7,7 @@ no traceback; ``dcsim --debug ...`` shows the traceback instead.
 from __future__ import annotations
 
 import json
-import re
 import sys
-import time
 import warnings
 from collections.abc import Sequence
 from dataclasses import asdict
@@ -20,6 +18,7 @@ from typing import TYPE_CHECKING
 import click
 
 from dcsim import __version__
+from dcsim.bench.options import comma_numbers
 from dcsim.cli_campaign import campaign_group, cluster_choice, cluster_options
 from dcsim.errors import DcsimError, PluginLoadWarning, PluginNotFoundError, did_you_mean
 from dcsim.interfaces import PLUGIN_KINDS
@@ -37,8 +36,30 @@ if TYPE_CHECKING:  # the bench modules and the runner are imported by their comm
 EXIT_USER_ERROR = 2
 
 
-class _Group(click.Group):
-    """A click group that prints dcsim errors without a traceback."""
+class _PluginGroup(click.Group):
+    """A click group that also holds the commands plugin packages add to it.
+
+    The packages are asked (:mod:`dcsim.cli_plugins`) only when a command is not one of
+    dcsim's own, or when the commands are listed, once per command line.
+    """
+
+    hook_argument = "bench"
+    """The argument of ``dcsim_register_commands`` that stands for this group."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        """dcsim's own commands and the plugin packages', sorted."""
+        return sorted({*self.commands, *_plugin_commands(ctx)[self.hook_argument]})
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        """dcsim's own command of that name, else a plugin package's."""
+        own = self.commands.get(cmd_name)
+        return own if own is not None else _plugin_commands(ctx)[self.hook_argument].get(cmd_name)
+
+
+class _Group(_PluginGroup):
+    """The ``dcsim`` group: it prints dcsim errors without a traceback."""
+
+    hook_argument = "cli"
 
     def invoke(self, ctx: click.Context) -> object:
         try:
@@ -58,6 +79,21 @@ def _registry() -> PluginRegistry:
     for message in registry.warnings:
         click.echo(f"warning: {message}", err=True)
     return registry
+
+
+def _plugin_commands(ctx: click.Context) -> dict[str, dict[str, click.Command]]:
+    """The commands plugin packages add, by hook argument (asked once per command line;
+    refused ones are printed as warnings on stderr)."""
+    meta = ctx.find_root().meta
+    if "dcsim.plugin_commands" not in meta:
+        from dcsim.cli_plugins import plugin_commands
+
+        taken = {"cli": cli.commands, "bench": bench_group.commands}
+        found = plugin_commands(_registry(), taken)
+        for message in found.warnings:
+            click.echo(f"warning: {message}", err=True)
+        meta["dcsim.plugin_commands"] = found.commands
+    return meta["dcsim.plugin_commands"]
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
@@ -390,7 +426,9 @@ def new_plugin_command(kind: str, name: str, directory: Path) -> None:
     click.echo(f"next: pip install -e '{root}[test]' && (cd {root} && pytest)")
 
 
-@cli.group("bench", short_help="Measure dcsim and its plugins against references.")
+@cli.group(
+    "bench", cls=_PluginGroup, short_help="Measure dcsim and its plugins against references."
+)
 def bench_group() -> None:
     """Measure dcsim and its plugins; results go into docs/benchmarks.md."""
 
@@ -771,7 +809,7 @@ def bench_campaign_command(
         )
         if not campaign.exists():
             raise click.BadParameter("name a campaign file", param_hint="CAMPAIGN")
-    counts = [int(n) for n in _numbers(workers, "--workers") if n >= 1]
+    counts = [int(n) for n in comma_numbers(workers, "--workers") if n >= 1]
     with tempfile.TemporaryDirectory() as scratch:
         folder = out if out is not None else Path(scratch)
         bench = bench_campaign(
@@ -964,272 +1002,6 @@ def bench_grid_search_command(
         registry, scenario, budget, fly, lambda line: click.echo(line, err=True), params
     )
     click.echo(tables(cells))
-
-
-@bench_group.command(
-    "ant-colony", short_help="The ant-colony planner against its graph's exact optimum."
-)
-@click.option(
-    "--layouts",
-    type=int,
-    default=None,
-    help="Seeded obstacle layouts static-spheres:0 to N - 1 (default 100).",
-)
-@click.option(
-    "--problems",
-    default=None,
-    help="Comma-separated problems instead of the layouts: a family (static-spheres, "
-    "cw-spheres, shapes) with :SEED or :FIRST..LAST seeds, or a transfer scenario file.",
-)
-@click.option("--deltas", default="2,6", show_default=True, help="Comma-separated δ values, m².")
-@click.option(
-    "--cross-sections",
-    default="line,grid",
-    show_default=True,
-    help="Comma-separated cross-sections: line (the paper's), grid.",
-)
-@click.option(
-    "--variants",
-    default="defaults,paper",
-    show_default=True,
-    help="Comma-separated variants: defaults (the planner's), paper (the paper's literal "
-    "colony: visibility=length, local_search=false, deposit_by=all, pheromone_floor=0, "
-    "stall_cycles=242).",
-)
-@click.option(
-    "--params",
-    "extra",
-    default=None,
-    help="Further ant-colony parameters for every variant as key=value:key=value (e.g. ants=60).",
-)
-@click.option(
-    "--budget",
-    type=float,
-    default=None,
-    help="Planning budget of every whole plan, s (default: the problem's; 1 s for the families).",
-)
-@click.option(
-    "--figure",
-    "figure_path",
-    type=click.Path(dir_okay=False, path_type=Path),
-    default=None,
-    help="Write the paper's Fig. 2 regenerated on --figure-scenario (paths for every δ) "
-    "here, and the convergence curves beside it as NAME_convergence.png.",
-)
-@click.option(
-    "--figure-scenario",
-    default="scenarios/ffsr_obstacles.yaml",
-    show_default=True,
-    help="The problem drawn by --figure.",
-)
-@click.option(
-    "--plot",
-    "plot_path",
-    type=click.Path(dir_okay=False, path_type=Path),
-    default=None,
-    help="Save box plots of the gap and the plan time over the layouts per setting.",
-)
-def bench_ant_colony_command(
-    layouts: int | None,
-    problems: str | None,
-    deltas: str,
-    cross_sections: str,
-    variants: str,
-    extra: str | None,
-    budget: float | None,
-    figure_path: Path | None,
-    figure_scenario: str,
-    plot_path: Path | None,
-) -> None:
-    """The ant-colony planner against the exact optimum of its own candidate graph.
-
-    On every layout, for every cross-section, δ and variant: the colony's gap to the
-    optimum that dynamic programming finds on the same graph, its cycles, and the wall
-    times of the graph, the colony, the whole plan and the DP, beside the targets
-    (median gap ≤ 1 %, p95 ≤ 3 %, ≤ 0.5 s per plan with the line cross-section). Prints
-    Markdown tables for docs/benchmarks.md; progress goes to stderr.
-    """
-    from dcsim.bench import ant_colony as bench
-    from dcsim.bench.path_planners import planner_spec
-    from dcsim.bench.path_problems import expand_specs, load_problem
-
-    if layouts is not None and problems is not None:
-        raise DcsimError("give --layouts or --problems, not both")
-    if layouts is not None and layouts < 1:
-        raise DcsimError(f"--layouts must be at least 1, got {layouts}")
-    if budget is not None and not budget > 0:
-        raise DcsimError(f"--budget must be a positive number of seconds, got {budget:g}")
-    chosen = bench.settings(
-        _words(cross_sections, "--cross-sections"),
-        _numbers(deltas, "--deltas"),
-        _words(variants, "--variants"),
-    )
-    registry = _registry()
-    params = dict(planner_spec(registry, f"{bench.PLANNER}:{extra}").params) if extra else None
-    resolved = bench.check_params(registry, chosen, params)
-    specs = (
-        expand_specs(_words(problems, "--problems"))
-        if problems is not None
-        else [f"static-spheres:{seed}" for seed in range(100 if layouts is None else layouts)]
-    )
-    figure_problem = load_problem(figure_scenario) if figure_path is not None else None
-
-    def say(line: str) -> None:
-        click.echo(line, err=True)
-
-    say(f"loading problems: {len(specs)}")
-    loaded = [load_problem(spec) for spec in specs]
-    began = time.monotonic()
-    runs = bench.bench_ant_colony(registry, loaded, chosen, params, budget, say)
-    wall = time.monotonic() - began
-    click.echo(
-        f"ant-colony on {len(loaded)} problems ({_span(specs)}), {len(chosen)} settings, "
-        f"planner seed = problem index, whole-plan budget "
-        f"{'the problem' + chr(39) + 's' if budget is None else f'{budget:g} s'}; "
-        f"{wall:.0f} s of wall time"
-    )
-    click.echo("")
-    for variant in dict.fromkeys(s.variant for s in chosen):
-        label = next(s.label for s in chosen if s.variant == variant)
-        shown = {k: v for k, v in resolved[label].items() if k not in ("cross_section", "delta")}
-        click.echo(f"- {variant}: " + ", ".join(f"{k}={v}" for k, v in shown.items()))
-    click.echo("")
-    click.echo("Gap to the exact optimum of the same graph")
-    click.echo("")
-    click.echo(bench.quality_table(runs))
-    click.echo("")
-    click.echo("Wall time, ms")
-    click.echo("")
-    click.echo(bench.time_table(runs))
-    click.echo("")
-    click.echo("Targets met")
-    click.echo("")
-    click.echo(bench.target_table(runs))
-    notes = bench.unscored_lines(runs)
-    if notes:
-        click.echo("")
-        click.echo("Runs unscored, without a trajectory, or below the optimum")
-        click.echo("")
-        click.echo("\n".join(notes))
-    if figure_problem is not None and figure_path is not None:
-        say(f"figure: {figure_problem.name}")
-        scenario_runs = bench.bench_ant_colony(
-            registry, [figure_problem], chosen, params, budget, say
-        )
-        click.echo("")
-        click.echo(f"{figure_problem.name} (the paper's Fig. 2), planner seed 0")
-        click.echo("")
-        click.echo(bench.scenario_table(scenario_runs, figure_problem.problem))
-        figure_path.parent.mkdir(parents=True, exist_ok=True)
-        bench.paths_figure(scenario_runs, figure_problem, figure_path)
-        convergence = bench.convergence_path(figure_path)
-        bench.convergence_figure(scenario_runs, runs, figure_problem.name, convergence)
-        click.echo(f"\nfigures: {figure_path}, {convergence}")
-    if plot_path is not None:
-        plot_path.parent.mkdir(parents=True, exist_ok=True)
-        bench.distribution_plot(runs, plot_path)
-        click.echo(f"plot: {plot_path}")
-
-
-@bench_group.command("q-learning", short_help="The q-learning planner against value iteration.")
-@click.option(
-    "--scenario",
-    default="scenarios/space_manipulator_reach.yaml",
-    show_default=True,
-    help="A reach scenario: its robot, start, target and limits.",
-)
-@click.option(
-    "--episodes",
-    default="500,1000,2000",
-    show_default=True,
-    help="Comma-separated training lengths of the working-cells table.",
-)
-@click.option("--seeds", type=click.IntRange(1, 1000), default=5, show_default=True)
-@click.option(
-    "--margins",
-    default="1,2,3,4,5,6",
-    show_default=True,
-    help="Comma-separated grid margins (cells) of the environment-size sweep.",
-)
-@click.option(
-    "--size-episodes",
-    type=click.IntRange(1),
-    default=2000,
-    show_default=True,
-    help="Training episodes of the environment-size sweep and the reward curves.",
-)
-@click.option(
-    "--figures",
-    "figures_dir",
-    type=click.Path(file_okay=False, path_type=Path),
-    default=None,
-    help="Write q_learning_rewards.png, q_learning_sizes.png and the two application "
-    "cases' q_learning_start_a.png and q_learning_start_b.png here.",
-)
-def bench_q_learning_command(
-    scenario: str,
-    episodes: str,
-    seeds: int,
-    margins: str,
-    size_episodes: int,
-    figures_dir: Path | None,
-) -> None:
-    """The q-learning planner against the exact answers of its cell environment.
-
-    The thesis's Table 7.3 (working cells for its three (α, γ) at equal episodes, as a
-    share of the cells from which the target can be reached at all), the greedy return's
-    gap to the optimum that value iteration finds, the cumulative reward per episode
-    (Figs 7.2-7.3), build and training time against the environment's size (Fig. 7.4),
-    and the two application cases of §7.4 with the arm's state along their paths (Figs
-    7.5-7.13). Prints Markdown tables for docs/benchmarks.md; progress goes to stderr.
-    """
-    from dcsim.bench import q_learning as bench
-    from dcsim.robots.loading import load_reach_problem
-
-    counts = [int(v) for v in _numbers(episodes, "--episodes")]
-    widths = [int(v) for v in _numbers(margins, "--margins")]
-    progress = lambda line: click.echo(line, err=True)  # noqa: E731
-    problem = load_reach_problem(scenario)
-    rows, reachable, cells = bench.working_table(problem, counts, seeds, progress=progress)
-    sizes = bench.size_sweep(problem, widths, size_episodes, progress=progress)
-    cases = bench.run_applications(scenario)
-    click.echo(bench.markdown(rows, reachable, cells, sizes, cases))
-    if figures_dir is not None:
-        figures_dir.mkdir(parents=True, exist_ok=True)
-        bench.plot_curves(
-            bench.reward_curves(problem, size_episodes), figures_dir / "q_learning_rewards.png"
-        )
-        bench.plot_sizes(sizes, figures_dir / "q_learning_sizes.png")
-        target = bench.target_of(scenario)
-        for case, name in zip(cases, ("start_a", "start_b"), strict=True):
-            bench.plot_application(case, target, figures_dir / f"q_learning_{name}.png")
-        click.echo(f"\nfigures in {figures_dir}")
-
-
-def _words(text: str, option: str) -> list[str]:
-    """The comma-separated words of an option (an error when there are none)."""
-    words = [word.strip() for word in text.split(",") if word.strip()]
-    if not words:
-        raise DcsimError(f"{option}: name at least one")
-    return words
-
-
-def _numbers(text: str, option: str) -> list[float]:
-    """The comma-separated numbers of an option."""
-    try:
-        return [float(word) for word in _words(text, option)]
-    except ValueError:
-        raise DcsimError(f"{option}: expected numbers like 2,6, got {text!r}") from None
-
-
-def _span(specs: Sequence[str]) -> str:
-    """``static-spheres:0..99`` for consecutive seeds of one family, else the specs."""
-    match = [re.fullmatch(r"([a-z-]+):(\d+)", spec) for spec in specs]
-    if all(match) and len({m[1] for m in match}) == 1:
-        seeds = [int(m[2]) for m in match]
-        if seeds == list(range(seeds[0], seeds[0] + len(seeds))) and len(seeds) > 1:
-            return f"{match[0][1]}:{seeds[0]}..{seeds[-1]}"
-    return ", ".join(specs)
 
 
 @bench_group.command(

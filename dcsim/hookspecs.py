@@ -5,7 +5,8 @@ entry-point group. Modules implement the hooks below, marked with
 :data:`hookimpl`: :func:`dcsim_plugin_classes` provides plugin classes, and the
 lifecycle hooks :func:`dcsim_run_start`, :func:`dcsim_run_step`,
 :func:`dcsim_run_event` and :func:`dcsim_run_end` let a package observe runs (a
-telemetry writer, a live report)::
+telemetry writer, a live report), and :func:`dcsim_register_commands` adds commands to
+the ``dcsim`` command line (a plugin's own bench)::
 
     from dcsim.api import hookimpl
 
@@ -26,6 +27,8 @@ import pluggy
 from dcsim.interfaces import Plugin
 
 if TYPE_CHECKING:
+    import click
+
     from dcsim.scenario.model import Scenario
 
 PROJECT_NAME = "dcsim"
@@ -68,6 +71,30 @@ def dcsim_plugin_classes() -> list[type[Plugin]]:
     -------
     list of type
         The plugin classes; their order does not matter.
+    """
+
+
+@hookspec
+def dcsim_register_commands(cli: click.Group, bench: click.Group) -> None:
+    """Add commands to the ``dcsim`` command line.
+
+    Called once when a ``dcsim`` command line needs a command it does not hold itself
+    (``dcsim --help``, ``dcsim bench NAME``). Add click commands or groups to either
+    group; the implementation may take only the arguments it uses::
+
+        @hookimpl
+        def dcsim_register_commands(bench):
+            bench.add_command(my_bench_command)      # dcsim bench my-planner
+
+    A name dcsim's own commands or another package already use is refused with a
+    warning, and so is every command of an implementation that raises.
+
+    Parameters
+    ----------
+    cli : click.Group
+        Commands added here run as ``dcsim NAME``.
+    bench : click.Group
+        Commands added here run as ``dcsim bench NAME``.
     """
 
 

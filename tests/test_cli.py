@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import re
 
+import click
 import pytest
 import yaml
 
@@ -251,11 +252,14 @@ def test_every_help_lists_its_commands_with_whole_one_line_descriptions(dcsim_cl
     from dcsim.cli import cli
 
     found = cli
+    context = click.Context(cli)  # the plugin packages' commands too
     for name in group:
-        found = found.commands[name]
+        found = found.get_command(context, name)
+    names = found.list_commands(context)
     lines = dcsim_cli(*group, "--help").stdout.split("Commands:\n")[1].splitlines()
-    assert len(lines) == len(found.commands)  # one line each, none wrapped
-    for name, command in found.commands.items():
+    assert len(lines) == len(names)  # one line each, none wrapped
+    for name in names:
+        command = found.get_command(context, name)
         line = next(line for line in lines if line.split()[0] == name)
         description = command.get_short_help_str(limit=1000)
         assert description.endswith(".") and "..." not in line

@@ -1,4 +1,5 @@
-"""Exact answers on a deterministic cell environment, the yardstick of the Q-learning planner.
+"""Exact answers on a deterministic cell task, the yardstick of tabular learners such as the
+``q-learning`` planner (its own ``dcsim bench q-learning``; public through ``dcsim.api``).
 
 The environment (``next_cell`` and ``reward``, cells × actions; ``ends``: cells whose entry
 ends an episode) is a deterministic Markov decision process. Value iteration

@@ -1,7 +1,8 @@
-"""The exact optimum of a layered path objective: the reference of the ant colony bench.
+"""The exact optimum of a layered path objective: a yardstick for layered-graph planners.
 
-The ant colony planner (the ant colony paper) chooses one node in each layer of a graph whose
-layers are cross-sections of the start-goal segment, and scores a path by
+A planner such as the ant colony of the ant colony paper chooses one node in each layer
+of a graph whose layers are cross-sections of the start-goal segment, and scores a path
+by
 
     F = Σᵢ w_i(kᵢ, kᵢ₊₁) + Σᵢ c_i(kᵢ)
 
@@ -12,11 +13,10 @@ plus the least, over the nodes of layer i, of the cheapest way there plus the ed
 Each layer is one numpy minimum over the predecessors (broadcast over every pair), so
 the cost is O(m P²) for m layers of P nodes.
 
-The graph is passed as arrays, so this module needs no plugin: the ``ant-colony``
-planner, taken from the registry, gives its graph (``planner.candidate_graph(problem)``,
-with ``lengths`` and ``node_cost``) and runs its colony on it (``planner.colony(graph)``,
-whose ``cost`` and per-cycle ``history`` are scored against the optimum of exactly that
-graph with :func:`optimality_gap`).
+The graph is passed as plain arrays, so the yardstick knows no planner: a planner's own
+bench (the ``ant-colony`` plugin's ``dcsim bench ant-colony``) hands it the arrays of
+the graph it searched and scores its answer against the optimum of exactly that graph
+with :func:`optimality_gap`. Public as ``dcsim.api.layered_optimum``.
 """
 
 from __future__ import annotations

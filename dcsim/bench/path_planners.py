@@ -38,8 +38,8 @@ from multiprocessing.connection import Connection
 from typing import Any
 
 import numpy as np
-import yaml
 
+from dcsim.bench.options import plugin_spec
 from dcsim.bench.path_problems import BenchProblem
 from dcsim.clearance import path_clearance
 from dcsim.errors import DcsimError
@@ -436,13 +436,7 @@ def select_planners(registry: PluginRegistry, names: Sequence[str] | None) -> li
 
 def planner_spec(registry: PluginRegistry, spec: str) -> PlannerChoice:
     """The planner and parameters of ``NAME[:key=value...]``."""
-    name, *assignments = spec.split(":")
-    params = {}
-    for assignment in assignments:
-        key, equals, value = assignment.partition("=")
-        if not equals or not key:
-            raise DcsimError(f"'{assignment}' in '{spec}' is not key=value")
-        params[key] = yaml.safe_load(value)
+    name, params = plugin_spec(spec)
     choice = PlannerChoice(registry.get("path_planner", name), params)
     choice.settings()  # an invalid parameter is an error now, not in every run
     return choice

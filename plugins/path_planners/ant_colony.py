@@ -28,7 +28,7 @@ Flight (:mod:`polyline_flight`)
 Departures from the paper (each a parameter; the defaults use them)
     The paper's constants are the defaults (α = 1, β = 5, ρ = 0.526, Q = 320, 30 ants,
     m = 40, 242 cycles, δ = 2), but its colony, scored against the exact optimum of the
-    same graph (``dcsim.bench.layered_optimum``), stops far above it: with β = 5 and
+    same graph (``dcsim.api.layered_optimum``), stops far above it: with β = 5 and
     ``η = 1/d_pq`` the ants hardly ever step sideways before an obstacle forces them to,
     so the δ term, which the visibility does not see, is left to the pheromone, and the
     pheromone of the first cycles' paths (Q/F against C) fixes the colony on one of
@@ -45,10 +45,11 @@ Moving obstacles (an extension; the paper's are at rest)
 Statistics: ``cycles`` (cycles run), ``ants``, ``best_cost`` (F of the answer),
 ``converged`` (1 if the colony converged before ``max_cycles`` and the budget),
 ``nodes`` (usable candidate points), ``waypoints`` (vertices flown). The best cost of
-every cycle is in :class:`~colony.ColonyResult`. A benchmark reaches both halves through
-the registered class, without importing these modules: ``planner.candidate_graph(problem)``
+every cycle is in :class:`~colony.ColonyResult`. The plugin's own bench
+(:mod:`ant_colony_bench`, ``dcsim bench ant-colony``, added through the
+``dcsim_register_commands`` hook) reaches both halves: ``planner.candidate_graph(problem)``
 is the graph :meth:`~AntColonyPlanner.plan` searches (its ``lengths`` and
-``node_cost`` are what ``dcsim.bench.layered_optimum`` minimises exactly) and
+``node_cost`` are what ``dcsim.api.layered_optimum`` minimises exactly) and
 ``planner.colony(graph)`` runs the colony on it with the planner's generator.
 """
 
@@ -56,7 +57,7 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from dcsim_plugins.path_planners.colony import ColonyResult, solve_colony
@@ -84,6 +85,9 @@ from dcsim.api import (
     hookimpl,
     quantity,
 )
+
+if TYPE_CHECKING:
+    import click
 
 PAPER_PARTS = 40
 """The paper's number of equal parts m."""
@@ -210,8 +214,7 @@ class AntColonyPlanner(PathPlanner):
     def candidate_graph(self, problem: PathProblem) -> LayeredGraph:
         """The graph :meth:`plan` searches for ``problem`` (:func:`~layered_graph.build_graph`
         with this planner's parameters), for scoring the colony against the exact optimum
-        of the same graph (``dcsim.bench.layered_optimum``) without importing the
-        plugin's modules.
+        of the same graph (``dcsim.api.layered_optimum``).
 
         Raises
         ------
@@ -281,3 +284,11 @@ class AntColonyPlanner(PathPlanner):
 def dcsim_plugin_classes() -> list[type]:
     """Register the ant colony path planner."""
     return [AntColonyPlanner]
+
+
+@hookimpl
+def dcsim_register_commands(bench: click.Group) -> None:
+    """Add ``dcsim bench ant-colony``: the colony against its graph's exact optimum."""
+    from dcsim_plugins.path_planners.ant_colony_bench import command
+
+    bench.add_command(command)

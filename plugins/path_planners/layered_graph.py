@@ -2,7 +2,7 @@
 start-goal segment (eqs 4–9 of the ant colony paper).
 
 Not a plugin itself; :mod:`ant_colony` builds it (:func:`build_graph`), :mod:`colony`
-searches it and ``dcsim.bench.layered_optimum`` solves it exactly.
+searches it and ``dcsim.api.layered_optimum`` solves it exactly.
 
 Candidate graph (:func:`build_graph`, eqs 4–5)
     The segment from the start S to the goal G is cut into ``parts`` (m) equal parts of

@@ -18,6 +18,10 @@ problem's speed and acceleration limits (:func:`minimum_jerk_legs`): a staircase
 cell by cell would stop at every cell. "No path" when the target is beyond the arm's
 reach, when its cell breaks a constraint, or when the greedy path enters a terminal
 cell, comes back to a cell, or does not arrive.
+
+Beside the planner: its bench (:mod:`q_learning_bench`, ``dcsim bench q-learning``,
+added through the ``dcsim_register_commands`` hook) and its cell task as a Gymnasium
+environment (:mod:`q_learning_gym`).
 """
 
 from __future__ import annotations
@@ -27,6 +31,7 @@ import os
 import tempfile
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from dcsim_plugins.path_planners.cell_environment import (
@@ -56,6 +61,9 @@ from dcsim.api import (
     hookimpl,
     quantity,
 )
+
+if TYPE_CHECKING:
+    import click
 
 
 class QLearningParams(PluginParams):
@@ -336,3 +344,11 @@ def _save(path: Path, q: np.ndarray, fingerprint: str) -> None:
 def dcsim_plugin_classes() -> list[type]:
     """Register the Q-learning planner."""
     return [QLearningPlanner]
+
+
+@hookimpl
+def dcsim_register_commands(bench: click.Group) -> None:
+    """Add ``dcsim bench q-learning``: the planner against value iteration on its cells."""
+    from dcsim_plugins.path_planners.q_learning_bench import command
+
+    bench.add_command(command)

@@ -5,12 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from dcsim_plugins.path_planners import ant_colony_bench as bench
+from dcsim_plugins.path_planners.ant_colony import AntColonyPlanner
 
-from dcsim.bench import ant_colony as bench
-from dcsim.bench.layered_optimum import layered_optimum
-from dcsim.bench.path_problems import load_problem
+from dcsim.api import layered_optimum, load_bench_problem
 from dcsim.cli import cli
-from dcsim.registry import PluginRegistry
 from tests.conftest import REPO
 
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -18,35 +17,29 @@ SETTINGS = bench.settings(["line"], [2.0], ["defaults", "paper"])
 
 
 @pytest.fixture(scope="module")
-def registry():
-    return PluginRegistry.discover()
-
-
-@pytest.fixture(scope="module")
 def layouts():
-    return [load_problem(f"static-spheres:{seed}") for seed in range(2)]
+    return [load_bench_problem(f"static-spheres:{seed}") for seed in range(2)]
 
 
 @pytest.fixture(scope="module")
-def runs(registry, layouts):
+def runs(layouts):
     lines = []  # a generous budget: a busy machine must not cut the whole plan's colony
-    runs = bench.bench_ant_colony(registry, layouts, SETTINGS, budget=30.0, progress=lines.append)
+    runs = bench.bench_ant_colony(layouts, SETTINGS, budget=30.0, progress=lines.append)
     return runs, lines
 
 
-def test_every_run_is_a_real_colony_scored_on_a_graph_rebuilt_here(registry, layouts, runs):
+def test_every_run_is_a_real_colony_scored_on_a_graph_rebuilt_here(layouts, runs):
     runs, progress = runs
     assert [(r.problem, r.setting) for r in runs] == [
         (layout.name, setting) for layout in layouts for setting in SETTINGS
     ]
     assert len(progress) == 2 and progress[-1].startswith("[2/2] static-spheres-1: ")
     assert "ETA" in progress[0]
-    cls = registry.get("path_planner", bench.PLANNER).cls
     for run in runs:
         assert run.scored and run.answered, (run.reason, run.plan_reason)
         seed = [layout.name for layout in layouts].index(run.problem)
         assert run.seed == seed
-        planner = cls(run.setting.params(), np.random.default_rng(seed))
+        planner = AntColonyPlanner(run.setting.params(), np.random.default_rng(seed))
         graph = planner.candidate_graph(layouts[seed].problem)
         assert layered_optimum(graph.lengths, graph.node_cost).cost == run.optimum
         again = planner.colony(graph)  # the same generator: the same colony
@@ -169,13 +162,12 @@ def test_the_convergence_figure_sits_beside_the_paths_figure(tmp_path):
     assert bench.convergence_path(tmp_path / "b") == tmp_path / "b_convergence.png"
 
 
-def test_a_whole_plan_cut_short_by_its_budget_is_counted(registry, layouts):
+def test_a_whole_plan_cut_short_by_its_budget_is_counted(layouts):
     setting = SETTINGS[0]
-    cls = bench.planner_class(registry)
-    unhurried = bench.run_setting(cls, layouts[0], setting, 0)
+    unhurried = bench.run_setting(layouts[0], setting, 0)
     # a third of what the whole plan took here: the cut holds however fast the machine,
     # and the candidate graph (about an eighth of the plan) is still built in time
-    run = bench.run_setting(cls, layouts[0], setting, 0, budget=unhurried.plan_seconds / 3)
+    run = bench.run_setting(layouts[0], setting, 0, budget=unhurried.plan_seconds / 3)
     assert run.scored and run.cycles > 1  # the measured colony has no deadline
     assert run.plan_cycles < run.cycles and run.cut_by_budget
     row = next(line for line in bench.time_table([run]).splitlines() if "| line |" in line)

@@ -1,19 +1,22 @@
 """The space manipulator's reach as a Gymnasium environment (optional extra ``rl``).
 
 ``dcsim/ManipulatorReachCells-v0`` is the cell task of the ``q-learning`` planner (the
-the space manipulator thesis, §5.5): the end effector moves one cell of a 3-D grid per step (six
+space manipulator thesis, §5.5): the end effector moves one cell of a 3-D grid per step (six
 actions: +z, −z, −y, +y, +x, −x; no move past the grid's edge), entering the target's
 cell ends the episode with the target reward, entering a cell where the arm breaks a
 joint limit, meets a singularity or loses sight of the target ends it with the
 terminal reward, and any other move pays the step reward (less where the base moves
 more than half as far as the end effector). The grid, the arm's state at each cell and
 every reward are those the planner builds for the reach scenario (its parameters set
-them), so any Gymnasium agent trains on exactly the planner's task::
+them), so any Gymnasium agent trains on exactly the planner's task. The environment
+lives with the planner; importing this module registers it, and Gymnasium imports the
+module itself when the id names it (also in a fresh process or a vector env's worker)::
 
     import gymnasium
-    import dcsim.gym  # registers the environment
 
-    env = gymnasium.make("dcsim/ManipulatorReachCells-v0")
+    env = gymnasium.make(
+        "dcsim_plugins.path_planners.q_learning_gym:dcsim/ManipulatorReachCells-v0"
+    )
     observation, info = env.reset(seed=1)
     observation, reward, terminated, truncated, info = env.step(4)   # +x
 
@@ -30,11 +33,10 @@ from typing import Any
 
 import gymnasium
 import numpy as np
+from dcsim_plugins.path_planners.q_learning import QLearningPlanner
 from gymnasium import spaces
 
-from dcsim.registry import PluginRegistry
-from dcsim.robots.loading import load_reach_problem
-from dcsim.scenario.loader import packaged_scenario_path
+from dcsim.api import load_reach_problem, packaged_scenario_path
 
 ENVIRONMENT_ID = "dcsim/ManipulatorReachCells-v0"
 """The id ``gymnasium.make`` knows the environment by, once this module is imported."""
@@ -69,9 +71,7 @@ class ReachCellsEnv(gymnasium.Env):
             packaged_scenario_path("space_manipulator_reach.yaml") if scenario is None else scenario
         )
         problem = load_reach_problem(path, start)
-        planner = PluginRegistry.discover().create(
-            "path_planner", "q-learning", planner_params or {}, np.random.default_rng(0)
-        )
+        planner = QLearningPlanner(planner_params or {}, np.random.default_rng(0))
         self.cells = planner.environment(problem)
         self.max_steps = max_steps
         self.observation_space = spaces.Discrete(self.cells.cells)

@@ -3,18 +3,23 @@ rewards and ends step by step."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import gymnasium
 import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-import dcsim.gym  # noqa: F401  (registers the environment)
-from dcsim.gym import ENVIRONMENT_ID
+MODULE = "dcsim_plugins.path_planners.q_learning_gym"
+"""The module that registers the environment when imported."""
+ENVIRONMENT_ID = "dcsim/ManipulatorReachCells-v0"
 
 
 @pytest.fixture(scope="module")
 def env():
-    environment = gymnasium.make(ENVIRONMENT_ID, planner_params={"margin": 0})
+    # the module:id form imports the module, as a fresh process or a vector env's worker would
+    environment = gymnasium.make(f"{MODULE}:{ENVIRONMENT_ID}", planner_params={"margin": 0})
     yield environment
     environment.close()
 
@@ -44,3 +49,21 @@ def test_random_starts_are_seeded_and_bad_actions_refused(env):
     assert first[0] == first[1]
     with pytest.raises(ValueError, match="action"):
         env.step(6)
+
+
+def test_a_fresh_process_makes_the_environment_by_its_module_and_id():
+    made = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import gymnasium\n"
+            f"env = gymnasium.make('{MODULE}:{ENVIRONMENT_ID}', planner_params={{'margin': 0}})\n"
+            "print(env.reset(seed=1)[0])",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert made.returncode == 0, made.stderr
+    start = gymnasium.make(f"{MODULE}:{ENVIRONMENT_ID}", planner_params={"margin": 0})
+    assert made.stdout.split() == [str(start.unwrapped.cells.start)]

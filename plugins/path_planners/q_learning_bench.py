@@ -3,10 +3,12 @@ own cell environment (the space manipulator thesis, §7.3–7.4).
 
 The problems are the reach of a manipulator scenario (default
 ``scenarios/space_manipulator_reach.yaml``): its robot and start, its target, its
-speed and acceleration limits. The planner is reached through the plugin registry only:
+speed and acceleration limits. The bench lives with its planner and uses it directly:
 ``planner.environment(problem)`` gives the cell environment, ``planner.train(env)`` a
 trained table with the planner's generator, ``planner.plan(problem)`` the whole answer.
-Exact answers on the same environment come from :mod:`dcsim.bench.cell_optimum`.
+Exact answers on the same environment come from ``dcsim.api.optimal_values``,
+``reachable_cells`` and ``working_cells``. The plugin adds the command to ``dcsim
+bench`` through the ``dcsim_register_commands`` hook, as a third party's package would.
 
 - **Working cells** (Table 7.3): for each (α, γ) and number of episodes, over seeds, the
   share of the cells from which the target can be reached at all whose greedy path gets
@@ -28,14 +30,22 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import click
 import numpy as np
+from dcsim_plugins.path_planners.q_learning import QLearningPlanner
 
-from dcsim.bench.cell_optimum import optimal_values, reachable_cells, working_cells
-from dcsim.bench.figures import pyplot, save
-from dcsim.messages import PathProblem, Trajectory
-from dcsim.registry import PluginRegistry
-from dcsim.robots.loading import load_reach_problem
-from dcsim.scenario.loader import load_scenario
+from dcsim.api import (
+    PathProblem,
+    Trajectory,
+    comma_numbers,
+    load_reach_problem,
+    load_scenario,
+    optimal_values,
+    pyplot,
+    reachable_cells,
+    save_figure,
+    working_cells,
+)
 
 THESIS_SETTINGS = ((0.9, 0.9), (0.5, 0.8), (0.2, 0.5))
 """The (α, γ) pairs of the thesis's Table 7.3."""
@@ -46,9 +56,8 @@ SECOND_START = (1.2, 0.9, -1.1)
 Progress = Callable[[str], None]
 
 
-def _planner(params: dict[str, Any], seed: int):
-    registry = PluginRegistry.discover()
-    return registry.create("path_planner", "q-learning", params, np.random.default_rng(seed))
+def _planner(params: dict[str, Any], seed: int) -> QLearningPlanner:
+    return QLearningPlanner(params, np.random.default_rng(seed))
 
 
 # --------------------------------------------------------------------- working cells
@@ -339,7 +348,7 @@ def plot_curves(curves: dict[tuple[float, float], np.ndarray], path: Path) -> No
         axis.grid(alpha=0.3)
     np.atleast_1d(axes)[0].set_ylabel("summed reward")
     np.atleast_1d(axes)[0].legend(fontsize=8)
-    save(figure, path)
+    save_figure(figure, path)
 
 
 def plot_sizes(sizes: Sequence[SizeRow], path: Path) -> None:
@@ -352,7 +361,7 @@ def plot_sizes(sizes: Sequence[SizeRow], path: Path) -> None:
     axis.set(xlabel="cells", ylabel="wall time [s]", title="Cost against environment size")
     axis.grid(alpha=0.3)
     axis.legend()
-    save(figure, path)
+    save_figure(figure, path)
 
 
 def plot_application(case: Application, target: np.ndarray, path: Path) -> None:
@@ -387,7 +396,7 @@ def plot_application(case: Application, target: np.ndarray, path: Path) -> None:
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     figure.suptitle(f"q-learning from {np.round(case.start, 3).tolist()} m")
-    save(figure, path)
+    save_figure(figure, path)
 
 
 def run_applications(scenario: str | Path, seed: int = 0) -> list[Application]:
@@ -401,3 +410,74 @@ def run_applications(scenario: str | Path, seed: int = 0) -> list[Application]:
 def target_of(scenario: str | Path) -> np.ndarray:
     """The scenario's target, m."""
     return np.asarray(load_scenario(scenario).mission.target, dtype=float)
+
+
+# --------------------------------------------------------------------- command
+@click.command("q-learning", short_help="The q-learning planner against value iteration.")
+@click.option(
+    "--scenario",
+    default="scenarios/space_manipulator_reach.yaml",
+    show_default=True,
+    help="A reach scenario: its robot, start, target and limits.",
+)
+@click.option(
+    "--episodes",
+    default="500,1000,2000",
+    show_default=True,
+    help="Comma-separated training lengths of the working-cells table.",
+)
+@click.option("--seeds", type=click.IntRange(1, 1000), default=5, show_default=True)
+@click.option(
+    "--margins",
+    default="1,2,3,4,5,6",
+    show_default=True,
+    help="Comma-separated grid margins (cells) of the environment-size sweep.",
+)
+@click.option(
+    "--size-episodes",
+    type=click.IntRange(1),
+    default=2000,
+    show_default=True,
+    help="Training episodes of the environment-size sweep and the reward curves.",
+)
+@click.option(
+    "--figures",
+    "figures_dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=None,
+    help="Write q_learning_rewards.png, q_learning_sizes.png and the two application "
+    "cases' q_learning_start_a.png and q_learning_start_b.png here.",
+)
+def command(
+    scenario: str,
+    episodes: str,
+    seeds: int,
+    margins: str,
+    size_episodes: int,
+    figures_dir: Path | None,
+) -> None:
+    """The q-learning planner against the exact answers of its cell environment.
+
+    The thesis's Table 7.3 (working cells for its three (α, γ) at equal episodes, as a
+    share of the cells from which the target can be reached at all), the greedy return's
+    gap to the optimum that value iteration finds, the cumulative reward per episode
+    (Figs 7.2-7.3), build and training time against the environment's size (Fig. 7.4),
+    and the two application cases of §7.4 with the arm's state along their paths (Figs
+    7.5-7.13). Prints Markdown tables for docs/benchmarks.md; progress goes to stderr.
+    """
+    counts = [int(v) for v in comma_numbers(episodes, "--episodes")]
+    widths = [int(v) for v in comma_numbers(margins, "--margins")]
+    progress = lambda line: click.echo(line, err=True)  # noqa: E731
+    problem = load_reach_problem(scenario)
+    rows, reachable, cells = working_table(problem, counts, seeds, progress=progress)
+    sizes = size_sweep(problem, widths, size_episodes, progress=progress)
+    cases = run_applications(scenario)
+    click.echo(markdown(rows, reachable, cells, sizes, cases))
+    if figures_dir is not None:
+        figures_dir.mkdir(parents=True, exist_ok=True)
+        plot_curves(reward_curves(problem, size_episodes), figures_dir / "q_learning_rewards.png")
+        plot_sizes(sizes, figures_dir / "q_learning_sizes.png")
+        target = target_of(scenario)
+        for case, name in zip(cases, ("start_a", "start_b"), strict=True):
+            plot_application(case, target, figures_dir / f"q_learning_{name}.png")
+        click.echo(f"\nfigures in {figures_dir}")

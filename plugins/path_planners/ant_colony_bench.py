@@ -3,14 +3,16 @@
 The ``ant-colony`` path planner (after the ant colony paper) searches a layered graph: one candidate
 point per cross-section of the start-goal segment, objective ``F = L + δ Σ 1/d_min``.
 Because F is a sum of per-edge and per-node terms, the exact optimum of the same graph is
-a dynamic programme (:mod:`dcsim.bench.layered_optimum`); this bench runs the colony on
+a dynamic programme (``dcsim.api.layered_optimum``); this bench runs the colony on
 seeded obstacle layouts and reports how far above that optimum it stops.
 
-The planner is reached through the plugin registry only (the framework does not import
-plugins): ``planner.candidate_graph(problem)`` gives the graph (``lengths``,
-``node_cost``), ``planner.colony(graph)`` runs the colony on it with the planner's
-generator, and ``planner.plan(problem)`` is the whole plan (graph, colony, simplified
-and timed trajectory, swept clearance check).
+The bench lives with its planner and uses it directly: ``planner.candidate_graph(problem)``
+gives the graph (``lengths``, ``node_cost``), ``planner.colony(graph)`` runs the colony
+on it with the planner's generator, and ``planner.plan(problem)`` is the whole plan
+(graph, colony, simplified and timed trajectory, swept clearance check). The plugin adds
+the command to ``dcsim bench`` through the ``dcsim_register_commands`` hook
+(:func:`~dcsim_plugins.path_planners.ant_colony.dcsim_register_commands`), as a third
+party's package would.
 
 For every layout, cross-section (``line``, the paper's, or ``grid``), δ and variant:
 
@@ -36,24 +38,40 @@ DP optimum on that scenario and over the benchmark's layouts.
 from __future__ import annotations
 
 import math
+import re
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+import click
 import numpy as np
+from dcsim_plugins.path_planners.ant_colony import AntColonyPlanner
 
-from dcsim.bench.figures import pyplot, save
-from dcsim.bench.layered_optimum import layered_optimum, optimality_gap
-from dcsim.bench.path_problems import BenchProblem
-from dcsim.clearance import path_clearance
-from dcsim.errors import DcsimError
-from dcsim.messages import NoPath, PathProblem, Shape, ShapeKind, Trajectory
-from dcsim.registry import PluginRegistry
-from dcsim.shape_outlines import outline, wireframe
+from dcsim.api import (
+    BenchProblem,
+    DcsimError,
+    NoPath,
+    PathProblem,
+    Shape,
+    ShapeKind,
+    Trajectory,
+    comma_numbers,
+    comma_words,
+    expand_bench_specs,
+    layered_optimum,
+    load_bench_problem,
+    optimality_gap,
+    path_clearance,
+    plugin_spec,
+    pyplot,
+    save_figure,
+    shape_outline,
+    shape_wireframe,
+)
 
-PLANNER = "ant-colony"
+PLANNER = AntColonyPlanner.name
 """The registered name of the planner benchmarked."""
 
 PAPER_LITERAL: dict[str, Any] = {
@@ -244,7 +262,6 @@ def gap_percent(cost: float, optimum: float) -> float:
 
 
 def run_setting(
-    planner_class: type,
     bench: BenchProblem,
     setting: Setting,
     seed: int,
@@ -255,8 +272,6 @@ def run_setting(
 
     Parameters
     ----------
-    planner_class : type
-        The registered ``ant-colony`` class.
     bench : BenchProblem
         The problem.
     setting : Setting
@@ -271,7 +286,7 @@ def run_setting(
     params = setting.params(extra)
     problem = bench.problem if budget is None else replace(bench.problem, time_budget=budget)
     base = {"problem": bench.name, "setting": setting, "seed": seed}
-    planner = planner_class(params, np.random.default_rng(seed))
+    planner = AntColonyPlanner(params, np.random.default_rng(seed))
     began = time.perf_counter()
     try:
         graph = planner.candidate_graph(problem)
@@ -288,7 +303,7 @@ def run_setting(
         began = time.perf_counter()
         colony = planner.colony(graph)
         colony_seconds = time.perf_counter() - began
-        whole = planner_class(params, np.random.default_rng(seed))
+        whole = AntColonyPlanner(params, np.random.default_rng(seed))
         began = time.perf_counter()
         answer = whole.plan(problem)
         plan_seconds = time.perf_counter() - began
@@ -323,13 +338,8 @@ def run_setting(
     )
 
 
-def planner_class(registry: PluginRegistry) -> type:
-    """The registered ``ant-colony`` class (a DcsimError when it is not installed)."""
-    return registry.get("path_planner", PLANNER).cls
-
-
 def check_params(
-    registry: PluginRegistry, chosen: Sequence[Setting], extra: Mapping[str, Any] | None
+    chosen: Sequence[Setting], extra: Mapping[str, Any] | None
 ) -> dict[str, dict[str, Any]]:
     """Every setting's full parameters (defaults included), validated before any run.
 
@@ -338,12 +348,11 @@ def check_params(
     DcsimError
         If the planner refuses a setting's parameters.
     """
-    cls = planner_class(registry)
-    return {s.label: cls.Params.parse(PLANNER, s.params(extra)).model_dump() for s in chosen}
+    parse = AntColonyPlanner.Params.parse
+    return {s.label: parse(PLANNER, s.params(extra)).model_dump() for s in chosen}
 
 
 def bench_ant_colony(
-    registry: PluginRegistry,
     problems: Sequence[BenchProblem],
     chosen: Sequence[Setting],
     extra: Mapping[str, Any] | None = None,
@@ -355,11 +364,10 @@ def bench_ant_colony(
     One progress line per problem: its worst gap and slowest plan, the time so far and
     an estimate of the time left.
     """
-    cls = planner_class(registry)
     runs: list[Run] = []
     began = time.monotonic()
     for k, bench in enumerate(problems):
-        mine = [run_setting(cls, bench, s, k, extra, budget) for s in chosen]
+        mine = [run_setting(bench, s, k, extra, budget) for s in chosen]
         runs += mine
         elapsed = time.monotonic() - began
         left = elapsed / (k + 1) * (len(problems) - k - 1)
@@ -609,7 +617,7 @@ def paths_figure(runs: Sequence[Run], bench: BenchProblem, path: Path) -> None:
     start = np.asarray(problem.start.position, float)
     points = [start[None], *(r.positions for r in shown if r.positions is not None)]
     for shape, centre, _ in bodies:
-        reach = np.abs(np.vstack(wireframe(shape))).max(axis=0)
+        reach = np.abs(np.vstack(shape_wireframe(shape))).max(axis=0)
         points += [(centre - reach)[None], (centre + reach)[None]]
     lower, upper = np.vstack(points).min(axis=0), np.vstack(points).max(axis=0)
     pad = 0.05 * float((upper - lower).max())
@@ -631,7 +639,7 @@ def paths_figure(runs: Sequence[Run], bench: BenchProblem, path: Path) -> None:
     figure = plt.figure(figsize=(13, 11))
     axis3 = figure.add_subplot(2, 2, 1, projection="3d")
     for shape, centre, colour in bodies:
-        for line in wireframe(shape):
+        for line in shape_wireframe(shape):
             axis3.plot(*(centre + line).T, color=colour, lw=0.6, alpha=0.7)
     for run in shown:
         for xyz, style in lines(run):
@@ -651,7 +659,7 @@ def paths_figure(runs: Sequence[Run], bench: BenchProblem, path: Path) -> None:
         axis = figure.add_subplot(2, 2, index)
         a, b = view
         for shape, centre, colour in bodies:  # the goal under the obstacles
-            ring = centre[list(view)] + outline(shape, view)
+            ring = centre[list(view)] + shape_outline(shape, view)
             axis.fill(*ring.T, facecolor=colour, alpha=0.3, lw=0)
             axis.fill(*ring.T, fill=False, edgecolor=colour, lw=0.7)
         for run in shown:
@@ -820,7 +828,7 @@ def convergence_figure(
         "Ant colony convergence: (F − F_optimum) / F_optimum per cycle\n"
         f"(dotted: {TARGET_MEDIAN_GAP:g} %, dash-dot: {TARGET_P95_GAP:g} %)"
     )
-    save(figure, path)
+    save_figure(figure, path)
 
 
 def _problems(runs: Sequence[Run]) -> list[str]:
@@ -861,4 +869,173 @@ def distribution_plot(runs: Sequence[Run], path: Path) -> None:
         f"(dashed: p95 gap target {TARGET_P95_GAP:g} %, line plan target "
         f"{1e3 * TARGET_PLAN_SECONDS:.0f} ms)"
     )
-    save(figure, path)
+    save_figure(figure, path)
+
+
+# ---------------------------------------------------------------------------- command
+
+
+def _span(specs: Sequence[str]) -> str:
+    """``static-spheres:0..99`` for consecutive seeds of one family, else the specs."""
+    match = [re.fullmatch(r"([a-z-]+):(\d+)", spec) for spec in specs]
+    if all(match) and len({m[1] for m in match}) == 1:
+        seeds = [int(m[2]) for m in match]
+        if seeds == list(range(seeds[0], seeds[0] + len(seeds))) and len(seeds) > 1:
+            return f"{match[0][1]}:{seeds[0]}..{seeds[-1]}"
+    return ", ".join(specs)
+
+
+@click.command("ant-colony", short_help="The ant-colony planner against its graph's exact optimum.")
+@click.option(
+    "--layouts",
+    type=int,
+    default=None,
+    help="Seeded obstacle layouts static-spheres:0 to N - 1 (default 100).",
+)
+@click.option(
+    "--problems",
+    default=None,
+    help="Comma-separated problems instead of the layouts: a family (static-spheres, "
+    "cw-spheres, shapes) with :SEED or :FIRST..LAST seeds, or a transfer scenario file.",
+)
+@click.option("--deltas", default="2,6", show_default=True, help="Comma-separated δ values, m².")
+@click.option(
+    "--cross-sections",
+    default="line,grid",
+    show_default=True,
+    help="Comma-separated cross-sections: line (the paper's), grid.",
+)
+@click.option(
+    "--variants",
+    default="defaults,paper",
+    show_default=True,
+    help="Comma-separated variants: defaults (the planner's), paper (the paper's literal "
+    "colony: visibility=length, local_search=false, deposit_by=all, pheromone_floor=0, "
+    "stall_cycles=242).",
+)
+@click.option(
+    "--params",
+    "extra",
+    default=None,
+    help="Further ant-colony parameters for every variant as key=value:key=value (e.g. ants=60).",
+)
+@click.option(
+    "--budget",
+    type=float,
+    default=None,
+    help="Planning budget of every whole plan, s (default: the problem's; 1 s for the families).",
+)
+@click.option(
+    "--figure",
+    "figure_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Write the paper's Fig. 2 regenerated on --figure-scenario (paths for every δ) "
+    "here, and the convergence curves beside it as NAME_convergence.png.",
+)
+@click.option(
+    "--figure-scenario",
+    default="scenarios/ffsr_obstacles.yaml",
+    show_default=True,
+    help="The problem drawn by --figure.",
+)
+@click.option(
+    "--plot",
+    "plot_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Save box plots of the gap and the plan time over the layouts per setting.",
+)
+def command(
+    layouts: int | None,
+    problems: str | None,
+    deltas: str,
+    cross_sections: str,
+    variants: str,
+    extra: str | None,
+    budget: float | None,
+    figure_path: Path | None,
+    figure_scenario: str,
+    plot_path: Path | None,
+) -> None:
+    """The ant-colony planner against the exact optimum of its own candidate graph.
+
+    On every layout, for every cross-section, δ and variant: the colony's gap to the
+    optimum that dynamic programming finds on the same graph, its cycles, and the wall
+    times of the graph, the colony, the whole plan and the DP, beside the targets
+    (median gap ≤ 1 %, p95 ≤ 3 %, ≤ 0.5 s per plan with the line cross-section). Prints
+    Markdown tables for docs/benchmarks.md; progress goes to stderr.
+    """
+    if layouts is not None and problems is not None:
+        raise DcsimError("give --layouts or --problems, not both")
+    if layouts is not None and layouts < 1:
+        raise DcsimError(f"--layouts must be at least 1, got {layouts}")
+    if budget is not None and not budget > 0:
+        raise DcsimError(f"--budget must be a positive number of seconds, got {budget:g}")
+    chosen = settings(
+        comma_words(cross_sections, "--cross-sections"),
+        comma_numbers(deltas, "--deltas"),
+        comma_words(variants, "--variants"),
+    )
+    params = plugin_spec(f"{PLANNER}:{extra}")[1] if extra else None
+    resolved = check_params(chosen, params)
+    specs = (
+        expand_bench_specs(comma_words(problems, "--problems"))
+        if problems is not None
+        else [f"static-spheres:{seed}" for seed in range(100 if layouts is None else layouts)]
+    )
+    figure_problem = load_bench_problem(figure_scenario) if figure_path is not None else None
+
+    def say(line: str) -> None:
+        click.echo(line, err=True)
+
+    say(f"loading problems: {len(specs)}")
+    loaded = [load_bench_problem(spec) for spec in specs]
+    began = time.monotonic()
+    runs = bench_ant_colony(loaded, chosen, params, budget, say)
+    wall = time.monotonic() - began
+    click.echo(
+        f"ant-colony on {len(loaded)} problems ({_span(specs)}), {len(chosen)} settings, "
+        f"planner seed = problem index, whole-plan budget "
+        f"{'the problem' + chr(39) + 's' if budget is None else f'{budget:g} s'}; "
+        f"{wall:.0f} s of wall time"
+    )
+    click.echo("")
+    for variant in dict.fromkeys(s.variant for s in chosen):
+        label = next(s.label for s in chosen if s.variant == variant)
+        shown = {k: v for k, v in resolved[label].items() if k not in ("cross_section", "delta")}
+        click.echo(f"- {variant}: " + ", ".join(f"{k}={v}" for k, v in shown.items()))
+    click.echo("")
+    click.echo("Gap to the exact optimum of the same graph")
+    click.echo("")
+    click.echo(quality_table(runs))
+    click.echo("")
+    click.echo("Wall time, ms")
+    click.echo("")
+    click.echo(time_table(runs))
+    click.echo("")
+    click.echo("Targets met")
+    click.echo("")
+    click.echo(target_table(runs))
+    notes = unscored_lines(runs)
+    if notes:
+        click.echo("")
+        click.echo("Runs unscored, without a trajectory, or below the optimum")
+        click.echo("")
+        click.echo("\n".join(notes))
+    if figure_problem is not None and figure_path is not None:
+        say(f"figure: {figure_problem.name}")
+        scenario_runs = bench_ant_colony([figure_problem], chosen, params, budget, say)
+        click.echo("")
+        click.echo(f"{figure_problem.name} (the paper's Fig. 2), planner seed 0")
+        click.echo("")
+        click.echo(scenario_table(scenario_runs, figure_problem.problem))
+        figure_path.parent.mkdir(parents=True, exist_ok=True)
+        paths_figure(scenario_runs, figure_problem, figure_path)
+        convergence = convergence_path(figure_path)
+        convergence_figure(scenario_runs, runs, figure_problem.name, convergence)
+        click.echo(f"\nfigures: {figure_path}, {convergence}")
+    if plot_path is not None:
+        plot_path.parent.mkdir(parents=True, exist_ok=True)
+        distribution_plot(runs, plot_path)
+        click.echo(f"plot: {plot_path}")
