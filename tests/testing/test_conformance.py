@@ -355,6 +355,6 @@ def test_docs_list_every_check_and_every_hook():
         for name, function in inspect.getmembers(hookspecs, inspect.isfunction)
         if hasattr(function, "dcsim_spec")
     ]
-    assert len(specs) == 5
+    assert len(specs) == 6
     for name in specs:
         assert f"### {name}\n" in text, f"hook {name} has no entry in docs/plugins.md"
