@@ -144,6 +144,7 @@ def test_the_command_prints_the_tables_and_writes_the_figures(tmp_path):
         (["--layouts", "2", "--problems", "shapes:1"], "not both"),
         (["--params", "ants=0"], "invalid parameters for plugin 'ant-colony'"),
         (["--params", "colour=red"], "colour: unknown key"),
+        (["--params", "ants"], "'ants' in 'ant-colony:ants' is not key=value"),
         (["--problems", "mars:1"], "'mars:1' is neither a problem family"),
         (["--budget", "0"], "--budget must be a positive"),
     ],
