@@ -1,7 +1,9 @@
 """The ``dcsim`` command line.
 
 Every error a user can cause is printed as ``error: <message>`` with exit status 2 and
-no traceback; ``dcsim --debug ...`` shows the traceback instead.
+no traceback; ``dcsim --debug ...`` shows the traceback instead. Installed plugin
+packages add their own commands (``dcsim bench ant-colony`` is the ``ant-colony``
+plugin's) through the ``dcsim_register_commands`` hook (:mod:`dcsim.cli_plugins`).
 """
 
 from __future__ import annotations
