@@ -398,7 +398,7 @@ def _plugins_flown(plugins: dict[str, dict[str, str]]) -> str:
     )
 
 
-@cli.command("new-plugin")
+@cli.command("new-plugin", short_help="Write a plugin or mission package of your own.")
 @click.argument("kind", type=click.Choice([*PLUGIN_KINDS, "mission"]))
 @click.argument("name")
 @click.option(
@@ -410,7 +410,7 @@ def _plugins_flown(plugins: dict[str, dict[str, str]]) -> str:
     help="Folder to create the package in.",
 )
 def new_plugin_command(kind: str, name: str, directory: Path) -> None:
-    """Write an out-of-tree plugin package of KIND called NAME, or a mission package.
+    """Write an out-of-tree package: a plugin of KIND called NAME, or a mission.
 
     The package (DIR/dcsim-NAME) has a pyproject.toml with the dcsim entry point, the
     plugin class with its parameter model and a simple working algorithm, a test file
