@@ -24,7 +24,8 @@ Missions (docs/plugins.md, "Writing a mission")
     distribution declares its missions in the ``dcsim.missions`` entry point group).
 Messages
     The robot: :class:`RobotState`, :class:`StateEstimate`, :class:`Prior`,
-    :class:`MotionInput`, :class:`Reference`, :class:`Command`, :class:`RobotSpec`.
+    :class:`MotionInput`, :class:`Reference`, :class:`Command`, :class:`RobotSpec`;
+    the typed contract of its ``model``, :class:`RobotModel`.
     Sensing: :class:`ObjectTrack`, :class:`ObjectKind`, :class:`Shape`, :class:`ShapeKind`,
     :class:`BeaconRange`, :class:`Observations`, :class:`Surroundings`.
     Path planning: :class:`PathProblem`, :class:`GoalRegion`, :class:`FrameDynamics`,
@@ -184,6 +185,7 @@ from dcsim.robots.manipulator import (
     ManipulatorModel,
     manipulator_model,
 )
+from dcsim.robots.model import RobotModel
 from dcsim.robots.urdf import urdf_text as manipulator_urdf
 from dcsim.runs import RunResult, close_run, load_scenario, open_run, read_run, run
 from dcsim.scenario.loader import packaged_scenario_path
@@ -322,6 +324,7 @@ __all__ = [
     "register_mission",
     "resolution_step",
     "rest_to_rest_time",
+    "RobotModel",
     "RobotSpec",
     "RobotState",
     "rotate",

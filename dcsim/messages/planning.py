@@ -11,7 +11,6 @@ import enum
 from collections.abc import Mapping
 from dataclasses import field
 from functools import cached_property
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -20,6 +19,7 @@ from dcsim.geometry import Vector, quaternion_conjugate, quaternion_multiply, ro
 from dcsim.messages.base import Message, array_field, message
 from dcsim.messages.sensing import ObjectTrack
 from dcsim.messages.state import RobotState
+from dcsim.robots.model import RobotModel, check_robot_model
 
 _INF = float("inf")
 
@@ -183,9 +183,14 @@ class PathProblem(Message):
         Cost weights.
     time_budget : float
         Wall time the planner may spend, s.
-    model : object or None
+    model : RobotModel or None
         The robot's model (``RobotSpec.model``): for a manipulator, its
         :class:`~dcsim.robots.manipulator.ManipulatorModel`; None for a free flyer.
+
+    Raises
+    ------
+    TypeError
+        If ``model`` is neither None nor a :class:`~dcsim.robots.model.RobotModel`.
     """
 
     start: RobotState
@@ -202,7 +207,11 @@ class PathProblem(Message):
     bounds: Bounds | None = None
     weights: CostWeights = field(default_factory=CostWeights)
     time_budget: float = 1.0
-    model: Any = None
+    model: RobotModel | None = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_robot_model("PathProblem.model", self.model)
 
 
 @message

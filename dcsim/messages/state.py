@@ -9,12 +9,11 @@ ordered ``[v_base, ω_base, θ̇]``.
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from dcsim.geometry import Vector, length
 from dcsim.messages.base import Message, array_field, message
+from dcsim.robots.model import RobotModel, check_robot_model
 
 _UNIT_TOLERANCE = 1e-6
 
@@ -227,9 +226,15 @@ class RobotSpec(Message):
         Lower and upper limit of each joint, rad or m; no rows for a free flyer.
     joint_torque_limits : ndarray (n,)
         Largest torque (N·m) or force (N) of each joint.
-    model : object or None
-        The robot's model for model-based plugins (for a manipulator: kinematics,
-        Jacobian, mass and Coriolis matrices); None for a free flyer.
+    model : RobotModel or None
+        The robot's model for model-based plugins (for a manipulator its
+        :class:`~dcsim.robots.manipulator.ManipulatorModel`: kinematics, ``det(J Jᵀ)``,
+        mass and Coriolis matrices); None for a free flyer.
+
+    Raises
+    ------
+    TypeError
+        If ``model`` is neither None nor a :class:`~dcsim.robots.model.RobotModel`.
     """
 
     mass: float
@@ -241,4 +246,8 @@ class RobotSpec(Message):
     max_angular_rate: float = float("inf")
     joint_position_limits: Vector = array_field(shape=(-1, 2), default=np.zeros((0, 2)))
     joint_torque_limits: Vector = array_field(shape=(-1,), default=())
-    model: Any = None
+    model: RobotModel | None = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_robot_model("RobotSpec.model", self.model)

@@ -118,6 +118,11 @@ class ManipulatorModel:
         """Number of joints ``n``."""
         return self.robot.n_joints
 
+    @property
+    def reach(self) -> float:
+        """Largest distance from the first joint's axis origin to the end effector, m."""
+        return self.robot.reach
+
     def urdf(self) -> str:
         """URDF text of the robot (:func:`dcsim.robots.urdf.urdf_text`)."""
         return urdf_text(self.robot)

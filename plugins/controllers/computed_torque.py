@@ -1,8 +1,9 @@
 """``computed-torque`` controller: full control of a space manipulator by feedback
 linearisation (the space manipulator thesis, eqs 6.1–6.7).
 
-With the robot's own model ``M(q)``, ``C(q, q̇)`` (on ``RobotSpec.model``, both from
-one call of its ``dynamics(q, q̇)`` per tick) the generalised force
+With the robot's own model ``M(q)``, ``C(q, q̇)`` (on ``RobotSpec.model``, a
+:class:`~dcsim.api.RobotModel`, both from one call of its ``dynamics(q, q̇)`` per tick)
+the generalised force
 
     τ = M(q) u + C(q, q̇) q̇,      u = q̈_d + K_D ė + K_P e                (6.1, 6.4)
 
@@ -106,13 +107,13 @@ class ComputedTorqueController(Controller):
             limits do not match the model's joints.
         """
         model = robot.model
-        if model is None or not all(hasattr(model, attr) for attr in ("dynamics", "n_joints")):
+        if model is None:
             raise PluginError(
                 f"controller '{self.name}' needs a manipulator's model (mass and Coriolis "
-                f"matrices) on RobotSpec.model, got {type(model).__name__}; use it with "
-                "robot.type: manipulator, or choose a free-flyer controller such as 'pd'"
+                "matrices) on RobotSpec.model, got none; use it with robot.type: "
+                "manipulator, or choose a free-flyer controller such as 'pd'"
             )
-        n = int(model.n_joints)
+        n = model.n_joints
         if robot.joint_torque_limits.shape != (n,):
             raise PluginError(
                 f"controller '{self.name}': the robot has {n} joints but "

@@ -83,14 +83,14 @@ def unreachable(problem: PathProblem) -> NoPath | None:
     """Why no end-effector path can be planned at all: no manipulator model, or a target
     beyond the arm's reach from its shoulder (the base where it is); None otherwise."""
     model = problem.model
-    if model is None or not hasattr(model, "forward_kinematics"):
+    if model is None:
         return NoPath("the problem carries no manipulator model: this planner moves an arm")
     shoulder = model.forward_kinematics(problem.start.configuration).origins[0]
     distance = float(np.linalg.norm(problem.goal.position - shoulder))
-    if distance > model.robot.reach:
+    if distance > model.reach:
         return NoPath(
             f"the target is {distance:.3f} m from the shoulder, beyond the arm's reach of "
-            f"{model.robot.reach:.3f} m"
+            f"{model.reach:.3f} m"
         )
     return None
 
