@@ -17,7 +17,8 @@ Plugin kinds
     :class:`Localiser`, :class:`TaskPlanner`, :class:`PathPlanner`, :class:`Controller`
     (and their common base :class:`Plugin`).
 Parameters
-    :class:`PluginParams`, :func:`quantity`.
+    :class:`PluginParams`, :func:`quantity`; :class:`PathPlannerParams` (the base of
+    path planners' models, which refuses the retired ``clearance``).
 Missions (docs/plugins.md, "Writing a mission")
     :class:`Mission` (the task side of a run), :class:`MissionSettings` (its scenario
     section), :func:`register_mission` (a mission class made at run time; a
@@ -131,7 +132,15 @@ from dcsim.geometry import (
     unit,
 )
 from dcsim.hookspecs import hookimpl
-from dcsim.interfaces import PLUGIN_KINDS, Controller, Localiser, PathPlanner, Plugin, TaskPlanner
+from dcsim.interfaces import (
+    PLUGIN_KINDS,
+    Controller,
+    Localiser,
+    PathPlanner,
+    PathPlannerParams,
+    Plugin,
+    TaskPlanner,
+)
 from dcsim.kinematics import cruise_speed, rest_to_rest_time, shortest_leg
 from dcsim.messages import (
     BeaconRange,
@@ -297,6 +306,7 @@ __all__ = [
     "Observations",
     "path_clearance",
     "PathPlanner",
+    "PathPlannerParams",
     "PathProblem",
     "Plan",
     "plan_cost",

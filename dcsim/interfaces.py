@@ -132,8 +132,27 @@ class TaskPlanner(Plugin):
         """
 
 
+MARGIN_MOVED = (
+    "the margin kept from obstacles is the same for every path planner now: the problem's "
+    "safety_margin, which the mission sets from its safety_distance; set "
+    "mission.safety_distance instead"
+)
+"""What a scenario that still gives a path planner its own ``clearance`` is told."""
+
+
+class PathPlannerParams(PluginParams):
+    """Base class of path planners' parameter models: ``clearance`` is refused with
+    :data:`MARGIN_MOVED` (the margin is :attr:`PathProblem.safety_margin`)."""
+
+    retired: ClassVar[Mapping[str, str]] = {"clearance": MARGIN_MOVED}
+
+
 class PathPlanner(Plugin):
     """Finds a time-stamped trajectory to a goal region among moving obstacles.
+
+    Every planner keeps the problem's ``safety_margin`` from every obstacle and answers
+    by ``problem.due()`` (``time.monotonic()`` seconds), which it reads once when it
+    starts.
 
     Attributes
     ----------
@@ -145,6 +164,7 @@ class PathPlanner(Plugin):
     """
 
     kind = "path_planner"
+    Params: ClassVar[type[PluginParams]] = PathPlannerParams
     handles_moving_obstacles: ClassVar[bool] = True
 
     @abstractmethod

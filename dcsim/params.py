@@ -19,7 +19,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import UnionType
-from typing import Any, Literal, Union, get_args, get_origin
+from typing import Any, ClassVar, Literal, Union, get_args, get_origin
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from pydantic_core import ErrorDetails, to_jsonable_python
@@ -162,11 +162,18 @@ class PluginParams(BaseModel):
     Subclasses declare their fields with :func:`quantity`. Instances are immutable,
     unknown parameter names are rejected, numbers must be finite, and types are checked
     strictly enough that a string is never silently taken for a number.
+
+    Attributes
+    ----------
+    retired : mapping of str to str
+        Names that were parameters once, each with what to set instead: giving one is
+        rejected with that advice rather than as an unknown key.
     """
 
     model_config = ConfigDict(
         extra="forbid", frozen=True, validate_default=True, allow_inf_nan=False
     )
+    retired: ClassVar[Mapping[str, str]] = {}
 
     @classmethod
     def parse(cls, plugin: str, values: Mapping[str, Any] | None) -> PluginParams:
@@ -224,6 +231,9 @@ def describe_error(model: type[BaseModel] | None, field: str | None, error: Erro
     if error["type"] == "extra_forbidden":
         if model is None:
             return "unknown key"
+        advice = getattr(model, "retired", {}).get(str(field))
+        if advice is not None:
+            return f"no longer a parameter: {advice}"
         known = ", ".join(model.model_fields)
         return f"unknown key (known keys: {known})" + did_you_mean(str(field), model.model_fields)
     message = f"{short_repr(error['input'])} is not allowed: {error['msg']}"

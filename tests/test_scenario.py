@@ -381,3 +381,11 @@ def test_docs_key_reference_matches_the_schema():
     assert block(text, BEGIN, END) == render_reference(), (
         "docs/scenarios.md is stale: run `make docs`"
     )
+
+
+def test_a_path_planners_own_clearance_is_refused_saying_where_the_margin_is(tmp_path, registry):
+    path = write(tmp_path, "path_planner: {plugin: straight-line, params: {clearance: 0.5}}\n")
+    (found,) = problems(path, registry=registry)
+    assert found.startswith(f"{path}:1:")
+    assert "path_planner.params.clearance: no longer a parameter: " in found
+    assert "safety_margin" in found and "set mission.safety_distance instead" in found

@@ -89,6 +89,8 @@ BOUNDS = {"lower": [-16.0, -8.0, -25.0], "upper": [16.0, 8.0, 25.0]}
 """The source's position sampling box, m."""
 BUDGET = 10.0
 """Planning budget of the bench's escapes, s (the target: solved within 10 s)."""
+SAFETY_DISTANCE = 0.05
+"""Surface gap every path planner keeps from the asteroids, m (``mission.safety_distance``)."""
 
 
 def escape_scenario(seed: int) -> dict[str, Any]:
@@ -122,7 +124,13 @@ def escape_scenario(seed: int) -> dict[str, Any]:
             },
         },
         "obstacles": obstacle_entries(draw_field(seed)),
-        "mission": {"type": "transfer", "goal": GOAL, "bounds": BOUNDS, "planning_budget": BUDGET},
+        "mission": {
+            "type": "transfer",
+            "goal": GOAL,
+            "bounds": BOUNDS,
+            "planning_budget": BUDGET,
+            "safety_distance": SAFETY_DISTANCE,
+        },
         "path_planner": {"plugin": "ompl-control"},
         "controller": {"plugin": "pd"},
         "stop": {"on_collision": True},

@@ -7,7 +7,9 @@ generator the transfer mission would give its planner under world seed ``i``
 in a process forked for it: a planner that overruns its budget by more than the
 conformance suite allows (20 % and 0.2 s) is a timeout, and is killed a second later; a
 crash is an error; and a library with process-wide state (OMPL's random seed) starts
-afresh every run.
+afresh every run. Every planner gets the same contract: the problem's safety margin (the
+scenario's ``mission.safety_distance``) and a deadline ``time_budget`` after the instant
+the bench starts its clock (``PathProblem.deadline``, ``time.monotonic()`` seconds).
 
 Per run: planning time; the status (``solved`` — a trajectory, ``no path``, ``error``,
 ``timeout``); whether the trajectory ends inside the goal region within its tolerances
@@ -223,19 +225,24 @@ def _plan_in_child(
     The second call (a fresh instance with the same generator) runs under tracemalloc,
     whose bookkeeping would otherwise slow the timed call down severalfold.
     """
-    began = time.perf_counter()
+    began = time.monotonic()
     try:
         planner = plugin(params, component_rng(seed, "path_planner"))
-        began = time.perf_counter()
-        answer: Any = planner.plan(problem)
+        began = time.monotonic()
+        answer: Any = planner.plan(due_from(problem, began))
     except Exception as error:  # the planner's own failure is a result, not the bench's
         answer = f"{type(error).__name__}: {error}"
-    elapsed = time.perf_counter() - began
+    elapsed = time.monotonic() - began
     try:
         connection.send((answer, elapsed))
     except Exception as error:  # an answer that cannot be pickled
         connection.send((f"its answer cannot be sent back: {error}", elapsed))
     connection.send(_traced_peak(plugin, seed, problem, params) if memory else math.nan)
+
+
+def due_from(problem: PathProblem, began: float) -> PathProblem:
+    """``problem`` due ``time_budget`` after ``began`` (``time.monotonic()`` seconds)."""
+    return replace(problem, deadline=began + problem.time_budget)
 
 
 def _traced_peak(
@@ -245,7 +252,7 @@ def _traced_peak(
     planner = plugin(params, component_rng(seed, "path_planner"))
     tracemalloc.start()
     try:
-        planner.plan(problem)
+        planner.plan(due_from(problem, time.monotonic()))
         return float(tracemalloc.get_traced_memory()[1])
     except Exception:  # already reported by the timed call
         return math.nan

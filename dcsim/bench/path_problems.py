@@ -6,7 +6,8 @@ transfer mission poses at t = 0 (:func:`dcsim.missions.transfer.mission.transfer
 the robot's true initial state, with the obstacles in sensor range.
 
 Families (the robot: the scenario default, 1 m radius, 1 m/s, 0.05 m/s² usable
-acceleration; a 1.5 m goal 60 m away, planning budget 1 s):
+acceleration; a 1.5 m goal 60 m away, planning budget 1 s, a safety margin of 0.5 m for
+every planner):
 
 - ``static-spheres``: 20 spheres of 1–3 m radius at rest in a force-free frame;
 - ``cw-spheres``: 20 spheres of 1–2.5 m radius drifting in Clohessy–Wiltshire motion
@@ -51,6 +52,8 @@ KEEP_OUT = 2.0
 """Least gap between an obstacle's bounding sphere and the start or the goal region, m."""
 GOAL_RADIUS = 1.5
 """Radius of the goal region, m."""
+FAMILY_MARGIN = 0.5
+"""Safety margin of the random families' problems, m (``mission.safety_distance``)."""
 ROBOT_RADIUS = 1.0
 """The robot's radius (the scenario default), m."""
 ORBIT_RADIUS = 6_778_137.0
@@ -124,6 +127,7 @@ def _scenario(name: str, frame: str, along: int, obstacles: list[dict]) -> dict[
             "goal": {"position": _rounded(LENGTH * forward), "radius": GOAL_RADIUS},
             "bounds": {"lower": _rounded(lower), "upper": _rounded(upper)},
             "planning_budget": 1.0,
+            "safety_distance": FAMILY_MARGIN,
         },
     }
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import enum
+import time as wallclock
 from collections.abc import Mapping
 from dataclasses import field
 from functools import cached_property
@@ -153,6 +154,9 @@ class PathProblem(Message):
     goal region, the speed and acceleration limits and the returned trajectory's
     positions and velocities are the end effector's (world frame).
 
+    Every planner keeps the same ``safety_margin`` and answers by the same clock: it
+    reads :meth:`due` once when it starts and returns by then.
+
     Attributes
     ----------
     start : RobotState
@@ -182,13 +186,23 @@ class PathProblem(Message):
     weights : CostWeights
         Cost weights.
     time_budget : float
-        Wall time the planner may spend, s.
+        Wall time the planner may spend from when it is called, s, unless ``deadline``
+        is given (the mission's ``planning_budget``).
     model : RobotModel or None
         The robot's model (``RobotSpec.model``): for a manipulator, its
         :class:`~dcsim.robots.manipulator.ManipulatorModel`; None for a free flyer.
+    safety_margin : float
+        Least surface gap to keep between the robot's bounding sphere and every
+        obstacle's shape, m, beyond both (the mission's ``safety_distance``); the same
+        for every planner.
+    deadline : float or None
+        When the answer is due, in ``time.monotonic()`` seconds; None: ``time_budget``
+        after the planner is called (see :meth:`due`).
 
     Raises
     ------
+    ValueError
+        If ``safety_margin`` is negative or not finite.
     TypeError
         If ``model`` is neither None nor a :class:`~dcsim.robots.model.RobotModel`.
     """
@@ -208,10 +222,27 @@ class PathProblem(Message):
     weights: CostWeights = field(default_factory=CostWeights)
     time_budget: float = 1.0
     model: RobotModel | None = None
+    safety_margin: float = 0.0
+    deadline: float | None = None
 
     def __post_init__(self) -> None:
         super().__post_init__()
+        if not 0.0 <= self.safety_margin < _INF:
+            raise ValueError(
+                f"PathProblem.safety_margin must be a finite gap of 0 m or more, "
+                f"got {self.safety_margin!r}"
+            )
         check_robot_model("PathProblem.model", self.model)
+
+    def due(self) -> float:
+        """When the answer is due, ``time.monotonic()`` seconds: ``deadline``, or
+        ``time_budget`` from now when no deadline is given.
+
+        A planner calls it once, when it starts, and measures all its work against it.
+        """
+        if self.deadline is not None:
+            return self.deadline
+        return wallclock.monotonic() + self.time_budget
 
 
 @message

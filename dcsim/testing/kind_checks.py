@@ -209,6 +209,38 @@ def check_budget(plugin_class: type[Plugin]) -> None:
     checked_answer(plugin_class.kind, answer, f"a problem with a {request.time_budget:g} s budget")
 
 
+DEADLINE_AWAY = 0.3
+"""How far the deadline of the deadline check lies when the planner is called, s."""
+
+LONG_BUDGET = 30.0
+"""The deadline check's ``time_budget``, s: far beyond its deadline."""
+
+
+@contract(
+    "honours_deadline",
+    "the problem of honours_time_budget, its deadline (`PathProblem.deadline`, "
+    f"`time.monotonic()` seconds) {DEADLINE_AWAY:g} s away and its time_budget "
+    f"{LONG_BUDGET:g} s, is answered by the deadline (plus 20 % of {DEADLINE_AWAY:g} s and "
+    f"{TIME_SLACK} s): the deadline rules, as `PathProblem.due()` gives it",
+    kinds=("path_planner",),
+)
+def check_deadline(plugin_class: type[Plugin]) -> None:
+    if problem_robot(plugin_class) == "manipulator":
+        problem = problems.reach_problem(LONG_BUDGET)
+    else:
+        problem = problems.posed(plugin_class, problems.enclosed_goal_problem(LONG_BUDGET))
+    plugin = make(plugin_class)
+    deadline = time.monotonic() + DEADLINE_AWAY
+    answer = plugin.plan(dataclasses.replace(problem, deadline=deadline))
+    late = time.monotonic() - deadline
+    if late > 0.2 * DEADLINE_AWAY + TIME_SLACK:
+        fail(
+            f"answered {late:.3f} s after the problem's deadline (its time_budget of "
+            f"{LONG_BUDGET:g} s counts only when no deadline is given: plan by problem.due())"
+        )
+    checked_answer(plugin_class.kind, answer, "a problem with a deadline")
+
+
 # --------------------------------------------------------------------- path planner
 
 
@@ -350,10 +382,27 @@ def check_acceleration(plugin_class: type[Plugin]) -> None:
         )
 
 
+def _check_margin(trajectory: Trajectory, problem: PathProblem, what: str) -> None:
+    """Fail unless the trajectory keeps the problem's safety margin from every obstacle."""
+    closest = path_clearance(trajectory, problem)
+    if closest.collides:
+        fail(
+            f"on {what} it overlaps obstacle {closest.obstacle_id} by {-closest.distance:.3f} m "
+            f"at t = {closest.time:.2f} s, at {closest.position}"
+        )
+    if closest.distance < problem.safety_margin:
+        fail(
+            f"on {what} it comes {closest.distance:.3f} m from obstacle {closest.obstacle_id} "
+            f"at t = {closest.time:.2f} s, at {closest.position}: inside the problem's "
+            f"safety_margin of {problem.safety_margin:g} m"
+        )
+
+
 @contract(
     "collision_free",
     "against every obstacle's true shape (sphere, or turned box or cylinder) moving by its "
-    "predicted motion, the robot's sphere never overlaps an obstacle; checked by "
+    "predicted motion, the robot's sphere never comes closer than the problem's "
+    f"safety_margin ({problems.SAFETY_MARGIN:g} m on the standard problem); checked by "
     "`dcsim.clearance.path_clearance` at every sample of the trajectory and at steps over "
     f"which no gap changes by more than {RESOLUTION:g} robot radius",
     kinds=("path_planner",),
@@ -361,12 +410,23 @@ def check_acceleration(plugin_class: type[Plugin]) -> None:
 )
 def check_collisions(plugin_class: type[Plugin]) -> None:
     trajectory, problem = _standard_path(plugin_class)
-    closest = path_clearance(trajectory, problem)
-    if closest.collides:
-        fail(
-            f"overlaps obstacle {closest.obstacle_id} by {-closest.distance:.3f} m at "
-            f"t = {closest.time:.2f} s, at {closest.position}"
-        )
+    _check_margin(trajectory, problem, "the standard path problem")
+
+
+@contract(
+    "keeps_safety_margin",
+    f"on the margin problem, whose direct line passes {problems.DIRECT_GAP:g} m from a "
+    f"sphere, a trajectory keeps the problem's safety_margin of {problems.WIDE_MARGIN:g} m "
+    "(measured as in collision_free; a planner that cannot bend may answer NoPath): the "
+    "margin is the problem's, not the planner's own",
+    kinds=("path_planner",),
+    robots=("free-flyer",),
+)
+def check_safety_margin(plugin_class: type[Plugin]) -> None:
+    problem = problems.posed(plugin_class, problems.margin_problem())
+    answer = run_plugin(plugin_class, [problem], "the margin problem")[0]
+    if isinstance(answer, Trajectory):
+        _check_margin(answer, problem, "the margin problem")
 
 
 _IMPOSSIBLE: tuple[tuple[str, Callable[[float], PathProblem]], ...] = (

@@ -196,11 +196,22 @@ def task_request(targets: int = 6, time_budget: float = 1.0, capacity: int = 2) 
 GOAL = np.array([40.0, 5.0, 0.0])
 """Centre of the standard path problem's goal region, m."""
 
+SAFETY_MARGIN = 0.2
+"""Safety margin of the standard path problem, m."""
+
+WIDE_MARGIN = 1.0
+"""Safety margin of the margin problem (:func:`margin_problem`), m."""
+
+DIRECT_GAP = 0.5
+"""Surface gap between the robot's sphere and the margin problem's obstacle on the
+direct line, m: less than :data:`WIDE_MARGIN`."""
+
 
 def path_problem(time_budget: float = 1.0) -> PathProblem:
     """The standard path problem: 40 m across a box, obstacles near but off the direct line.
 
-    Three spheres (two of them moving), a turned box and a turned cylinder.
+    Three spheres (two of them moving), a turned box and a turned cylinder; a safety
+    margin of :data:`SAFETY_MARGIN`.
     """
     box = Shape(ShapeKind.BOX, half_extents=(1.5, 1.0, 2.0), orientation=_turn((0, 0, 1), 30))
     cylinder = Shape(ShapeKind.CYLINDER, radius=1.0, height=3.0, orientation=_turn((1, 0, 0), 60))
@@ -220,6 +231,21 @@ def path_problem(time_budget: float = 1.0) -> PathProblem:
         max_delta_v=5.0,
         bounds=Bounds(lower=[-10.0, -30.0, -30.0], upper=[60.0, 30.0, 30.0]),
         time_budget=time_budget,
+        safety_margin=SAFETY_MARGIN,
+    )
+
+
+def margin_problem(time_budget: float = 1.0) -> PathProblem:
+    """A 40 m transfer along x past one static sphere (radius 2 m) beside the direct line:
+    flown straight, the robot's sphere passes :data:`DIRECT_GAP` from it, inside the
+    problem's safety margin of :data:`WIDE_MARGIN`, so a path that keeps the margin
+    bends away from the sphere. Otherwise as the standard problem."""
+    side = ROBOT.radius + 2.0 + DIRECT_GAP
+    return dataclasses.replace(
+        path_problem(time_budget),
+        goal=GoalRegion(position=(40.0, 0.0, 0.0), tolerance=1.0),
+        obstacles=(obstacle_track(1, (20.0, side, 0.0), radius=2.0),),
+        safety_margin=WIDE_MARGIN,
     )
 
 

@@ -9,7 +9,7 @@ Candidate graph (:mod:`layered_graph`, eqs 4–9)
     the plane perpendicular to SG at each division point is a cross-section holding
     2n + 1 points on a line (``cross_section: line``, the paper) or (2n + 1)² on a grid.
     A path is S, one point of each cross-section in order, and G. A point closer to an
-    obstacle's true shape than ``robot_radius + clearance`` is unusable, and so is a
+    obstacle's true shape than ``robot_radius + safety_margin`` is unusable, and so is a
     segment the robot's grown sphere, swept along it, touches. The objective is
     ``F = L + δ Σᵢ 1/d_min,i`` (eq. 8): the path's length plus δ (``delta``, m²) times
     the reciprocal clearances of its m − 1 points. The balance depends on the problem's
@@ -79,8 +79,8 @@ from dcsim_plugins.path_planners.polyline_flight import (
 from dcsim.api import (
     NoPath,
     PathPlanner,
+    PathPlannerParams,
     PathProblem,
-    PluginParams,
     Trajectory,
     hookimpl,
     quantity,
@@ -94,7 +94,7 @@ PAPER_PARTS = 40
 _RESERVE = 0.1  # share of the time budget kept for timing and checking the path
 
 
-class AntColonyParams(PluginParams):
+class AntColonyParams(PathPlannerParams):
     """Parameters of :class:`AntColonyPlanner`; the defaults are the paper's where it
     gives them (α, β, ρ, Q, ants, m, cycles, δ)."""
 
@@ -177,9 +177,6 @@ class AntColonyParams(PluginParams):
         ge=0,
         description="Obstacle-avoidance coefficient δ of the objective L + δ Σ 1/d_min.",
     )
-    clearance: float = quantity(
-        0.05, unit="m", ge=0, description="Margin kept beyond the robot radius."
-    )
     check_spacing: float = quantity(
         0.05,
         unit="m",
@@ -232,7 +229,7 @@ class AntColonyPlanner(PathPlanner):
 
     def plan(self, problem: PathProblem) -> Trajectory | NoPath:
         """Build the graph, run the colony, simplify and fly the best path."""
-        started = time.monotonic()
+        started, due = time.monotonic(), problem.due()
         refusal = arrival_refusal(problem)
         if refusal is not None:
             return refusal
@@ -241,7 +238,7 @@ class AntColonyPlanner(PathPlanner):
             return ends
         if np.linalg.norm(ends.goal - ends.start) < SHORTEST:
             return self._flown(problem, ends.departure, ends.start[None], {"cycles": 0.0})
-        deadline = started + (1.0 - _RESERVE) * problem.time_budget
+        deadline = due - _RESERVE * max(0.0, due - started)
         try:
             graph = graph_between(problem, self.params, ends, deadline)
         except GraphUnfinished as unfinished:
@@ -273,11 +270,9 @@ class AntColonyPlanner(PathPlanner):
         vertices: np.ndarray,
         statistics: dict[str, float],
     ) -> Trajectory | NoPath:
-        """The polyline flown and checked at this planner's speed and clearance."""
-        params = self.params
-        return fly_polyline(
-            problem, start, vertices, params.speed_fraction, params.clearance, statistics
-        )
+        """The polyline flown at this planner's speed and checked with the problem's
+        safety margin."""
+        return fly_polyline(problem, start, vertices, self.params.speed_fraction, statistics)
 
 
 @hookimpl

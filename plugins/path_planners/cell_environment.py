@@ -151,7 +151,7 @@ def build_environment(
     rules : CellRules
         Grid, constraints and rewards.
     deadline : float
-        ``time.perf_counter()`` by which the environment must be built.
+        ``time.monotonic()`` by which the environment must be built.
 
     Raises
     ------

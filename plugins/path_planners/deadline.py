@@ -1,4 +1,7 @@
-"""A planning deadline: work that takes long checks it and stops with :class:`OutOfTime`."""
+"""A planning deadline: work that takes long checks it and stops with :class:`OutOfTime`.
+
+Deadlines are ``time.monotonic()`` seconds, the clock of :meth:`PathProblem.due`.
+"""
 
 from __future__ import annotations
 
@@ -10,7 +13,7 @@ class OutOfTime(Exception):
 
 
 def check(deadline: float, progress: str) -> None:
-    """Raise :class:`OutOfTime` saying ``progress`` if ``time.perf_counter()`` is past
+    """Raise :class:`OutOfTime` saying ``progress`` if ``time.monotonic()`` is past
     ``deadline``."""
-    if time.perf_counter() > deadline:
+    if time.monotonic() > deadline:
         raise OutOfTime(progress)

@@ -17,10 +17,18 @@ from __future__ import annotations
 import numpy as np
 from dcsim_plugins.path_planners.minimum_jerk import minimum_jerk_move, shortest_duration
 
-from dcsim.api import NoPath, PathPlanner, PathProblem, PluginParams, Trajectory, hookimpl, quantity
+from dcsim.api import (
+    NoPath,
+    PathPlanner,
+    PathPlannerParams,
+    PathProblem,
+    Trajectory,
+    hookimpl,
+    quantity,
+)
 
 
-class EndEffectorLineParams(PluginParams):
+class EndEffectorLineParams(PathPlannerParams):
     """Parameters of :class:`EndEffectorLinePlanner`."""
 
     samples: int = quantity(

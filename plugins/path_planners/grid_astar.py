@@ -40,13 +40,13 @@ Heuristic (``heuristic``)
     bound is approximate.
 Collisions (``collision``)
     ``swept``: every arc sampled at most ``check_spacing`` of closing distance apart,
-    the robot's sphere (``robot_radius`` + ``clearance``, grown by half the largest
-    closing between samples and by ``max_burn² / 2a``, the most the path flown with
-    finite burns strays from the impulsive arcs) clear of every obstacle's true shape
-    where the obstacle is at each sample's time; the trajectory flown is checked again
-    at the end. ``grid-points``: the paper's test, at the grid points alone,
-    so an arc between two clear points may cross an obstacle. Tests against obstacles at
-    rest are done once per grid point and move.
+    the robot's sphere (``robot_radius`` + the problem's ``safety_margin``, grown by
+    half the largest closing between samples and by ``max_burn² / 2a``, the most the
+    path flown with finite burns strays from the impulsive arcs) clear of every
+    obstacle's true shape where the obstacle is at each sample's time; the trajectory
+    flown is checked again at the end. ``grid-points``: the paper's test, at the grid
+    points alone, so an arc between two clear points may cross an obstacle. Tests
+    against obstacles at rest are done once per grid point and move.
 
 Statistics: ``points_searched`` (states taken off the open list and expanded, the
 paper's measure; also reported as ``nodes_expanded``), ``nodes_generated`` (states
@@ -77,8 +77,8 @@ from dcsim_plugins.path_planners.relative_motion import (
 from dcsim.api import (
     NoPath,
     PathPlanner,
+    PathPlannerParams,
     PathProblem,
-    PluginParams,
     Trajectory,
     hookimpl,
     quantity,
@@ -94,7 +94,7 @@ BURN_SHARE = 0.45
 may take."""
 
 
-class GridAStarParams(PluginParams):
+class GridAStarParams(PathPlannerParams):
     """Parameters of :class:`GridAStarPlanner`.
 
     Left unset, the grid follows the paper's Table 2 scaled to the problem's speed limit
@@ -138,9 +138,6 @@ class GridAStarParams(PluginParams):
     )
     collision: Literal["swept", "grid-points"] = quantity(
         "swept", description="Check whole arcs, or only grid points as the paper did."
-    )
-    clearance: float = quantity(
-        0.0, unit="m", ge=0, description="Margin kept beyond the robot radius."
     )
     check_spacing: float = quantity(
         0.1,
@@ -365,7 +362,7 @@ class GridSearch:
         self.moves = move_table(
             self.motion, offsets, steps, grid.distance_resolution, grid.time_resolution
         )
-        self.obstacles = ObstacleField(problem, p.clearance)
+        self.obstacles = ObstacleField(problem)
         # how far the flown path may stray from the impulsive arcs near a burn
         self.corner_cut = 0.5 * grid.max_burn**2 / problem.max_acceleration
         self.resting = self.obstacles.resting_indices
@@ -638,7 +635,7 @@ class GridAStarPlanner(PathPlanner):
 
     def plan(self, problem: PathProblem) -> Trajectory | NoPath:
         """Search the grid; the cheapest plan found, or why there is none."""
-        deadline = time.monotonic() + problem.time_budget
+        deadline = problem.due()
         search = GridSearch(problem, self.params)
         refusal = endpoint_refusal(problem, search.obstacles)
         if refusal is not None:
@@ -662,7 +659,7 @@ class GridAStarPlanner(PathPlanner):
         if swept and not search.obstacles.clear_trajectory(flown, self.params.check_spacing):
             return NoPath(
                 "the plan flown with finite burns cuts a corner into an obstacle: "
-                "raise clearance or lower max_burn"
+                "raise the safety margin (mission.safety_distance) or lower max_burn"
             )
         return flown
 

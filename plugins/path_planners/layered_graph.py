@@ -19,9 +19,10 @@ Candidate graph (:func:`build_graph`, eqs 4–5)
     same number of nodes). S is where the robot comes to rest when it moves, G the goal
     region's centre or its first clear probe point (:func:`endpoints`).
 Clearance of a node (eqs 7, 9)
-    ``d_min``: the distance from the robot's sphere, grown by ``clearance``, to the
-    surface of the nearest obstacle's TRUE shape (sphere, turned box or cylinder), that
-    is the surface distance of the point minus ``robot_radius + clearance``. A node with
+    ``d_min``: the distance from the robot's sphere, grown by the problem's
+    ``safety_margin``, to the surface of the nearest obstacle's TRUE shape (sphere,
+    turned box or cylinder), that is the surface distance of the point minus
+    ``robot_radius + safety_margin``. A node with
     ``d_min ≤ 0`` or outside the problem's bounds is unusable.
 Segments (eq. 6)
     A segment between consecutive layers has its Euclidean length, ``√(Δd² + |Δz'|²)``
@@ -165,9 +166,10 @@ def build_graph(problem: PathProblem, params: AntColonyParams) -> LayeredGraph:
     Parameters
     ----------
     problem : PathProblem
-        Start, goal, obstacles (true shapes, predicted motion), robot radius, bounds.
+        Start, goal, obstacles (true shapes, predicted motion), robot radius, safety
+        margin, bounds.
     params : AntColonyParams
-        Cross-section, parts, points, half-width, δ, clearance, check spacing.
+        Cross-section, parts, points, half-width, δ, check spacing.
 
     Returns
     -------
@@ -195,7 +197,7 @@ class Ends:
 
 def endpoints(problem: PathProblem, params: AntColonyParams) -> Ends | NoPath:
     """S and G of ``problem`` (see :func:`build_graph`), or why there are none."""
-    goal = goal_or_refusal(problem, ObstacleField(problem, params.clearance))
+    goal = goal_or_refusal(problem, ObstacleField(problem))
     if isinstance(goal, NoPath):
         return goal
     return Ends(departure(problem), goal)
@@ -293,7 +295,7 @@ def graph_between(
     usable[0, 1:] = usable[m, 1:] = False
     if problem.bounds is not None:
         usable[1:m] &= problem.bounds.contains(points[1:m])
-    reach = problem.robot_radius + params.clearance
+    reach = problem.robot_radius + problem.safety_margin
     gaps = np.full((m + 1, count), np.inf)
     blocked = np.zeros((m, count, count), dtype=bool)
     for done, track in enumerate(problem.obstacles):
@@ -419,7 +421,7 @@ def simplify(
     tolerance = (
         params.simplify_tolerance if params.simplify_tolerance is not None else graph.spacing
     )
-    reach = problem.robot_radius + params.clearance
+    reach = problem.robot_radius + problem.safety_margin
     kept = [0]
     while kept[-1] < len(points) - 1:
         i = kept[-1]

@@ -33,12 +33,13 @@ Two burns
     is the slowest transfer: ``T = chord / min_speed``, delta-v ``2 min_speed``.
 Collisions
     Swept: every arc sampled at most ``check_spacing`` of closing distance apart, the
-    robot's sphere (``robot_radius`` + ``clearance``, grown by half the largest step
-    between samples but at least half of ``check_spacing``, as the flown trajectory's
-    check grows it, and by how far flying the burns at the problem's acceleration takes
-    the robot off the arcs) tested against every obstacle's true shape where the
-    obstacle is at each sample's time (``ObstacleField.arc_overlaps``, which also gives
-    how deep an arc goes in). Samples also stay in the problem's bounds.
+    robot's sphere (``robot_radius`` + the problem's ``safety_margin``, grown by half
+    the largest step between samples but at least half of ``check_spacing``, as the
+    flown trajectory's check grows it, and by how far flying the burns at the problem's
+    acceleration takes the robot off the arcs) tested against every obstacle's true
+    shape where the obstacle is at each sample's time (``ObstacleField.arc_overlaps``,
+    which also gives how deep an arc goes in). Samples also stay in the problem's
+    bounds.
 More burns
     When the best plan so far collides, one burn is added: each leg of the few best
     plans that collides is split at a new waypoint. The waypoint is searched on a grid
@@ -74,7 +75,6 @@ limits were computed: transfer times scanned and grid candidates), ``plans_tried
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -91,8 +91,8 @@ from scipy.optimize import minimize, minimize_scalar
 from dcsim.api import (
     NoPath,
     PathPlanner,
+    PathPlannerParams,
     PathProblem,
-    PluginParams,
     Trajectory,
     hookimpl,
     quantity,
@@ -129,7 +129,7 @@ KEPT_PLANS = 8
 """Clear plans kept for the answer (the cheapest)."""
 
 
-class MultiBurnParams(PluginParams):
+class MultiBurnParams(PathPlannerParams):
     """Parameters of :class:`MultiBurnPlanner`.
 
     ``min_speed`` and ``max_burn`` mean what they mean to ``grid-astar`` and, left
@@ -179,9 +179,6 @@ class MultiBurnParams(PluginParams):
     )
     refine: int = quantity(
         4, ge=1, le=64, description="Candidates refined at each number of burns."
-    )
-    clearance: float = quantity(
-        0.0, unit="m", ge=0, description="Margin kept beyond the robot radius."
     )
     check_spacing: float = quantity(
         0.1,
@@ -292,7 +289,7 @@ class BurnSearch:
             self.params.min_speed, self.params.max_burn, problem.max_speed
         )
         self.motion = FreeMotion.of(problem.frame)
-        self.obstacles = ObstacleField(problem, self.params.clearance)
+        self.obstacles = ObstacleField(problem)
         self.everyone = np.arange(self.obstacles.count)
         goal, start = problem.goal, problem.start
         self.total = None if goal.time is None else float(goal.time - start.time)
@@ -749,7 +746,7 @@ class MultiBurnPlanner(PathPlanner):
 
     def plan(self, problem: PathProblem) -> Trajectory | NoPath:
         """Search plans of more and more burns; the cheapest clear one, or why there is none."""
-        deadline = time.perf_counter() + problem.time_budget
+        deadline = problem.due()
         search = BurnSearch(problem, self.params)
         refusal = endpoint_refusal(problem, search.obstacles)
         if refusal is not None:

@@ -41,15 +41,14 @@ class ObstacleField:
     Parameters
     ----------
     problem : PathProblem
-        Its obstacles (true shapes and predicted motion) and ``robot_radius``.
-    clearance : float
-        Margin kept beyond the robot radius, m.
+        Its obstacles (true shapes and predicted motion), ``robot_radius`` and
+        ``safety_margin``: a sphere is clear when it keeps the margin beyond its radius.
     """
 
-    def __init__(self, problem: PathProblem, clearance: float) -> None:
+    def __init__(self, problem: PathProblem) -> None:
         self.tracks = problem.obstacles
         self.count = len(self.tracks)
-        self.reach = problem.robot_radius + clearance
+        self.reach = problem.robot_radius + problem.safety_margin
         affine = [_is_affine(track.motion) for track in self.tracks]
         self.affine = np.flatnonzero(affine)
         self.curved = [i for i, ok in enumerate(affine) if not ok]
@@ -272,7 +271,9 @@ def endpoint_refusal(problem: PathProblem, field: ObstacleField) -> NoPath | Non
         return NoPath("the start is outside the bounds")
     hit = field.blocker(start.position, start.time)
     if hit is not None:
-        return NoPath(f"the start is inside obstacle {hit} (robot radius and clearance included)")
+        return NoPath(
+            f"the start is inside obstacle {hit} (robot radius and safety margin included)"
+        )
     probes = goal_probes(problem)
     if bounds is not None:
         probes = probes[bounds.contains(probes)]

@@ -41,11 +41,11 @@ Sampling
     time or ``horizon``. With probability ``goal_bias`` RRT samples a state in the goal
     region instead (OMPL's goal bias; EST and KPIECE1 have none from Python).
 Validity
-    Inside the bounds, speed, angular rate and delta-v within the limits, and the robot's
-    sphere (``robot_radius`` plus ``clearance``) clear of every obstacle's TRUE shape
-    (sphere, box, cylinder) where it is at the state's time. Each checked sphere is grown
-    by half the distance robot and obstacles can cover in one step, so the straight
-    segments between the checked steps are clear too.
+    Inside the bounds, speed, angular rate and delta-v within the limits, and the
+    robot's sphere (``robot_radius`` plus the problem's ``safety_margin``) clear of
+    every obstacle's TRUE shape (sphere, box, cylinder) where it is at the state's time.
+    Each checked sphere is grown by half the distance robot and obstacles can cover in
+    one step, so the straight segments between the checked steps are clear too.
 Goal
     A state counts as arrived when it is inside the goal region within every tolerance,
     or when a closing manoeuvre (:class:`ClosingManoeuvre`) reaches the goal from it:
@@ -110,8 +110,8 @@ from dcsim.api import (
     FrameKind,
     NoPath,
     PathPlanner,
+    PathPlannerParams,
     PathProblem,
-    PluginParams,
     Trajectory,
     hookimpl,
     quantity,
@@ -128,7 +128,7 @@ SOURCE_SPEED, SOURCE_RATE = 5.0, 2.0
 _RESERVE = 0.05  # s of the budget kept for expanding and returning the solution
 
 
-class OmplControlParams(PluginParams):
+class OmplControlParams(PathPlannerParams):
     """Parameters of :class:`OmplControlPlanner`."""
 
     planner: Literal["rrt", "est", "kpiece"] = quantity(
@@ -177,7 +177,6 @@ class OmplControlParams(PluginParams):
     torque: float = quantity(
         0.01, unit="N m", gt=0, description="Torque when max_angular_acceleration is inf."
     )
-    clearance: float = quantity(0.05, unit="m", ge=0, description="Margin beyond the robot radius.")
 
     @field_validator("inertia")
     @classmethod
@@ -220,7 +219,7 @@ class StateCheck:
     problem : PathProblem
         Bounds, limits, robot radius and obstacles.
     field : ObstacleField
-        The obstacles, with the robot radius and clearance.
+        The obstacles, with the robot radius and the safety margin.
     model : Model
         For the largest speed change within one step.
     step : float
@@ -519,7 +518,7 @@ class Setup:
     def __init__(self, params: OmplControlParams, problem: PathProblem, rng: Any) -> None:
         self.params, self.problem = params, problem
         self.model = make_model(params, problem)
-        self.field = ObstacleField(problem, params.clearance)
+        self.field = ObstacleField(problem)
         self.check = StateCheck(problem, self.field, self.model, params.step)
         self.coordinates = Coordinates(params)
         self.counters = Counters()
@@ -687,9 +686,9 @@ class OmplControlPlanner(PathPlanner):
     params: OmplControlParams
 
     def plan(self, problem: PathProblem) -> Trajectory | NoPath:
-        """Plan from the start state into the goal region within ``problem.time_budget``."""
-        deadline = time.monotonic() + problem.time_budget
-        refusal = endpoint_refusal(problem, ObstacleField(problem, self.params.clearance))
+        """Plan from the start state into the goal region by ``problem.due()``."""
+        deadline = problem.due()
+        refusal = endpoint_refusal(problem, ObstacleField(problem))
         if refusal is not None:
             return refusal
         seed = int(self.rng.integers(1, 2**31 - 1))

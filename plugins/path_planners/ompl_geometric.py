@@ -2,12 +2,12 @@
 
 OMPL plans a path of straight segments for the robot's centre in the problem's bounds
 (without bounds: the box spanning the start and the goal, grown by half their distance
-and at least 10 m) among the obstacles' TRUE shapes (sphere, box, cylinder) at rest.
-A position is valid when the robot's sphere, grown by ``clearance`` and by half the
-``resolution``, is clear of every obstacle; OMPL checks each segment at points at most
-``resolution`` apart, so the whole segment is clear. The goal is the first clear point
-among the goal region's centre, the ends of its axes and (for a box) its corners and the
-middles of its edges and faces.
+and at least 10 m) among the obstacles' TRUE shapes (sphere, box, cylinder) at rest. A
+position is valid when the robot's sphere, grown by the problem's ``safety_margin`` and
+by half the ``resolution``, is clear of every obstacle; OMPL checks each segment at
+points at most ``resolution`` apart, so the whole segment is clear. The goal is the
+first clear point among the goal region's centre, the ends of its axes and (for a box)
+its corners and the middles of its edges and faces.
 
 Planners (``planner``): ``rrtconnect`` (default; stops at its first path), ``rrt``,
 ``rrtstar``, ``informed-rrtstar`` and ``sorrtstar`` (asymptotically optimal: they
@@ -59,8 +59,8 @@ from ompl import geometric as og
 from dcsim.api import (
     NoPath,
     PathPlanner,
+    PathPlannerParams,
     PathProblem,
-    PluginParams,
     Trajectory,
     hookimpl,
     quantity,
@@ -80,7 +80,7 @@ _RESERVE = 0.05  # s of the budget kept for simplifying and returning the path
 _MIN_SPAN = 10.0  # m: least growth of the box planned in when the problem has no bounds
 
 
-class OmplGeometricParams(PluginParams):
+class OmplGeometricParams(PathPlannerParams):
     """Parameters of :class:`OmplGeometricPlanner`."""
 
     planner: Literal["rrtconnect", "rrt", "rrtstar", "informed-rrtstar", "sorrtstar"] = quantity(
@@ -96,7 +96,6 @@ class OmplGeometricParams(PluginParams):
     range: float = quantity(
         0.0, unit="m", ge=0, description="Longest tree edge; 0 lets OMPL choose."
     )
-    clearance: float = quantity(0.1, unit="m", ge=0, description="Margin beyond the robot radius.")
     resolution: float = quantity(
         0.25, unit="m", gt=0, description="Largest spacing of collision checks along a segment."
     )
@@ -154,7 +153,7 @@ def solve(
     """Plan from ``start`` to ``goal`` (m) until ``deadline`` (``time.monotonic()``), then
     simplify; run in a fresh worker (it seeds OMPL)."""
     seed_ompl(seed)
-    field = ObstacleField(problem, params.clearance)
+    field = ObstacleField(problem)
     t0, margin = problem.start.time, 0.5 * params.resolution
     space = ob.RealVectorStateSpace(3)
     lower, upper = planning_box(problem, start, goal)
@@ -231,9 +230,9 @@ class OmplGeometricPlanner(PathPlanner):
     handles_moving_obstacles = False
 
     def plan(self, problem: PathProblem) -> Trajectory | NoPath:
-        """Plan, simplify and time a path to the goal region within the budget."""
-        deadline = time.monotonic() + problem.time_budget
-        field = ObstacleField(problem, self.params.clearance)
+        """Plan, simplify and time a path to the goal region by ``problem.due()``."""
+        deadline = problem.due()
+        field = ObstacleField(problem)
         if field.moving:
             return NoPath(MOVING_REFUSAL)
         goal = goal_or_refusal(problem, field)

@@ -17,18 +17,18 @@ Rest to rest (:func:`rest_to_rest`)
     planner, so the polyline is followed exactly.
 Timing and checks (:func:`fly_polyline`)
     v is ``speed_fraction`` of the speed limit, lowered until every piece holds its
-    ramps and half-blends (:func:`blend_speed_limit`), or chosen to arrive exactly at the
-    goal's time when it sets one (no path if even the fastest admissible v is late). A
-    start that moves first brakes to rest along its velocity (:func:`departure`). The
-    timed trajectory must stay in the bounds and within the delta-v limit, and is checked
-    with dcsim's swept clearance (``path_clearance``) against the obstacles' predicted
-    motion: it must keep half of ``clearance``. If the blends cut too close it is flown
-    again with half the cruise speed (when there is no goal time), then rest to rest at
-    every vertex (the polyline exactly; waiting at the goal for its time), and "no path"
-    if none passes. The goal is arrived at at rest (a goal velocity beyond its tolerance
-    is "no path"); the attitude is left free (the transfer mission holds the goal's or
-    the start's). The frame's free motion is not used: straight pieces are flown with
-    thrust.
+    ramps and half-blends (:func:`blend_speed_limit`), or chosen to arrive exactly at
+    the goal's time when it sets one (no path if even the fastest admissible v is late).
+    A start that moves first brakes to rest along its velocity (:func:`departure`). The
+    timed trajectory must stay in the bounds and within the delta-v limit, and is
+    checked with dcsim's swept clearance (``path_clearance``) against the obstacles'
+    predicted motion: it must keep half of the problem's ``safety_margin``. If the
+    blends cut too close it is flown again with half the cruise speed (when there is no
+    goal time), then rest to rest at every vertex (the polyline exactly; waiting at the
+    goal for its time), and "no path" if none passes. The goal is arrived at at rest (a
+    goal velocity beyond its tolerance is "no path"); the attitude is left free (the
+    transfer mission holds the goal's or the start's). The frame's free motion is not
+    used: straight pieces are flown with thrust.
 """
 
 from __future__ import annotations
@@ -238,12 +238,11 @@ def fly_polyline(
     start: Departure,
     vertices: np.ndarray,
     speed_fraction: float,
-    clearance: float,
     statistics: dict[str, float],
 ) -> Trajectory | NoPath:
     """The polyline ``vertices`` (k, 3) m, from where ``start`` comes to rest, flown with
-    blends (or rest to rest) and checked to keep half of ``clearance`` (m); see the
-    module docstring."""
+    blends (or rest to rest) and checked to keep half of the problem's ``safety_margin``
+    (m); see the module docstring."""
     keep = np.append(True, np.linalg.norm(np.diff(vertices, axis=0), axis=1) > SHORTEST)
     vertices = vertices[keep]
     goal = problem.goal
@@ -251,7 +250,7 @@ def fly_polyline(
     if len(vertices) < 2:  # already there: hold, until the goal's time if it sets one
         hold = max(available or 0.0, 1e-3)
         samples = (np.array([0.0, hold]), np.vstack([vertices, vertices]), np.zeros((2, 3)))
-        return _checked(problem, start, samples, clearance, statistics)
+        return _checked(problem, start, samples, statistics)
     attempts, reason = _attempts(problem, vertices, speed_fraction, available)
     for samples in attempts:
         if available is not None:
@@ -263,7 +262,7 @@ def fly_polyline(
                 continue
             if late < 0:
                 samples = _waiting(samples, available)
-        answer = _checked(problem, start, samples, clearance, statistics)
+        answer = _checked(problem, start, samples, statistics)
         if isinstance(answer, Trajectory):
             return answer
         reason = answer.reason
@@ -308,11 +307,11 @@ def _checked(
     problem: PathProblem,
     start: Departure,
     samples: Samples,
-    clearance: float,
     statistics: dict[str, float],
 ) -> Trajectory | NoPath:
-    """The trajectory of the braking piece and ``samples``, if it keeps half of
-    ``clearance`` from every obstacle, stays in bounds and within the delta-v limit."""
+    """The trajectory of the braking piece and ``samples``, if it keeps half of the
+    problem's ``safety_margin`` from every obstacle, stays in bounds and within the
+    delta-v limit."""
     braking = start.samples
     parts = [braking, samples] if len(braking[0]) > 1 else [samples]
     joined = chain(parts, problem.start.time)
@@ -322,10 +321,10 @@ def _checked(
     if isinstance(trajectory, NoPath) or not problem.obstacles:
         return trajectory
     closest = path_clearance(trajectory, problem)
-    if closest.distance < 0.5 * clearance:
+    needed = 0.5 * problem.safety_margin
+    if closest.distance < needed:
         return NoPath(
             f"the timed path passes {closest.distance:.3g} m from obstacle "
-            f"{closest.obstacle_id} at t = {closest.time:.1f} s (needs "
-            f"{0.5 * clearance:.3g} m)"
+            f"{closest.obstacle_id} at t = {closest.time:.1f} s (needs {needed:.3g} m)"
         )
     return trajectory

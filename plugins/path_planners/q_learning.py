@@ -29,7 +29,6 @@ from __future__ import annotations
 import hashlib
 import os
 import tempfile
-import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -54,9 +53,9 @@ from dcsim_plugins.path_planners.tabular_q import (
 from dcsim.api import (
     NoPath,
     PathPlanner,
+    PathPlannerParams,
     PathProblem,
     PluginError,
-    PluginParams,
     Trajectory,
     hookimpl,
     quantity,
@@ -66,7 +65,7 @@ if TYPE_CHECKING:
     import click
 
 
-class QLearningParams(PluginParams):
+class QLearningParams(PathPlannerParams):
     """Parameters of :class:`QLearningPlanner`."""
 
     cell_size: float = quantity(0.05, unit="m", gt=0, description="Side of a grid cell.")
@@ -183,12 +182,12 @@ class QLearningPlanner(PathPlanner):
 
     def environment(self, problem: PathProblem, deadline: float = float("inf")) -> CellEnvironment:
         """The cell environment of ``problem`` (:func:`build_environment`), built by
-        ``deadline`` (``time.perf_counter()``) or :class:`OutOfTime`."""
+        ``deadline`` (``time.monotonic()``) or :class:`OutOfTime`."""
         return build_environment(problem, self.rules(), deadline)
 
     def train(self, environment: CellEnvironment, deadline: float = float("inf")) -> Training:
         """A Q-table trained on ``environment`` with the planner's generator, by
-        ``deadline`` (``time.perf_counter()``) or :class:`OutOfTime`."""
+        ``deadline`` (``time.monotonic()``) or :class:`OutOfTime`."""
         starts = np.flatnonzero(~environment.ends)
         return train(
             environment.next_cell,
@@ -218,8 +217,7 @@ class QLearningPlanner(PathPlanner):
         refusal = unreachable(problem)
         if refusal is not None:
             return refusal
-        began = time.perf_counter()
-        deadline = began + problem.time_budget
+        deadline = problem.due()
         try:
             environment = self.environment(problem, deadline)
             if environment.start == environment.target:  # nothing to learn: one move

@@ -4,11 +4,11 @@ The collector flies straight at the goal in the frame that moves with the goal's
 velocity (for a goal at rest, a straight line in space), with a trapezoidal speed
 profile: it accelerates at ``max_acceleration``, cruises, and brakes to arrive at rest
 relative to the goal, that is, matching the goal's velocity. It arrives at the goal's
-required time if one is given, otherwise as soon as a cruise speed of
-``speed_fraction`` of the speed limit allows. The path is checked against every
-obstacle's predicted motion every ``check_spacing`` metres; if it passes closer than
-the two radii plus ``clearance`` the answer is "no path", naming the obstacle and the
-time (unless ``check_obstacles`` is false). An obstacle's radius is its bounding sphere's
+required time if one is given, otherwise as soon as a cruise speed of ``speed_fraction``
+of the speed limit allows. The path is checked against every obstacle's predicted motion
+every ``check_spacing`` metres; if it passes closer than the two radii plus the
+problem's ``safety_margin`` the answer is "no path", naming the obstacle and the time
+(unless ``check_obstacles`` is false). An obstacle's radius is its bounding sphere's
 (``ObjectTrack.radius``): for a box or a cylinder (``ObjectTrack.shape``) the check is
 conservative and may refuse a path that clears the true shape. The attitude is held at
 the start's, or, when the goal gives one, turned onto it at a constant rate (slerp) over
@@ -22,8 +22,8 @@ import numpy as np
 from dcsim.api import (
     NoPath,
     PathPlanner,
+    PathPlannerParams,
     PathProblem,
-    PluginParams,
     Trajectory,
     cruise_speed,
     hookimpl,
@@ -39,7 +39,7 @@ _MIN_DURATION = 1e-3  # s; a zero-length path still spans a positive time
 _RAMP_SAMPLES = 12  # trajectory samples per acceleration ramp
 
 
-class StraightLineParams(PluginParams):
+class StraightLineParams(PathPlannerParams):
     """Parameters of :class:`StraightLinePlanner`."""
 
     speed_fraction: float = quantity(
@@ -47,9 +47,6 @@ class StraightLineParams(PluginParams):
         gt=0,
         le=1,
         description="Fraction of the speed limit flown when no arrival time is set.",
-    )
-    clearance: float = quantity(
-        0.5, unit="m", ge=0, description="Margin kept beyond the sum of robot and obstacle radii."
     )
     check_obstacles: bool = quantity(
         True,
@@ -209,7 +206,7 @@ class StraightLinePlanner(PathPlanner):
     ) -> NoPath | None:
         for obstacle in problem.obstacles:
             gaps = np.linalg.norm(obstacle.predict(times)[0] - path, axis=1)
-            needed = problem.robot_radius + obstacle.radius + self.params.clearance
+            needed = problem.robot_radius + obstacle.radius + problem.safety_margin
             hits = np.flatnonzero(gaps < needed)
             if hits.size:
                 k = int(hits[0])

@@ -112,7 +112,7 @@ def train(
     rng : numpy.random.Generator
         Draws the starts, the ε tests and the random actions.
     deadline : float
-        ``time.perf_counter()`` by which training must end (checked every 50 episodes).
+        ``time.monotonic()`` by which training must end (checked every 50 episodes).
 
     Raises
     ------

@@ -91,10 +91,27 @@ class SeededPlanner(StraightLinePlanner):
         return dataclasses.replace(trajectory, statistics=statistics)
 
 
+class DeadlineEcho(StraightLinePlanner):
+    name = "deadline-echo"
+    summary = "Answers with the deadline it was given and when it was called (test)"
+
+    def plan(self, problem):
+        return NoPath(f"{problem.deadline!r} {time.monotonic()!r}")
+
+
 @pytest.fixture(scope="module")
 def quick():
     bench = load_problem("static-spheres")  # the straight line is clear on seed 0
     return dataclasses.replace(bench, problem=dataclasses.replace(bench.problem, time_budget=0.05))
+
+
+def test_every_plan_is_due_its_budget_after_the_bench_starts_its_clock(quick):
+    budget = quick.problem.time_budget
+    assert quick.problem.deadline is None
+    answer, seconds, _ = plan_in_process(DeadlineEcho, 0, quick.problem, memory=False)
+    deadline, called = (float(word) for word in answer.reason.split())
+    assert budget - 0.01 < deadline - called <= budget
+    assert 0 <= seconds < 0.5
 
 
 def test_each_run_plans_in_its_own_process_with_its_seed(quick):
@@ -250,17 +267,23 @@ def test_the_command_refuses_unknown_planners_and_problems():
 def test_planners_can_be_named_with_parameters():
     registry = PluginRegistry.discover()
     plain, tuned = select_planners(
-        registry, ["straight-line", "straight-line:clearance=1.5:check_obstacles=false"]
+        registry, ["straight-line", "straight-line:speed_fraction=0.4:check_obstacles=false"]
     )
     assert (plain.name, tuned.name) == (
         "straight-line",
-        "straight-line:clearance=1.5:check_obstacles=False",
+        "straight-line:speed_fraction=0.4:check_obstacles=False",
     )
-    assert tuned.params == {"clearance": 1.5, "check_obstacles": False}
-    assert tuned.settings()["clearance"] == 1.5 and plain.settings()["clearance"] == 0.5
-    for spec in ("straight-line:clearance", "straight-line:clearance=-1"):
+    assert tuned.params == {"speed_fraction": 0.4, "check_obstacles": False}
+    assert tuned.settings()["speed_fraction"] == 0.4 and plain.settings()["speed_fraction"] == 0.8
+    for spec in ("straight-line:speed_fraction", "straight-line:speed_fraction=-1"):
         with pytest.raises(DcsimError):
             select_planners(registry, [spec])
+
+
+def test_a_planner_is_given_no_margin_of_its_own():
+    registry = PluginRegistry.discover()
+    with pytest.raises(DcsimError, match="safety_margin.*mission.safety_distance"):
+        select_planners(registry, ["straight-line:clearance=1.5"])
 
 
 def test_a_planners_parameters_reach_its_runs(quick):

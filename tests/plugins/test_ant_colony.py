@@ -41,7 +41,8 @@ PAPER = {"visibility": "length", "local_search": False, "deposit_by": "all", "ph
 
 
 def problem(*obstacles, goal=(4.0, 0.0, 0.0), **changes) -> PathProblem:
-    """A transfer along +x from the origin (the line cross-sections then lie along y)."""
+    """A transfer along +x from the origin (the line cross-sections then lie along y),
+    with a safety margin of 0.05 m."""
     base = PathProblem(
         start=RobotState(time=0.0, position=[0.0, 0.0, 0.0]),
         goal=GoalRegion(position=goal, tolerance=0.2),
@@ -50,20 +51,21 @@ def problem(*obstacles, goal=(4.0, 0.0, 0.0), **changes) -> PathProblem:
         max_speed=0.5,
         max_acceleration=0.05,
         time_budget=2.0,
+        safety_margin=0.05,
     )
     return dataclasses.replace(base, **changes)
 
 
 # A 4 m transfer cut into 4 parts: three cross-sections (x = 1, 2, 3) of three points
-# (y = -1, 0, 1), and a sphere of radius 1 at (2, 5, 0), clear of every segment.
-SMALL = {"parts": 4, "points": 1, "half_width": 1.0, "clearance": 0.0, "delta": 2.0}
+# (y = -1, 0, 1), and a sphere of radius 1 at (2, 5, 0), clear of every segment; no margin.
+SMALL = {"parts": 4, "points": 1, "half_width": 1.0, "delta": 2.0}
 FAR_SPHERE = obstacle_track(1, (2.0, 5.0, 0.0), radius=1.0)
 
 
 @pytest.fixture(scope="module")
 def small() -> tuple[LayeredGraph, AntColonyParams]:
     params = AntColonyParams(**SMALL, **PAPER)
-    return build_graph(problem(FAR_SPHERE), params), params
+    return build_graph(problem(FAR_SPHERE, safety_margin=0.0), params), params
 
 
 def hand_clearance(x: float, y: float) -> float:
@@ -162,7 +164,9 @@ def test_the_roulette_follows_eq_11(small):
 def blocked_problem() -> PathProblem:
     """The small transfer with a sphere of 0.3 m between the cross-sections x = 1 and 2,
     for a robot of 0.1 m: every point is clear, some segments are not."""
-    return problem(obstacle_track(1, (1.5, 0.0, 0.0), radius=0.3), robot_radius=0.1)
+    return problem(
+        obstacle_track(1, (1.5, 0.0, 0.0), radius=0.3), robot_radius=0.1, safety_margin=0.0
+    )
 
 
 def test_blocked_segments_have_infinite_length_and_are_never_chosen():

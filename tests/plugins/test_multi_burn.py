@@ -178,7 +178,7 @@ def test_too_few_burns_or_a_goal_time_passed_is_no_path():
 
 def test_arc_overlaps_are_zero_exactly_where_arcs_are_clear():
     problem = problems.path_problem()
-    field = ObstacleField(problem, clearance=0.2)
+    field = ObstacleField(dataclasses.replace(problem, safety_margin=0.2))
     rng = np.random.default_rng(3)
     centres = np.array([track.position for track in problem.obstacles])
     starts = centres[rng.integers(len(centres), size=200)] + rng.uniform(-5, 5, (200, 3))

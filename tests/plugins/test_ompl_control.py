@@ -214,7 +214,9 @@ def test_the_asteroid_escape_is_solved_clear_of_every_asteroid(escape):
 def test_a_start_inside_an_asteroid_is_no_path(escape):
     inside = dataclasses.replace(escape.start, position=[1.22, -1.02, 8.09])  # asteroid 13
     answer = plan(dataclasses.replace(escape, start=inside))
-    assert answer == NoPath("the start is inside obstacle 13 (robot radius and clearance included)")
+    assert answer == NoPath(
+        "the start is inside obstacle 13 (robot radius and safety margin included)"
+    )
 
 
 def test_parameters_hold_the_sources_values_by_default():

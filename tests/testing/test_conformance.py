@@ -170,6 +170,24 @@ class SlowPathPlanner(StraightLinePlanner):
         return super().plan(problem)
 
 
+class MarginBlindPathPlanner(StraightLinePlanner):
+    name = "margin-blind"
+    summary = "Keeps the robot's radius from obstacles but not the problem's margin (test)"
+
+    def plan(self, problem):
+        return super().plan(dataclasses.replace(problem, safety_margin=0.0))
+
+
+class DeadlineBlindPathPlanner(StraightLinePlanner):
+    name = "deadline-blind"
+    summary = "Takes a second when its time budget is long, whatever the deadline (test)"
+
+    def plan(self, problem):
+        if problem.time_budget > 5.0:
+            time.sleep(1.0)
+        return super().plan(problem)
+
+
 class StillnessPathPlanner(StraightLinePlanner):
     name = "stillness"
     summary = "Plans among static obstacles only, and says so (test)"
@@ -245,6 +263,8 @@ def results_of(plugin: type) -> dict[str, CheckResult]:
         (ShortcutPathPlanner, {"collision_free"}),
         (StartBlindPathPlanner, {"answers_no_path"}),
         (SlowPathPlanner, {"honours_time_budget"}),
+        (MarginBlindPathPlanner, {"keeps_safety_margin"}),
+        (DeadlineBlindPathPlanner, {"honours_deadline"}),
         (BoastfulPathPlanner, {"declares_obstacle_motion"}),
         (PeekingController, {"uses_only_the_public_api"}),
         (
@@ -298,6 +318,11 @@ def test_path_planner_messages_say_what_the_plugin_did():
     assert "overlaps obstacle 4 by " in shortcut["collision_free"].message
     blind = {r.check: r for r in check_plugin(StartBlindPathPlanner)}
     assert "for a start inside obstacle 9" in blind["answers_no_path"].message
+    margin = results_of(MarginBlindPathPlanner)["keeps_safety_margin"].message
+    assert "on the margin problem it comes 0.500 m from obstacle 1" in margin
+    assert "inside the problem's safety_margin of 1 m" in margin
+    late = results_of(DeadlineBlindPathPlanner)["honours_deadline"].message
+    assert "s after the problem's deadline (its time_budget of 30 s" in late
     hurried = {r.check: r for r in check_plugin(HurriedPathPlanner)}
     assert "exceeds 0.5 m/s" in hurried["respects_limits"].message
 

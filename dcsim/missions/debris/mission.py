@@ -243,6 +243,7 @@ class DebrisMission(Mission):
             max_speed=self.robot.max_speed if max_speed is None else max_speed,
             max_acceleration=self._max_acceleration(),
             time_budget=self.settings.planning_budget,
+            safety_margin=self.settings.safety_distance,
         )
         result = self.call("path_planner", "plan", problem)
         if isinstance(result, NoPath):

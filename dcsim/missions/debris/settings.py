@@ -34,8 +34,9 @@ class DebrisMissionSection(MissionSettings):
         2.0,
         unit="m",
         ge=0,
-        description="Least surface gap to keep from obstacles (SAFETY_DISTANCE), given to the "
-        "controller and marked on the run's plots.",
+        description="Least surface gap to keep from obstacles (SAFETY_DISTANCE): the path "
+        "planner's safety margin (PathProblem.safety_margin), also given to the controller and "
+        "marked on the run's plots.",
     )
     drop_speed: float = quantity(
         0.0,

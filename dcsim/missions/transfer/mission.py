@@ -320,7 +320,8 @@ def transfer_problem(
     Parameters
     ----------
     scenario : Scenario
-        A transfer scenario: its goal, bounds, weights, limits, budget and frame.
+        A transfer scenario: its goal, bounds, weights, limits, budget, safety distance
+        (the planner's safety margin) and frame.
     start : RobotState
         Where the path starts (the mission's estimate).
     obstacles : tuple of ObjectTrack
@@ -355,6 +356,7 @@ def transfer_problem(
         bounds=bounds,
         weights=CostWeights(weights.delta_v, weights.length, weights.time),
         time_budget=settings.planning_budget,
+        safety_margin=settings.safety_distance,
     )
 
 

@@ -120,7 +120,11 @@ class TransferMissionSection(MissionSettings):
         description="Re-plan from the estimate when it strays this far from the trajectory.",
     )
     safety_distance: float = quantity(
-        0.0, unit="m", ge=0, description="Least surface gap to obstacles, given to the controller."
+        0.0,
+        unit="m",
+        ge=0,
+        description="Least surface gap to obstacles: the path planner's safety margin "
+        "(PathProblem.safety_margin), also given to the controller."
     )
     max_plan_attempts: int = quantity(
         3,
