@@ -124,7 +124,7 @@ class TransferMissionSection(MissionSettings):
         unit="m",
         ge=0,
         description="Least surface gap to obstacles: the path planner's safety margin "
-        "(PathProblem.safety_margin), also given to the controller."
+        "(PathProblem.safety_margin), also given to the controller.",
     )
     max_plan_attempts: int = quantity(
         3,
