@@ -249,8 +249,8 @@ def validate_command(files: tuple[Path, ...]) -> None:
     multiple=True,
     metavar="KEY.PATH=VALUE",
     help="Override one scenario value, e.g. --set robot.max_force=20 or "
-    "--set targets[0].motion.r=150000; the value is read as YAML. A path ending in [+] "
-    "appends to the list there: --set 'targets[+]={id: 9, ...}'. Repeatable.",
+    "--set mission.targets[0].motion.r=150000; the value is read as YAML. A path ending in "
+    "[+] appends to the list there: --set 'mission.targets[+]={id: 9, ...}'. Repeatable.",
 )
 @click.option(
     "--view",

@@ -49,7 +49,7 @@ class Problem:
     Parameters
     ----------
     path : str
-        Key path of the offending value, e.g. ``targets[3].motion.r``.
+        Key path of the offending value, e.g. ``mission.targets[3].motion.r``.
     message : str
         What is wrong and what is allowed.
     line, column : int or None

@@ -165,7 +165,7 @@ def load_scenario(
         a loaded scenario; the packaged default scenario if None.
     overrides : sequence of str or mapping
         ``key.path=value`` texts, as ``dcsim run --set`` takes them
-        (``["world.duration=30", "targets[0].motion.r=150000"]``), or a mapping of key
+        (``["world.duration=30", "mission.targets[0].motion.r=150000"]``), or a mapping of key
         paths to values (``{"world.duration": 30}``).
     seed : int, optional
         Replaces ``world.seed``.

@@ -208,8 +208,8 @@ def test_run_writes_resolved_scenario_with_seed_and_overrides(dcsim_cli, tmp_pat
             "controller.params.gian: unknown key (known keys: bandwidth, damping, attitude_bandwidth, attitude_damping)",
         ),
         (
-            "targets[7].mass=1",
-            "targets[7]: index 7 is out of range (the list has 4 items; [+] appends)",
+            "mission.targets[7].mass=1",
+            "mission.targets[7]: index 7 is out of range (the list has 4 items; [+] appends)",
         ),
         ("robot.mass", "expected key.path=value"),
     ],

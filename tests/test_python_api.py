@@ -122,13 +122,16 @@ def test_a_scenario_is_a_file_a_mapping_or_a_loaded_one_with_overrides_of_either
     assert from_file.world.seed == 4 and from_file.robot.max_force == 12.5
     assert load_scenario(data) == from_file
     assert load_scenario(from_file, {"robot.max_force": 1e-3}).robot.max_force == 1e-3
-    reshaped = load_scenario(data, {"targets[0].motion.position": [1, 2, 3.5], "name": "mapped"})
-    assert tuple(reshaped.targets[0].motion.position) == (1, 2, 3.5) and reshaped.name == "mapped"
+    reshaped = load_scenario(
+        data, {"mission.targets[0].motion.position": [1, 2, 3.5], "name": "mapped"}
+    )
+    moved = reshaped.mission.targets[0].motion.position
+    assert tuple(moved) == (1, 2, 3.5) and reshaped.name == "mapped"
     assert load_scenario().name == "default"
     swept = load_scenario(path, {"world.duration": np.float64(30), "world.seed": np.int64(7)})
     assert swept.world.duration == 30 and swept.world.seed == 7
-    placed = load_scenario(data, {"targets[0].motion.position": np.array([1.0, 2.0, 3.5])})
-    assert tuple(placed.targets[0].motion.position) == (1, 2, 3.5)
+    placed = load_scenario(data, {"mission.targets[0].motion.position": np.array([1.0, 2.0, 3.5])})
+    assert tuple(placed.mission.targets[0].motion.position) == (1, 2, 3.5)
 
 
 def test_bad_scenarios_and_overrides_are_refused_by_key_path_before_anything_runs(tmp_path):

@@ -21,7 +21,7 @@ from dcsim.runsetup import prepare_run
 from dcsim.scenario import load_scenario
 from tests.conftest import DCSIM
 
-LONG_RUN = ["world.duration=100000", "stop.on_all_delivered=false"]
+LONG_RUN = ["world.duration=100000", "mission.stop_on_all_delivered=false"]
 
 
 def long_runner(out):
@@ -84,7 +84,7 @@ def test_a_killed_run_leaves_a_readable_repeatable_run_directory(tmp_path):
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "running" and summary["scenario"] == "default"
     repeated = load_scenario(out / "scenario.yaml")
-    assert repeated.world.duration == 100000 and not repeated.stop.on_all_delivered
+    assert repeated.world.duration == 100000 and not repeated.mission.stop_on_all_delivered
     table = read_telemetry(telemetry)
     assert len(table["time"]) > 20 and table["time"][0] == 0.0
     assert np.all(np.diff(table["time"]) > 0)
@@ -155,7 +155,7 @@ import resource, sys
 resource.setrlimit(resource.RLIMIT_FSIZE, (60_000, 60_000))
 from dcsim.cli import main
 sys.argv = ["dcsim", "run", "--out", sys.argv[1], "--set", "world.duration=600",
-            "--set", "stop.on_all_delivered=false"]
+            "--set", "mission.stop_on_all_delivered=false"]
 main()
 """
 

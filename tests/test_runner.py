@@ -223,11 +223,12 @@ def test_a_failed_grab_makes_a_new_plan(tmp_path):
         """\
         world: {frame: geocentric, duration: 120}
         robot: {max_force: 5, max_speed: 0.5, grab_distance: 0.6, capacity: 1}
-        mission: {reach: 0.5}
-        targets:
-          - {id: 1, radius: 0.3, motion: {type: static, position: [-8, 0, 0]}}
+        mission:
+          reach: 0.5
+          targets:
+            - {id: 1, radius: 0.3, motion: {type: static, position: [-8, 0, 0]}}
+          drop_point: {position: [0, 0, 0]}
         beacons: {positions: [[50, 50, 50], [50, -50, -50], [-50, 50, -50], [-50, -50, 50]], noise_sigma: 0.01}
-        drop_point: {position: [0, 0, 0]}
         localiser: {plugin: biased}
         """,
     )
@@ -250,11 +251,12 @@ def test_a_target_entering_sensor_range_triggers_a_replan(tmp_path):
         """\
         world: {frame: geocentric, duration: 400}
         robot: {max_force: 5, max_speed: 0.5, sensor_range: 20, capacity: 2}
-        targets:
-          - {id: 1, radius: 0.3, motion: {type: static, position: [8, 0, 0]}}
-          - {id: 2, radius: 0.3, motion: {type: cartesian, position: [30, 6, 0], velocity: [-0.3, 0, 0]}}
+        mission:
+          targets:
+            - {id: 1, radius: 0.3, motion: {type: static, position: [8, 0, 0]}}
+            - {id: 2, radius: 0.3, motion: {type: cartesian, position: [30, 6, 0], velocity: [-0.3, 0, 0]}}
+          drop_point: {position: [0, -3, 0]}
         beacons: {positions: [[50, 50, 50], [50, -50, -50], [-50, 50, -50], [-50, -50, 50]]}
-        drop_point: {position: [0, -3, 0]}
         """,
     )
     runner, summary = run(path)

@@ -81,7 +81,7 @@ def test_thesis_scenario_is_geocentric_near_150_km():
     scenario = load_scenario(REPO / "scenarios" / "thesis_debris_field.yaml")
     assert scenario.world.frame == "geocentric"
     assert scenario.beacons.report_nearest == 3
-    motions = [o.motion for o in [*scenario.targets, *scenario.obstacles]]
+    motions = [o.motion for o in [*scenario.mission.targets, *scenario.obstacles]]
     assert all(isinstance(m, SphericalMotionSpec) for m in motions)
     assert all(145_000 <= m.r <= 155_000 for m in motions)
     rates = [abs(r) for m in motions for r in (m.alpha_deg_s, m.beta_deg_s)]
@@ -94,23 +94,26 @@ def test_errors_name_file_line_column_and_key_path(tmp_path):
         """\
         world:
           frame: lvlh
-        targets:
-          - id: 1
-            motion: {type: spherical, r: -5, polar_deg: 10, azimuth_deg: 0}
-          - id: 2
-            motion: {type: warp}
+        mission:
+          targets:
+            - id: 1
+              motion: {type: spherical, r: -5, polar_deg: 10, azimuth_deg: 0}
+            - id: 2
+              motion: {type: warp}
         robot:
           massive: 3
         """,
     )
     found = problems(path)
     assert (
-        f"{path}:5:31: targets[0].motion.r: -5 is not allowed: Input should be greater than or equal to 0 (allowed: >= 0 m)"
+        f"{path}:6:33: mission.targets[0].motion.r: -5 is not allowed: Input should be greater than or equal to 0 (allowed: >= 0 m)"
         in found
     )
-    assert any(p.startswith(f"{path}:7:5: targets[1].motion: ") and "'warp'" in p for p in found)
     assert any(
-        p.startswith(f"{path}:9:3: robot.massive: unknown key (known keys: type, mass,")
+        p.startswith(f"{path}:8:7: mission.targets[1].motion: ") and "'warp'" in p for p in found
+    )
+    assert any(
+        p.startswith(f"{path}:10:3: robot.massive: unknown key (known keys: type, mass,")
         for p in found
     )
     assert len(found) == 3
@@ -122,11 +125,12 @@ def test_rules_across_sections(tmp_path):
         """\
         world: {frame: geocentric, physics_step: 0.03, control_period: 0.1}
         robot: {mass: 5, propellant_mass: 5, initial: {attitude: [0, 0, 0, 0]}}
-        targets:
-          - {id: 4, motion: {type: cw, position: [1, 0, 0]}}
+        mission:
+          targets:
+            - {id: 4, motion: {type: cw, position: [1, 0, 0]}}
+          drop_point: {position: [0, 0, 0], motion: {type: static, position: [1, 1, 1]}}
         obstacles:
           - {id: 4, motion: {type: static, position: [9, 9, 9]}}
-        drop_point: {position: [0, 0, 0], motion: {type: static, position: [1, 1, 1]}}
         """,
     )
     found = problems(path)
@@ -134,9 +138,9 @@ def test_rules_across_sections(tmp_path):
         f"{path}:1:48: world.control_period: 0.1 s is not a whole multiple of physics_step (0.03 s)",
         f"{path}:2:18: robot.propellant_mass: 5 kg must be less than robot.mass (5 kg)",
         f"{path}:2:48: robot.initial.attitude: the quaternion must not be zero",
-        f"{path}:4:22: targets[0].motion.type: 'cw' motion needs world.frame: lvlh",
-        f"{path}:6:6: obstacles[0].id: id 4 is already used by targets[0]",
-        f"{path}:7:35: drop_point.motion: give either position or motion, not both",
+        f"{path}:5:24: mission.targets[0].motion.type: 'cw' motion needs world.frame: lvlh",
+        f"{path}:6:37: mission.drop_point.motion: give either position or motion, not both",
+        f"{path}:8:6: obstacles[0].id: id 4 is already used by mission.targets[0]",
     ]
 
 
@@ -171,28 +175,29 @@ def test_shape_errors_name_their_key_paths(tmp_path):
     path = write(
         tmp_path,
         """\
-        targets:
-          - id: 1
-            shape: {type: box, half_extents: [1, -2, 2], orientation: [0, 0, 0, 0]}
-            motion: {type: static, position: [0, 0, 0]}
-          - id: 2
-            shape: {type: cone, radius: 1}
-            motion: {type: static, position: [0, 0, 0]}
-          - id: 3
-            shape: {type: cylinder, radius: 1, half_extents: [1, 1, 1]}
-            motion: {type: static, position: [0, 0, 0]}
-          - id: 4
-            shape: {type: sphere}
-            motion: {type: static, position: [0, 0, 0]}
+        mission:
+          targets:
+            - id: 1
+              shape: {type: box, half_extents: [1, -2, 2], orientation: [0, 0, 0, 0]}
+              motion: {type: static, position: [0, 0, 0]}
+            - id: 2
+              shape: {type: cone, radius: 1}
+              motion: {type: static, position: [0, 0, 0]}
+            - id: 3
+              shape: {type: cylinder, radius: 1, half_extents: [1, 1, 1]}
+              motion: {type: static, position: [0, 0, 0]}
+            - id: 4
+              shape: {type: sphere}
+              motion: {type: static, position: [0, 0, 0]}
         """,
     )
     assert problems(path) == [
-        f"{path}:3:42: targets[0].shape.half_extents[1]: -2 is not allowed: Input should be greater than 0",
-        f"{path}:3:50: targets[0].shape.orientation: [0, 0, 0, 0] is not allowed: Value error, the quaternion must not be zero",
-        f"{path}:6:5: targets[1].shape: {{'type': 'cone', 'radius': 1}} is not allowed: Input tag 'cone' found using 'type' does not match any of the expected tags: 'sphere', 'box', 'cylinder'",
-        f"{path}:9:5: targets[2].shape.height: required but missing",
-        f"{path}:9:40: targets[2].shape.half_extents: unknown key (known keys: type, radius, height, orientation)",
-        f"{path}:12:5: targets[3].shape.radius: required but missing",
+        f"{path}:4:44: mission.targets[0].shape.half_extents[1]: -2 is not allowed: Input should be greater than 0",
+        f"{path}:4:52: mission.targets[0].shape.orientation: [0, 0, 0, 0] is not allowed: Value error, the quaternion must not be zero",
+        f"{path}:7:7: mission.targets[1].shape: {{'type': 'cone', 'radius': 1}} is not allowed: Input tag 'cone' found using 'type' does not match any of the expected tags: 'sphere', 'box', 'cylinder'",
+        f"{path}:10:7: mission.targets[2].shape.height: required but missing",
+        f"{path}:10:42: mission.targets[2].shape.half_extents: unknown key (known keys: type, radius, height, orientation)",
+        f"{path}:13:7: mission.targets[3].shape.radius: required but missing",
     ]
 
 
@@ -200,16 +205,17 @@ def test_radius_given_with_a_shape_must_agree_with_it(tmp_path):
     path = write(
         tmp_path,
         """\
-        targets:
-          - {id: 1, radius: 2, shape: {type: box, half_extents: [1, 2, 2]}, motion: {type: static, position: [0, 0, 0]}}
+        mission:
+          targets:
+            - {id: 1, radius: 2, shape: {type: box, half_extents: [1, 2, 2]}, motion: {type: static, position: [0, 0, 0]}}
         obstacles:
           - {id: 2, radius: 3, shape: {type: box, half_extents: [1, 2, 2]}, motion: {type: static, position: [0, 0, 0]}}
           - {id: 3, radius: 1.5, shape: {type: sphere, radius: 2}, motion: {type: static, position: [0, 0, 0]}}
         """,
     )
     assert problems(path) == [
-        f"{path}:2:13: targets[0].radius: 2 m disagrees with the shape's bounding radius (3 m); leave radius out when giving a shape",
-        f"{path}:5:13: obstacles[1].radius: 1.5 m disagrees with the shape's bounding radius (2 m); leave radius out when giving a shape",
+        f"{path}:3:15: mission.targets[0].radius: 2 m disagrees with the shape's bounding radius (3 m); leave radius out when giving a shape",
+        f"{path}:6:13: obstacles[1].radius: 1.5 m disagrees with the shape's bounding radius (2 m); leave radius out when giving a shape",
     ]
 
 
@@ -256,14 +262,14 @@ def test_overrides_apply_and_are_validated(tmp_path, registry):
     scenario = load_scenario(
         base,
         [
-            "targets[1].motion.position=[1, 2, 3]",
+            "mission.targets[1].motion.position=[1, 2, 3]",
             "beacons.max_range=null",
             "world.seed=9",
             "controller.params.damping=2",
         ],
         registry,
     )
-    assert scenario.targets[1].motion.position == (1.0, 2.0, 3.0)
+    assert scenario.mission.targets[1].motion.position == (1.0, 2.0, 3.0)
     assert scenario.beacons.max_range is None and scenario.world.seed == 9
     assert scenario.controller.params["damping"] == 2
     found = problems(base, ["robot.max_force=-2"])
@@ -271,8 +277,27 @@ def test_overrides_apply_and_are_validated(tmp_path, registry):
         "--set robot.max_force=-2: robot.max_force: -2 is not allowed: "
         "Input should be greater than 0 (allowed: > 0 N)"
     ]
-    assert problems(base, ["targets.mass=3"]) == [
-        "--set targets.mass=3: targets: is a list: select an item with [index] first"
+    assert problems(base, ["mission.targets.mass=3"]) == [
+        "--set mission.targets.mass=3: mission.targets: is a list: select an item with [index] "
+        "first"
+    ]
+
+
+def test_a_key_the_mission_moved_is_refused_naming_its_new_place(tmp_path):
+    path = write(
+        tmp_path,
+        """\
+        targets:
+          - {id: 1, motion: {type: static, position: [5, 0, 0]}}
+        drop_point: {position: [0, 0, 0]}
+        stop: {on_collision: true, on_all_delivered: false}
+        """,
+    )
+    assert problems(path) == [
+        f"{path}:1:1: targets: this key has moved: give it as mission.targets",
+        f"{path}:3:1: drop_point: this key has moved: give it as mission.drop_point",
+        f"{path}:4:28: stop.on_all_delivered: this key has moved: give it as "
+        "mission.stop_on_all_delivered",
     ]
 
 
@@ -343,19 +368,23 @@ def test_malformed_key_paths_are_rejected(bad):
 def test_an_override_ending_in_plus_appends_to_a_list(tmp_path):
     base = REPO / "scenarios" / "default.yaml"
     item = "{id: 99, radius: 1.0, motion: {type: static, position: [50, 0, 0]}}"
-    scenario = load_scenario(base, [f"targets[+]={item}", "targets[4].radius=2"])
-    assert [t.id for t in scenario.targets][-1] == 99 and scenario.targets[4].radius == 2
+    scenario = load_scenario(base, [f"mission.targets[+]={item}", "mission.targets[4].radius=2"])
+    targets = scenario.mission.targets
+    assert [t.id for t in targets][-1] == 99 and targets[4].radius == 2
     bare = write(tmp_path, "world:\n  seed: 1\n")
     assert len(load_scenario(bare, [f"obstacles[+]={item}"]).obstacles) == 1  # list created
-    assert problems(base, ["targets[+]={id: 98, radius: -1, motion: {type: static}}"])[0] == (
-        "--set targets[+]={id: 98, radius: -1, motion: {type: static}}: targets[4].radius: "
+    assert problems(base, ["mission.targets[+]={id: 98, radius: -1, motion: {type: static}}"])[
+        0
+    ] == (
+        "--set mission.targets[+]={id: 98, radius: -1, motion: {type: static}}: "
+        "mission.targets[4].radius: "
         "-1 is not allowed: Input should be greater than 0 (allowed: > 0 m)"
     )
     assert problems(base, ["world[+]=1"]) == [
         "--set world[+]=1: world: is not a list: [+] appends to a list"
     ]
-    assert problems(base, ["targets[+].id=3"]) == [
-        "--set targets[+].id=3: [+] must end the key path: give the whole item as the value"
+    assert problems(base, ["mission.targets[+].id=3"]) == [
+        "--set mission.targets[+].id=3: [+] must end the key path: give the whole item as the value"
     ]
 
 

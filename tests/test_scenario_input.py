@@ -94,8 +94,8 @@ def test_a_control_character_is_an_error(tmp_path):
             "3:19: robot.initial.velocity[1]: inf is not allowed: Input should be a finite number",
         ),
         (
-            "targets:\n  - {id: 1, motion: {type: spherical, r: 5, polar_deg: -.inf, azimuth_deg: 0}}\n",
-            "2:45: targets[0].motion.polar_deg: -inf is not allowed: Input should be a finite number",
+            "mission:\n  targets:\n    - {id: 1, motion: {type: spherical, r: 5, polar_deg: -.inf, azimuth_deg: 0}}\n",
+            "3:47: mission.targets[0].motion.polar_deg: -inf is not allowed: Input should be a finite number",
         ),
         (
             "beacons: {max_range: .inf}\n",
@@ -241,8 +241,8 @@ def test_a_recursive_alias_is_an_error(tmp_path):
     "text, expected",
     [
         (
-            "targets:\n  - {motion: {type: static, position: [1, 2, 3]}}\n",
-            ["2:5: targets[0].id: required but missing"],
+            "mission:\n  targets:\n    - {motion: {type: static, position: [1, 2, 3]}}\n",
+            ["3:7: mission.targets[0].id: required but missing"],
         ),
         (
             "world: 3\nrobot: [1, 2]\n",
@@ -282,9 +282,10 @@ robot:
   mass: 5
   propellant_mass: 5
   capacity: 0
-targets:
-  - {id: 1, motion: {type: cw, position: [1, 2, .nan]}}
-  - {id: 1, radius: x, motion: {type: static, position: [1, 2, 3]}}
+mission:
+  targets:
+    - {id: 1, motion: {type: cw, position: [1, 2, .nan]}}
+    - {id: 1, radius: x, motion: {type: static, position: [1, 2, 3]}}
 """,
     )
     assert problems(path) == [
@@ -292,9 +293,9 @@ targets:
         f"{path}:3:3: world.seed: -1 is not allowed: Input should be greater than or equal to 0 (allowed: >= 0, <= 2147483647)",
         f"{path}:6:3: robot.propellant_mass: 5 kg must be less than robot.mass (5 kg)",
         f"{path}:7:3: robot.capacity: 0 is not allowed: Input should be greater than or equal to 1 (allowed: >= 1)",
-        f"{path}:9:49: targets[0].motion.position[2]: nan is not allowed: Input should be a finite number",
-        f"{path}:10:6: targets[1].id: id 1 is already used by targets[0]",
-        f"{path}:10:13: targets[1].radius: 'x' is not allowed: Input should be a valid number, unable to parse string as a number (allowed: > 0 m)",
+        f"{path}:10:51: mission.targets[0].motion.position[2]: nan is not allowed: Input should be a finite number",
+        f"{path}:11:8: mission.targets[1].id: id 1 is already used by mission.targets[0]",
+        f"{path}:11:15: mission.targets[1].radius: 'x' is not allowed: Input should be a valid number, unable to parse string as a number (allowed: > 0 m)",
     ]
 
 

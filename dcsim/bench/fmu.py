@@ -88,7 +88,7 @@ def bench_fmu(
         Seconds per tick of every repeat, both ways.
     """
     say = progress or (lambda line: None)
-    overrides = [*overrides, f"world.duration={duration}", "stop.on_all_delivered=false"]
+    overrides = [*overrides, f"world.duration={duration}", "mission.stop_on_all_delivered=false"]
     registry = PluginRegistry.discover()
     with tempfile.TemporaryDirectory(prefix="dcsim-bench-fmu-") as tmp:
         path = export_fmu(scenario, Path(tmp) / "closed_loop.fmu", overrides=overrides)

@@ -260,7 +260,7 @@ def slew_scenario(case: SlewCase, hold_position: bool) -> Scenario:
                 "attitude": list(case.goal_attitude),
                 "hold_position": hold_position,
             },
-            "stop": {"on_collision": False, "on_all_delivered": False},
+            "stop": {"on_collision": False},
         }
     )
 

@@ -117,7 +117,11 @@ def soak(
         None,
         # One simulated second per tick is more than the ticks need at the default
         # 0.1 s control period, and stays within the scenario's bound on physics steps.
-        ["stop.on_all_delivered=false", f"world.duration={ticks}", "stop.on_collision=false"],
+        [
+            "mission.stop_on_all_delivered=false",
+            f"world.duration={ticks}",
+            "stop.on_collision=false",
+        ],
         registry=registry,
     )
     runner = Runner(setup, out_dir)

@@ -101,11 +101,14 @@ def field_scenario(objects: int, duration: float, seed: int = 0) -> Scenario:
             "name": f"bench-{objects}",
             "world": {"frame": "lvlh", "orbit": {"radius": ORBIT_RADIUS}, "duration": duration},
             "robot": {"radius": 0.5, "max_force": 5.0, "max_speed": 0.5, "sensor_range": 120.0},
-            "targets": targets,
             "obstacles": obstacles,
             "beacons": {"positions": _BEACONS, "noise_sigma": 0.05, "report_nearest": 4},
-            "drop_point": {"position": [-5.0, 0.0, 0.0], "tolerance": 1.5},
-            "stop": {"on_collision": False, "on_all_delivered": False},
+            "mission": {
+                "targets": targets,
+                "drop_point": {"position": [-5.0, 0.0, 0.0], "tolerance": 1.5},
+                "stop_on_all_delivered": False,
+            },
+            "stop": {"on_collision": False},
         }
     )
 

@@ -169,7 +169,7 @@ class ScenarioDocument:
     def apply_override(self, assignment: str) -> None:
         """Apply one ``key.path=value`` override; the value is parsed as YAML.
 
-        A key path ending in ``[+]`` (``targets[+]={...}``) appends the value to the list
+        A key path ending in ``[+]`` (``mission.targets[+]={...}``) appends the value to the list
         there, which is created if the document has none.
 
         Raises

@@ -15,6 +15,7 @@ gives an equal scenario.
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Callable, Mapping, Sequence
 from functools import cache
@@ -131,17 +132,46 @@ def validate(doc: ScenarioDocument) -> Scenario:
     """
     _refuse_campaign(doc)
     model = _scenario_model(doc)
+    data, problems = _without_moved_keys(doc, model)
     try:
-        scenario = model.model_validate(doc.data)
+        scenario = model.model_validate(data)
     except ValidationError as exc:
-        problems = schema_problems(doc, exc, model)
-    else:
-        problems = []
-    violations = _rule_violations(doc.data, model)
+        problems += schema_problems(doc, exc, model)
+    violations = _rule_violations(data, model)
     problems += [doc.problem(path, message) for path, message in violations]
     if problems:
         raise ScenarioError(doc.filename, sorted(problems, key=_document_order))
     return scenario
+
+
+def _without_moved_keys(
+    doc: ScenarioDocument, model: type[Scenario]
+) -> tuple[dict[str, Any], list[Problem]]:
+    """The document's data without the keys its mission moved elsewhere
+    (``MissionSettings.moved_keys``), and one problem per such key naming its new place."""
+    moved = model.model_fields["mission"].annotation.moved_keys
+    found = [(old, new) for old, new in moved.items() if _has_key(doc.data, old)]
+    if not found:
+        return doc.data, []
+    data = copy.deepcopy(doc.data)
+    problems = []
+    for old, new in found:
+        *parents, last = old
+        section = data
+        for key in parents:
+            section = section[key]
+        del section[last]
+        problems.append(doc.problem(old, f"this key has moved: give it as {format_key_path(new)}"))
+    return data, problems
+
+
+def _has_key(data: Any, path: KeyPath) -> bool:
+    """Whether raw ``data`` has a value at key ``path``."""
+    for key in path:
+        if not isinstance(data, dict) or key not in data:
+            return False
+        data = data[key]
+    return True
 
 
 def _refuse_campaign(doc: ScenarioDocument) -> None:
@@ -252,9 +282,11 @@ class ScenarioValues:
             node = node[key]
         return True
 
-    def items(self, key: str) -> range:
-        """Indices of the raw list at top-level ``key`` (none if it is not a list)."""
-        raw = self.data.get(key)
+    def items(self, *path: str) -> range:
+        """Indices of the raw list at ``path`` (none if there is no list there)."""
+        raw: Any = self.data
+        for key in path:
+            raw = raw.get(key) if isinstance(raw, dict) else None
         return range(len(raw) if isinstance(raw, list) else 0)
 
 
@@ -359,11 +391,12 @@ def _attitude_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
 def _object_rules(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
     found: list[tuple[KeyPath, str]] = []
     owners: dict[int, str] = {}
-    for section in ("targets", "obstacles"):
-        for index in get.items(section):
-            found += _checked(_unique_id_rule, get, (section, index), owners)
-            found += _checked(cw_motion_rule, get, (section, index, "motion", "type"))
-            found += _checked(_shape_radius_rule, get, (section, index))
+    for section in (("mission", "targets"), ("obstacles",)):
+        for index in get.items(*section):
+            item = (*section, index)
+            found += _checked(_unique_id_rule, get, item, owners)
+            found += _checked(cw_motion_rule, get, (*item, "motion", "type"))
+            found += _checked(_shape_radius_rule, get, item)
     return found
 
 

@@ -584,26 +584,6 @@ class BeaconsSection(Section):
     )
 
 
-class DropPointSection(Section):
-    """Where targets are delivered: a fixed ``position`` or a ``motion``."""
-
-    position: Point | None = quantity(
-        None, unit="m", description="Fixed position (or give `motion`)."
-    )
-    motion: MotionSpec | None = Field(
-        None, description="Motion of a moving drop point (or give `position`)."
-    )
-    tolerance: float = quantity(
-        2.0, unit="m", gt=0, description="Distance within which cargo is released."
-    )
-
-    def build(self, mean_motion: float) -> MotionModel:
-        """The drop point's motion model."""
-        if self.motion is not None:
-            return self.motion.build(mean_motion)
-        return StaticMotion(point_to_cartesian(self.position or (0.0, 0.0, 0.0)))
-
-
 class PluginChoice(Section):
     """Which plugin fills a role, and its parameters."""
 
@@ -627,6 +607,9 @@ class MissionSettings(Section):
 
     role_defaults: ClassVar[dict[str, PluginChoice | None]] = {}
     rules: ClassVar[tuple[Callable[..., list[tuple[tuple[str | int, ...], str]]], ...]] = ()
+    moved_keys: ClassVar[dict[tuple[str, ...], tuple[str, ...]]] = {}
+    """Keys the mission's scenarios once had elsewhere, by old key path: a file that
+    still has one is refused with an error naming the new place."""
 
     type: str = Field(
         "debris",
@@ -634,12 +617,16 @@ class MissionSettings(Section):
         "`hold`) or one an installed package adds.",
     )
 
+    def target_specs(self) -> list[SpaceObjectSpec]:
+        """The objects the mission puts into the world as its targets, beside the
+        scenario's obstacles (none unless the mission has targets)."""
+        return []
+
 
 class StopSection(Section):
     """When a run ends before ``world.duration``."""
 
     on_collision: bool = Field(True, description="End the run at the first collision.")
-    on_all_delivered: bool = Field(True, description="End the run once every target is delivered.")
     max_wall_time: float | None = quantity(
         None,
         unit="s",
@@ -649,7 +636,7 @@ class StopSection(Section):
 
 
 class Scenario(Section):
-    """A complete scenario: world, collector, objects, sensors, plugins, stop rules."""
+    """A complete scenario: world, robot, obstacles, sensors, plugins, mission, stop rules."""
 
     name: str = Field("unnamed", description="Short name of the scenario.")
     description: str = Field("", description="What the scenario shows.")
@@ -658,13 +645,9 @@ class Scenario(Section):
         default_factory=RobotSection,
         description="The robot; `type` selects it (default `free-flyer`).",
     )
-    targets: list[SpaceObjectSpec] = Field(default_factory=list, description="Objects to collect.")
     obstacles: list[SpaceObjectSpec] = Field(default_factory=list, description="Objects to avoid.")
     beacons: BeaconsSection = Field(
         default_factory=BeaconsSection, description="Localisation beacons."
-    )
-    drop_point: DropPointSection = Field(
-        default_factory=DropPointSection, description="Delivery point."
     )
     localiser: PluginChoice = Field(
         default_factory=lambda: PluginChoice(plugin="trilateration"),

@@ -98,7 +98,7 @@ def _handling(
     handling: Handling,
 ) -> list[dict[str, Any]]:
     """Targets captured, delivered and carried, for missions that collect them."""
-    total = len(scenario.targets)
+    total = len(scenario.mission.target_specs())
     if scenario.mission.type != "debris" or total == 0:
         return []
     captured, delivered = handling.counts(times)

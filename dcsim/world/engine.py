@@ -129,8 +129,6 @@ class World:
         Inputs applied over the next :meth:`step`.
     field : ObjectField
         The targets and obstacles.
-    drop_point : DropPoint
-        Where cargo is delivered.
     collisions : list of CollisionEvent
         Every collision so far.
     """
@@ -150,9 +148,6 @@ class World:
         self.collisions: list[CollisionEvent] = []
         self.inputs = WorldInputs()
         self._mean_motion = scenario.mean_motion if scenario.world.frame == "lvlh" else None
-        self.drop_point = DropPoint(
-            scenario.drop_point.build(scenario.mean_motion), scenario.drop_point.tolerance
-        )
         self.field = ObjectField(build_objects(scenario))
         self._sensors = Sensors(scenario, self.field, rng)
         self._client = connect_direct()
@@ -599,12 +594,12 @@ class World:
             self._contacts = {pair for pair in self._contacts if pair[0] != index}
         return result
 
-    def release(self) -> ReleaseResult:
-        """Release every carried target if the collector is at the drop point.
+    def release(self, drop_point: DropPoint) -> ReleaseResult:
+        """Release every carried target if the collector is at ``drop_point``.
 
         Released targets count as delivered and leave the world.
         """
-        result = self._cargo.release(self.collector_state()[0], self.drop_point, self.time)
+        result = self._cargo.release(self.collector_state()[0], drop_point, self.time)
         if result.delivered:
             pb.changeDynamics(
                 self.collector, -1, mass=self.collector_mass(), physicsClientId=self._client

@@ -56,12 +56,13 @@ _FREE = int(ObjectStatus.FREE)
 
 
 def build_objects(scenario: Scenario) -> list[SpaceObject]:
-    """The scenario's targets and obstacles as world objects (targets first)."""
+    """The mission's targets and the scenario's obstacles as world objects (targets
+    first)."""
     n = scenario.mean_motion
     return [
         SpaceObject(spec.id, kind, spec.build_shape(), spec.mass, spec.motion.build(n))
         for kind, specs in (
-            (ObjectKind.TARGET, scenario.targets),
+            (ObjectKind.TARGET, scenario.mission.target_specs()),
             (ObjectKind.OBSTACLE, scenario.obstacles),
         )
         for spec in specs

@@ -232,13 +232,14 @@ def test_the_move_quaternion_turns_the_heading_onto_the_commanded_direction(velo
 CROSSING = """\
     world: {{frame: geocentric, duration: 600}}
     robot: {{radius: 0.5, max_speed: 0.5, initial: {{position: [0, 0, 0]}}}}
-    targets:
-      - {{id: 1, radius: 0.3, motion: {{type: static, position: [40, 0, 0]}}}}
+    mission:
+      targets:
+        - {{id: 1, radius: 0.3, motion: {{type: static, position: [40, 0, 0]}}}}
+      drop_point: {{position: [-5, 0, 0], tolerance: 1.5}}
+      safety_distance: 5.0
     obstacles:
       - {{id: 9, radius: 1.0, motion: {{type: cartesian, position: {obstacle_at}, velocity: {obstacle_v}}}}}
     beacons: {{positions: [[100, 100, 100], [100, -100, -100], [-100, 100, -100], [-100, -100, 100]]}}
-    drop_point: {{position: [-5, 0, 0], tolerance: 1.5}}
-    mission: {{safety_distance: 5.0}}
     localiser: {{plugin: ekf}}
     task_planner: {{plugin: nearest}}
     path_planner: {{plugin: straight-line, params: {{check_obstacles: false}}}}

@@ -7,7 +7,13 @@ import textwrap
 import numpy as np
 import pytest
 
-from dcsim.api import ClohessyWiltshireMotion, SphericalMotion, mean_motion
+from dcsim.api import (
+    ClohessyWiltshireMotion,
+    DropPoint,
+    SphericalMotion,
+    StaticMotion,
+    mean_motion,
+)
 from dcsim.scenario import ScenarioDocument, validate
 from dcsim.world import World, WorldInputs
 from dcsim.world.environment import STANDARD_GRAVITY
@@ -25,11 +31,12 @@ FIELD = """\
     world: {frame: lvlh, physics_step: 0.01, control_period: 0.1}
     robot: {mass: 100, propellant_mass: 10, radius: 0.5, max_force: 5, sensor_range: 30,
             grab_distance: 1.0, capacity: 1, specific_impulse: 200}
-    targets:
-      - {id: 1, radius: 0.5, mass: 5, motion: {type: cw, position: [2.5, 0, 0], velocity: [0, -0.005657, 0]}}
-      - {id: 2, radius: 0.5, mass: 5, motion: {type: cw, position: [0, 2.2, 0], velocity: [0, 0, 0]}}
-      - {id: 3, radius: 0.5, mass: 5, motion: {type: cw, position: [0, -25, 0], velocity: [0, 0, 0.01]}}
-      - {id: 4, radius: 0.5, mass: 5, motion: {type: cw, position: [0, 0, 40], velocity: [0, 0, 0]}}
+    mission:
+      targets:
+        - {id: 1, radius: 0.5, mass: 5, motion: {type: cw, position: [2.5, 0, 0], velocity: [0, -0.005657, 0]}}
+        - {id: 2, radius: 0.5, mass: 5, motion: {type: cw, position: [0, 2.2, 0], velocity: [0, 0, 0]}}
+        - {id: 3, radius: 0.5, mass: 5, motion: {type: cw, position: [0, -25, 0], velocity: [0, 0, 0.01]}}
+        - {id: 4, radius: 0.5, mass: 5, motion: {type: cw, position: [0, 0, 40], velocity: [0, 0, 0]}}
     obstacles:
       - {id: 9, radius: 1.0, motion: {type: cw, position: [-20, 5, 0], velocity: [0, 0.04525, 0]}}
     beacons:
@@ -147,21 +154,16 @@ def test_cargo_protrusion_is_how_far_cargo_sticks_out_of_the_collector():
 
 
 def test_release_only_at_the_drop_point():
-    world = world_from(
-        FIELD.replace("position: [0, 2.2, 0]", "position: [0, 1.9, 0]").rstrip(" ")
-        + "    drop_point: {position: [0, 0, 0], tolerance: 0.5}\n"
-    )
-    assert world.release().reason == "nothing carried"
+    world = world_from(FIELD.replace("position: [0, 2.2, 0]", "position: [0, 1.9, 0]"))
+    here = DropPoint(StaticMotion([0.0, 0.0, 0.0]), tolerance=0.5)
+    assert world.release(here).reason == "nothing carried"
     assert world.grab(2).success
-    assert world.release().delivered == (2,)
+    assert world.release(here).delivered == (2,)
     assert world.outputs()["delivered"] == 1 and world.outputs()["carried"] == 0
     assert world.cargo_protrusion() == 0.0 and world.robot_spec().radius == 0.5
-    away = world_from(
-        FIELD.replace("position: [0, 2.2, 0]", "position: [0, 1.9, 0]").rstrip(" ")
-        + "    drop_point: {position: [9, 0, 0], tolerance: 0.5}\n"
-    )
+    away = world_from(FIELD.replace("position: [0, 2.2, 0]", "position: [0, 1.9, 0]"))
     assert away.grab(2).success
-    refused = away.release()
+    refused = away.release(DropPoint(StaticMotion([9.0, 0.0, 0.0]), tolerance=0.5))
     assert refused.delivered == () and "from the drop point" in refused.reason
     assert away.cargo_protrusion() > 1.0  # still on board
 

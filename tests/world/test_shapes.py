@@ -129,10 +129,11 @@ def test_grab_gap_and_cargo_use_the_target_shape():
     text = """\
         world: {frame: geocentric, physics_step: 0.01, control_period: 0.1}
         robot: {radius: 0.5, grab_distance: 1.0, capacity: 1}
-        targets:
-          - id: 1
-            shape: {type: box, half_extents: [1.0, 0.2, 0.2], orientation: [0, 1, 0, 1]}  # long along z
-            motion: {type: static, position: [1.2, 0, 0]}
+        mission:
+          targets:
+            - id: 1
+              shape: {type: box, half_extents: [1.0, 0.2, 0.2], orientation: [0, 1, 0, 1]}  # long along z
+              motion: {type: static, position: [1.2, 0, 0]}
         obstacles:
           - {id: 2, radius: 0.5, motion: {type: static, position: [1.2, 0, 3.0]}}
         """

@@ -31,6 +31,7 @@ import numpy as np
 from dcsim.geometry import length, unit
 from dcsim.interfaces import Plugin
 from dcsim.messages import (
+    DropPoint,
     DropVisit,
     GoalRegion,
     NoPath,
@@ -78,15 +79,20 @@ class DebrisMission(Mission):
     scenario : Scenario
         The resolved scenario (mission settings, robot limits).
     world : World
-        Provides the grab and release services and the drop point.
+        Provides the grab and release services.
     plugins : mapping of str to Plugin
         The plugin of each role in :attr:`roles`.
     emit : callable
         ``emit(event_name, **data)`` records an event.
+
+    Attributes
+    ----------
+    drop_point : DropPoint
+        Where cargo is delivered (the section's ``drop_point``).
     """
 
     type = "debris"
-    summary = "collect drifting targets and deliver them to a drop point (the source thesis)"
+    summary = "collect drifting targets and deliver them to a drop point (the debris thesis)"
     Settings = DebrisMissionSection
     roles = ("localiser", "task_planner", "path_planner", "controller")
     summary_names = ("targets", "captured", "delivered")
@@ -99,6 +105,8 @@ class DebrisMission(Mission):
     ) -> None:
         super().__init__(scenario, world, plugins, emit)
         self.robot = scenario.robot
+        drop = self.settings.drop_point
+        self.drop_point = DropPoint(drop.build(scenario.mean_motion), drop.tolerance)
         self.state = Mode.LOCALIZE
         self.known: dict[int, ObjectTrack] = {}
         self.planned: set[int] = set()
@@ -181,7 +189,7 @@ class DebrisMission(Mission):
         field = self.world.field
         targets = int(field.is_target.sum())
         if (
-            self.scenario.stop.on_all_delivered
+            self.settings.stop_on_all_delivered
             and targets
             and field.count(ObjectStatus.DELIVERED) == targets
         ):
@@ -284,7 +292,7 @@ class DebrisMission(Mission):
             time=self.time,
             robot=self.estimate,
             targets=targets,
-            drop_point=self.world.drop_point,
+            drop_point=self.drop_point,
             capacity=self.robot.capacity,
             carried=len(self.world.carried_ids()),
             max_speed=self.robot.max_speed,
@@ -409,7 +417,7 @@ class DebrisMission(Mission):
         return reference
 
     def _move_to_drop(self) -> Reference:
-        drop = self.world.drop_point
+        drop = self.drop_point
         if self.trajectory is None and self.time >= self.retry_at:
             arrive = self.visit.time if self.visit and self.visit.time > self.time else None
             position, velocity = drop.state_at(self.time if arrive is None else arrive)
@@ -423,7 +431,7 @@ class DebrisMission(Mission):
         )
         distance = length(self.estimate.position - drop.state_at(self.time)[0])
         if distance <= self.settings.release_fraction * drop.tolerance:
-            result = self.world.release()
+            result = self.world.release(drop)
             if result.delivered or not self.world.carried_ids():
                 self.emit("release", delivered=list(result.delivered), reason=result.reason)
                 self.trajectory = None

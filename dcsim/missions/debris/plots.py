@@ -167,7 +167,7 @@ def _trajectory_paths(
         true=true,
         estimated=stacked(telemetry, ("est_x", "est_y", "est_z")),
         grabs=grab_points.reshape(-1, 3),
-        drop=scenario.drop_point.build(scenario.mean_motion).state_at(sample)[0],
+        drop=scenario.mission.drop_point.build(scenario.mean_motion).state_at(sample)[0],
         objects=list(_object_paths(scenario, sample, events)),
     )
 

@@ -16,14 +16,18 @@ def reach_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
 
 def drop_point_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
     """A drop point is fixed or moving, not both."""
-    if get("drop_point", "position") is not None and get("drop_point", "motion") is not None:
-        return [(("drop_point", "motion"), "give either position or motion, not both")]
+    position, motion = (
+        get("mission", "drop_point", "position"),
+        get("mission", "drop_point", "motion"),
+    )
+    if position is not None and motion is not None:
+        return [(("mission", "drop_point", "motion"), "give either position or motion, not both")]
     return []
 
 
 def drop_point_motion_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
     """A drop point on a ``cw`` motion needs the LVLH frame."""
-    return cw_motion_rule(get, ("drop_point", "motion", "type"))
+    return cw_motion_rule(get, ("mission", "drop_point", "motion", "type"))
 
 
 RULES = (reach_rule, drop_point_rule, drop_point_motion_rule)

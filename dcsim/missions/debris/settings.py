@@ -7,19 +7,59 @@ from typing import ClassVar, Literal
 from pydantic import Field
 
 from dcsim.missions.debris.rules import RULES
+from dcsim.motion import MotionModel, StaticMotion
 from dcsim.params import quantity
 from dcsim.scenario.loader import Rule
-from dcsim.scenario.model import MissionSettings
+from dcsim.scenario.model import (
+    MissionSettings,
+    MotionSpec,
+    Point,
+    Section,
+    SpaceObjectSpec,
+    point_to_cartesian,
+)
+
+
+class DropPointSection(Section):
+    """Where targets are delivered: a fixed ``position`` or a ``motion``."""
+
+    position: Point | None = quantity(
+        None, unit="m", description="Fixed position (or give `motion`)."
+    )
+    motion: MotionSpec | None = Field(
+        None, description="Motion of a moving drop point (or give `position`)."
+    )
+    tolerance: float = quantity(
+        2.0, unit="m", gt=0, description="Distance within which cargo is released."
+    )
+
+    def build(self, mean_motion: float) -> MotionModel:
+        """The drop point's motion model."""
+        if self.motion is not None:
+            return self.motion.build(mean_motion)
+        return StaticMotion(point_to_cartesian(self.position or (0.0, 0.0, 0.0)))
 
 
 class DebrisMissionSection(MissionSettings):
     """How the executer flies the debris-collection mission (the thesis's §5.2 and §5.4)."""
 
     rules: ClassVar[tuple[Rule, ...]] = RULES
+    moved_keys: ClassVar[dict[tuple[str, ...], tuple[str, ...]]] = {
+        ("targets",): ("mission", "targets"),
+        ("drop_point",): ("mission", "drop_point"),
+        ("stop", "on_all_delivered"): ("mission", "stop_on_all_delivered"),
+    }
 
     type: Literal["debris"] = Field(
         "debris",
         description="The mission type: debris collection (the debris collector thesis).",
+    )
+    targets: list[SpaceObjectSpec] = Field(default_factory=list, description="Objects to collect.")
+    drop_point: DropPointSection = Field(
+        default_factory=DropPointSection, description="Where the targets are delivered."
+    )
+    stop_on_all_delivered: bool = Field(
+        True, description="End the run once every target is delivered."
     )
 
     reach: float = quantity(
@@ -74,3 +114,7 @@ class DebrisMissionSection(MissionSettings):
         le=1,
         description="Fraction of the drop tolerance within which the collector releases its cargo.",
     )
+
+    def target_specs(self) -> list[SpaceObjectSpec]:
+        """The targets to collect."""
+        return list(self.targets)
