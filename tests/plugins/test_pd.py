@@ -90,7 +90,7 @@ def test_slews_a_free_flyer_in_pybullet_to_a_held_attitude_within_its_torque_lim
             f"robot.initial.attitude=[{quaternion}]",
             "robot.initial.angular_velocity=[0.02,-0.01,0.03]",
             "world.frame=geocentric",
-            "targets=[]",
+            "mission.targets=[]",
             "obstacles=[]",
         ],
     )
