@@ -16,21 +16,76 @@ import warnings
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 import numpy as np
 
 from dcsim.errors import PlanOutlastsRunWarning
 from dcsim.interfaces import Plugin
-from dcsim.messages import Observations, Reference, StateEstimate, Surroundings
+from dcsim.messages import (
+    DropPoint,
+    Observations,
+    Reference,
+    RobotSpec,
+    RobotState,
+    StateEstimate,
+    Surroundings,
+)
 from dcsim.plugin_calls import call_plugin
 from dcsim.scenario.model import MissionSettings, Scenario
 
 if TYPE_CHECKING:
-    from dcsim.world import World
+    from dcsim.world.objects import ObjectField
+    from dcsim.world.services import GrabResult, ReleaseResult
 
 Emit = Callable[..., None]
 """``emit(event_name, **data)`` records an event at the current time."""
+
+
+class MissionWorld(Protocol):
+    """What a mission may use of the world: its objects, the robot, and the services.
+
+    The runner's world (:class:`dcsim.world.World`) is one; a mission is typed against
+    this, not against the PyBullet engine, so that it depends on no more of the world
+    than it uses. States are the truth, for the mission's bookkeeping; what the robot
+    believes comes to :meth:`Mission.tick` as its estimate.
+
+    Attributes
+    ----------
+    field : ObjectField
+        The targets and obstacles: their kinds, shapes, status (free, carried,
+        delivered) and counts.
+    """
+
+    field: ObjectField
+
+    def robot_spec(self) -> RobotSpec:
+        """The robot's mass (cargo included), inertia, limits and model now."""
+        ...
+
+    def robot_state(self) -> RobotState:
+        """The robot's true state now (base and joints)."""
+        ...
+
+    def assembly_mass(self) -> float:
+        """Mass of the robot and everything it carries, kg."""
+        ...
+
+    def carried_ids(self) -> list[int]:
+        """Ids of the targets the robot holds."""
+        ...
+
+    def cargo_protrusion(self) -> float:
+        """How far carried targets reach beyond the robot's surface, m (0 if none)."""
+        ...
+
+    def grab(self, target_id: int) -> GrabResult:
+        """Grab a target within reach, holding it rigidly (a fixed joint)."""
+        ...
+
+    def release(self, drop_point: DropPoint) -> ReleaseResult:
+        """Release every carried target if the robot is at ``drop_point``."""
+        ...
 
 
 class Mission(ABC):
@@ -40,7 +95,7 @@ class Mission(ABC):
     ----------
     scenario : Scenario
         The resolved scenario; ``scenario.mission`` is an instance of :attr:`Settings`.
-    world : World
+    world : MissionWorld
         The world, for its services (grab, release) and bookkeeping.
     plugins : mapping of str to Plugin
         The constructed plugin of each role in :attr:`roles`.
@@ -88,7 +143,7 @@ class Mission(ABC):
     summary_names: ClassVar[tuple[str, ...]] = ()
 
     def __init__(
-        self, scenario: Scenario, world: World, plugins: Mapping[str, Plugin], emit: Emit
+        self, scenario: Scenario, world: MissionWorld, plugins: Mapping[str, Plugin], emit: Emit
     ) -> None:
         self.scenario = scenario
         self.settings = scenario.mission

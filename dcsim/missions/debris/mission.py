@@ -46,10 +46,9 @@ from dcsim.messages import (
     TaskRequest,
     Trajectory,
 )
-from dcsim.missions.base import Emit, Mission
+from dcsim.missions.base import Emit, Mission, MissionWorld
 from dcsim.missions.debris.settings import DebrisMissionSection
 from dcsim.scenario.model import Scenario
-from dcsim.world import World
 from dcsim.world.objects import ObjectStatus
 
 #: Gap kept between carried cargo and a target being approached, m.
@@ -78,7 +77,7 @@ class DebrisMission(Mission):
     ----------
     scenario : Scenario
         The resolved scenario (mission settings, robot limits).
-    world : World
+    world : MissionWorld
         Provides the grab and release services.
     plugins : mapping of str to Plugin
         The plugin of each role in :attr:`roles`.
@@ -101,7 +100,7 @@ class DebrisMission(Mission):
     settings: DebrisMissionSection
 
     def __init__(
-        self, scenario: Scenario, world: World, plugins: Mapping[str, Plugin], emit: Emit
+        self, scenario: Scenario, world: MissionWorld, plugins: Mapping[str, Plugin], emit: Emit
     ) -> None:
         super().__init__(scenario, world, plugins, emit)
         self.robot = scenario.robot

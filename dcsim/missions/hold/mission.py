@@ -21,10 +21,9 @@ from numpy.typing import ArrayLike
 from dcsim.geometry import length
 from dcsim.interfaces import Plugin
 from dcsim.messages import Observations, Reference, StateEstimate
-from dcsim.missions.base import Emit, Mission
+from dcsim.missions.base import Emit, Mission, MissionWorld
 from dcsim.missions.hold.settings import HoldMissionSection
 from dcsim.scenario.model import Scenario, point_to_cartesian
-from dcsim.world import World
 
 
 class HoldMission(Mission):
@@ -34,7 +33,7 @@ class HoldMission(Mission):
     ----------
     scenario : Scenario
         The resolved scenario; ``scenario.mission`` is a :class:`HoldMissionSection`.
-    world : World
+    world : MissionWorld
         The world.
     plugins : mapping of str to Plugin
         The controller and, if the scenario names one, the localiser.
@@ -64,7 +63,7 @@ class HoldMission(Mission):
     settings: HoldMissionSection
 
     def __init__(
-        self, scenario: Scenario, world: World, plugins: Mapping[str, Plugin], emit: Emit
+        self, scenario: Scenario, world: MissionWorld, plugins: Mapping[str, Plugin], emit: Emit
     ) -> None:
         super().__init__(scenario, world, plugins, emit)
         initial = scenario.robot.initial

@@ -47,11 +47,10 @@ from dcsim.messages import (
     StateEstimate,
     Trajectory,
 )
-from dcsim.missions.base import Emit, Mission
+from dcsim.missions.base import Emit, Mission, MissionWorld
 from dcsim.missions.reach.settings import ReachMissionSection
 from dcsim.robots.joint_path import JointPath, SingularPath
 from dcsim.scenario.model import Scenario
-from dcsim.world import World
 
 
 class ReachMission(Mission):
@@ -62,7 +61,7 @@ class ReachMission(Mission):
     scenario : Scenario
         The resolved scenario; ``scenario.mission`` is a :class:`ReachMissionSection` and
         ``scenario.robot`` a manipulator.
-    world : World
+    world : MissionWorld
         The world, for the robot's model and the true state recorded in telemetry.
     plugins : mapping of str to Plugin
         The path planner, the controller and, if the scenario names one, the localiser.
@@ -92,7 +91,7 @@ class ReachMission(Mission):
     settings: ReachMissionSection
 
     def __init__(
-        self, scenario: Scenario, world: World, plugins: Mapping[str, Plugin], emit: Emit
+        self, scenario: Scenario, world: MissionWorld, plugins: Mapping[str, Plugin], emit: Emit
     ) -> None:
         super().__init__(scenario, world, plugins, emit)
         self.model = world.robot_spec().model

@@ -42,10 +42,9 @@ from dcsim.messages import (
     StateEstimate,
     Trajectory,
 )
-from dcsim.missions.base import Emit, Mission
+from dcsim.missions.base import Emit, Mission, MissionWorld
 from dcsim.missions.transfer.settings import TransferMissionSection
 from dcsim.scenario.model import Scenario
-from dcsim.world import World
 
 _TRAJECTORY_HEADER = (
     "time_s,x_m,y_m,z_m,qx,qy,qz,qw,vx_mps,vy_mps,vz_mps,wx_radps,wy_radps,wz_radps,"
@@ -60,7 +59,7 @@ class TransferMission(Mission):
     ----------
     scenario : Scenario
         The resolved scenario; ``scenario.mission`` is a :class:`TransferMissionSection`.
-    world : World
+    world : MissionWorld
         The world (its frame, the robot's properties).
     plugins : mapping of str to Plugin
         The path planner, the controller and, if the scenario names one, the localiser.
@@ -88,7 +87,7 @@ class TransferMission(Mission):
     settings: TransferMissionSection
 
     def __init__(
-        self, scenario: Scenario, world: World, plugins: Mapping[str, Plugin], emit: Emit
+        self, scenario: Scenario, world: MissionWorld, plugins: Mapping[str, Plugin], emit: Emit
     ) -> None:
         super().__init__(scenario, world, plugins, emit)
         self.goal = self.settings.goal.build()
