@@ -244,7 +244,30 @@ class InitialStateSpec(Section):
     )
 
 
-class RobotSection(Section):
+class RobotBaseSection(Section):
+    """What every robot's base has: a type, a wet mass, thrusters fed by its propellant,
+    a torque and a speed limit, and an object sensor. Each robot type's section derives
+    from it (and states its own type, mass and propellant)."""
+
+    type: str = Field(description="The robot type.")
+    mass: float = quantity(unit="kg", gt=0, description="Mass, propellant included.")
+    propellant_mass: float = quantity(0.0, unit="kg", ge=0, description="Usable propellant.")
+    max_force: float = quantity(10.0, unit="N", gt=0, description="Largest thrust magnitude.")
+    max_torque: float = quantity(
+        1.0, unit="N*m", gt=0, description="Largest torque magnitude on the base."
+    )
+    max_speed: float = quantity(
+        1.0, unit="m/s", gt=0, description="Speed guidance must not exceed."
+    )
+    specific_impulse: float = quantity(
+        220.0, unit="s", gt=0, description="Thruster specific impulse."
+    )
+    sensor_range: float = quantity(
+        200.0, unit="m", gt=0, description="Objects farther away are not tracked."
+    )
+
+
+class RobotSection(RobotBaseSection):
     """The robot: a free flyer (the debris collector) with mass, limits, sensors, grabber."""
 
     type: Literal["free-flyer"] = Field(
@@ -255,17 +278,6 @@ class RobotSection(Section):
         10.0, unit="kg", ge=0, description="Usable propellant (part of mass)."
     )
     radius: float = quantity(1.0, unit="m", gt=0, description="Radius of the bounding sphere.")
-    max_force: float = quantity(10.0, unit="N", gt=0, description="Largest thrust magnitude.")
-    max_torque: float = quantity(1.0, unit="N*m", gt=0, description="Largest torque magnitude.")
-    max_speed: float = quantity(
-        1.0, unit="m/s", gt=0, description="Speed guidance must not exceed."
-    )
-    specific_impulse: float = quantity(
-        220.0, unit="s", gt=0, description="Thruster specific impulse."
-    )
-    sensor_range: float = quantity(
-        200.0, unit="m", gt=0, description="Objects farther away are not tracked."
-    )
     grab_distance: float = quantity(
         2.0, unit="m", gt=0, description="Largest centre distance at which a grab succeeds."
     )
@@ -351,7 +363,7 @@ class DHLinkSpec(Section):
         )
 
 
-class ManipulatorSection(Section):
+class ManipulatorSection(RobotBaseSection):
     """The robot: a space manipulator, a satellite base carrying an arm of revolute joints.
 
     The base flies as a free flyer does (thrust from propellant, torque from reaction
@@ -381,19 +393,6 @@ class ManipulatorSection(Section):
     )
     links: list[DHLinkSpec] = Field(
         min_length=1, description="The DH table, one row per joint, from the base outwards."
-    )
-    max_force: float = quantity(10.0, unit="N", gt=0, description="Largest thrust magnitude.")
-    max_torque: float = quantity(
-        1.0, unit="N*m", gt=0, description="Largest base torque magnitude."
-    )
-    max_speed: float = quantity(
-        1.0, unit="m/s", gt=0, description="Speed guidance must not exceed."
-    )
-    specific_impulse: float = quantity(
-        220.0, unit="s", gt=0, description="Thruster specific impulse."
-    )
-    sensor_range: float = quantity(
-        200.0, unit="m", gt=0, description="Objects farther away are not tracked."
     )
     initial: ManipulatorInitialSpec = Field(
         default_factory=ManipulatorInitialSpec, description="State at t = 0."
