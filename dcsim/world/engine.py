@@ -149,7 +149,7 @@ class World:
         self.inputs = WorldInputs()
         self._mean_motion = scenario.mean_motion if scenario.world.frame == "lvlh" else None
         self.field = ObjectField(build_objects(scenario))
-        self._sensors = Sensors(scenario, self.field, rng)
+        self._sensors = Sensors(scenario.beacons, robot.sensor_range, self.field, rng)
         self._client = connect_direct()
         # A world dropped without close() (an FMU reset does that) still disconnects.
         self._disconnect = weakref.finalize(self, pb.disconnect, physicsClientId=self._client)

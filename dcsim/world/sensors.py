@@ -11,7 +11,7 @@ import numpy as np
 
 from dcsim.geometry import row_lengths
 from dcsim.messages import BeaconRange, ObjectTrack, Observations
-from dcsim.scenario.model import Scenario, point_to_cartesian
+from dcsim.scenario.model import BeaconsSection, point_to_cartesian
 from dcsim.world.objects import ObjectField
 
 
@@ -20,8 +20,10 @@ class Sensors:
 
     Parameters
     ----------
-    scenario : Scenario
-        Beacons, their range sensor and the object sensor's range.
+    beacons : BeaconsSection
+        The beacons and their range sensor (noise, reach, readings per step).
+    sensor_range : float
+        Range of the object sensor, m.
     field : ObjectField
         The world's objects.
     rng : numpy.random.Generator
@@ -33,15 +35,19 @@ class Sensors:
         Beacon positions, world frame, m (read-only).
     """
 
-    def __init__(self, scenario: Scenario, field: ObjectField, rng: np.random.Generator) -> None:
+    def __init__(
+        self,
+        beacons: BeaconsSection,
+        sensor_range: float,
+        field: ObjectField,
+        rng: np.random.Generator,
+    ) -> None:
         self.beacons = (
-            np.array([point_to_cartesian(p) for p in scenario.beacons.positions])
-            .reshape(-1, 3)
-            .copy()
+            np.array([point_to_cartesian(p) for p in beacons.positions]).reshape(-1, 3).copy()
         )  # its own data, not a view of the list's array
         self.beacons.setflags(write=False)  # shared by every range message, not copied
-        self._settings = scenario.beacons
-        self._sensor_range = scenario.robot.sensor_range
+        self._settings = beacons
+        self._sensor_range = sensor_range
         self._field = field
         self._rng = rng
 
