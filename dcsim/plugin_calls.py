@@ -9,7 +9,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from dcsim.interfaces import Plugin
-from dcsim.plugin_outputs import EXPECTED, answers, output_problem
+from dcsim.plugin_outputs import ANSWERS, output_problem
 
 
 class PluginFailure(Exception):
@@ -89,11 +89,8 @@ def call_plugin(
         answer = getattr(plugin, method)(*args)
     except Exception as error:  # a plugin's own bug ends the run, recorded
         raise PluginFailure(role, plugin.name, method, error) from error
-    if answers(plugin.kind, method):
-        problem = output_problem(plugin.kind, method, answer, joints)
-        if problem is not None:
-            expected = EXPECTED[plugin.kind, method]
-            raise PluginFailure(
-                role, plugin.name, method, problem=f"{problem}; expected {expected}"
-            )
+    problem = output_problem(plugin.kind, method, answer, joints)
+    if problem is not None:
+        expected = ANSWERS[plugin.kind].expected
+        raise PluginFailure(role, plugin.name, method, problem=f"{problem}; expected {expected}")
     return answer

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
-from dataclasses import fields, is_dataclass
+from dataclasses import dataclass, fields, is_dataclass
 from functools import cache
 from typing import Any
 
@@ -24,38 +24,42 @@ import numpy as np
 
 from dcsim.messages import Command, NoPath, Plan, StateEstimate, Trajectory
 
-ANSWER_METHODS: dict[str, str] = {
-    "localiser": "estimate",
-    "task_planner": "plan",
-    "path_planner": "plan",
-    "controller": "command",
-}
-"""The method of each kind whose answer is checked (the kind's other methods answer None)."""
 
-EXPECTED: dict[tuple[str, str], str] = {
-    ("localiser", "estimate"): "a StateEstimate with finite numbers",
-    ("task_planner", "plan"): "a Plan with finite times and points",
-    ("path_planner", "plan"): (
+@dataclass(frozen=True)
+class Answer:
+    """What one kind's answering method must hand back.
+
+    Attributes
+    ----------
+    method : str
+        The method whose answer is checked (the kind's other methods answer None).
+    types : tuple of type
+        The message types it may return.
+    expected : str
+        The contract in words, for messages.
+    """
+
+    method: str
+    types: tuple[type, ...]
+    expected: str
+
+
+ANSWERS: dict[str, Answer] = {
+    "localiser": Answer("estimate", (StateEstimate,), "a StateEstimate with finite numbers"),
+    "task_planner": Answer("plan", (Plan,), "a Plan with finite times and points"),
+    "path_planner": Answer(
+        "plan",
+        (Trajectory, NoPath),
         "a Trajectory (at least two samples, strictly increasing times, finite numbers) "
-        "or a NoPath with a reason"
+        "or a NoPath with a reason",
     ),
-    ("controller", "command"): (
-        "a Command with finite force, torque and joint torques (none, or one per joint)"
+    "controller": Answer(
+        "command",
+        (Command,),
+        "a Command with finite force, torque and joint torques (none, or one per joint)",
     ),
 }
-"""What each answering method must return, in words, by ``(kind, method)``."""
-
-_TYPES: dict[tuple[str, str], tuple[type, ...]] = {
-    ("localiser", "estimate"): (StateEstimate,),
-    ("task_planner", "plan"): (Plan,),
-    ("path_planner", "plan"): (Trajectory, NoPath),
-    ("controller", "command"): (Command,),
-}
-
-
-def answers(kind: str, method: str) -> bool:
-    """Whether ``method`` of a plugin of ``kind`` hands back a value that is checked."""
-    return (kind, method) in _TYPES
+"""The answer each plugin kind owes, by kind."""
 
 
 def output_problem(kind: str, method: str, output: Any, joints: int | None = None) -> str | None:
@@ -67,8 +71,8 @@ def output_problem(kind: str, method: str, output: Any, joints: int | None = Non
         The plugin's kind (``localiser``, ``task_planner``, ``path_planner``,
         ``controller``).
     method : str
-        The method that answered; a method not in :data:`EXPECTED` (``reset``,
-        ``predict``, ``update``) answers nothing that is checked.
+        The method that answered; any other than the kind's :data:`ANSWERS` method
+        (``reset``, ``predict``, ``update``) answers nothing that is checked.
     output : object
         What it returned.
     joints : int, optional
@@ -80,10 +84,10 @@ def output_problem(kind: str, method: str, output: Any, joints: int | None = Non
     str or None
         E.g. ``"returned ndarray"`` or ``"returned non-finite numbers: force [nan 0 0]"``.
     """
-    wanted = _TYPES.get((kind, method))
-    if wanted is None:
+    answer = ANSWERS.get(kind)
+    if answer is None or answer.method != method:
         return None
-    if not isinstance(output, wanted):
+    if not isinstance(output, answer.types):
         return f"returned {type(output).__name__}"
     if isinstance(output, NoPath):
         return None if str(output.reason).strip() else "returned a NoPath without a reason"

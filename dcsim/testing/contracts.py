@@ -27,7 +27,7 @@ from dcsim.messages import (
     Surroundings,
     Trajectory,
 )
-from dcsim.plugin_outputs import ANSWER_METHODS, EXPECTED, output_problem
+from dcsim.plugin_outputs import ANSWERS, output_problem
 from dcsim.registry import check_plugin_class
 from dcsim.testing import problems
 
@@ -282,10 +282,10 @@ def checked_answer(kind: str, output: Any, what: str, joints: int | None = None)
     """``output`` when it is an answer a plugin of ``kind`` may give (the check a run makes
     at the plugin boundary, :func:`dcsim.plugin_outputs.output_problem`); otherwise a
     violation saying what was wrong on ``what`` and what was expected."""
-    method = ANSWER_METHODS[kind]
-    problem = output_problem(kind, method, output, joints)
+    answer = ANSWERS[kind]
+    problem = output_problem(kind, answer.method, output, joints)
     if problem is not None:
-        fail(f"{problem} on {what}; expected {EXPECTED[kind, method]}")
+        fail(f"{problem} on {what}; expected {answer.expected}")
     return output
 
 
@@ -399,7 +399,7 @@ def check_no_mutation(plugin_class: type[Plugin]) -> None:
 def _check_output(kind: str, output: Any) -> str | None:
     """Why an output is not of the documented type, shape and finiteness, or (for an
     estimate) its covariance not symmetric (None if fine)."""
-    problem = output_problem(kind, ANSWER_METHODS[kind], output)
+    problem = output_problem(kind, ANSWERS[kind].method, output)
     if problem is not None:
         return problem
     if isinstance(output, StateEstimate):
