@@ -20,6 +20,7 @@ import copy
 import tempfile
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -97,17 +98,22 @@ def _document(scenario: ScenarioSource) -> dict[str, Any]:
     return copy.deepcopy(scenario_document(scenario).data)
 
 
+@cache
+def _registry() -> PluginRegistry:
+    """The installed plugins, discovered once for every check."""
+    return PluginRegistry.discover()
+
+
 def _setup(scenario: ScenarioSource) -> RunSetup:
-    """The scenario's run set-up: validated, its plugins made."""
+    """The scenario's run set-up: validated, its plugins made (afresh for each flight)."""
     try:
-        return prepare_run(_document(scenario), registry=PluginRegistry.discover())
+        return prepare_run(_document(scenario), registry=_registry())
     except ScenarioError as error:
         fail(f"its scenario does not validate: {error}")
 
 
-def _fly(scenario: ScenarioSource, out: Path) -> dict[str, Any]:
-    """Fly the scenario into run directory ``out``; return its summary."""
-    setup = _setup(scenario)
+def _fly(setup: RunSetup, out: Path) -> dict[str, Any]:
+    """Fly a run set-up into run directory ``out``; return its summary."""
     try:
         return Runner(setup, out).run()
     except Exception as error:  # the mission's own bug: name it
@@ -154,7 +160,7 @@ def check_section_validation(mission: type[Mission], scenario: ScenarioSource) -
     data = _document(scenario)
     data.setdefault("mission", {})["no_such_key_xyz"] = 1
     try:
-        prepare_run(data, registry=PluginRegistry.discover())
+        prepare_run(data, registry=_registry())
     except ScenarioError as error:
         if "mission.no_such_key_xyz" not in str(error):
             fail(f"an unknown mission key was refused without being named: {error}")
@@ -171,11 +177,12 @@ def check_section_validation(mission: type[Mission], scenario: ScenarioSource) -
 def check_flight(mission: type[Mission], scenario: ScenarioSource) -> None:
     with tempfile.TemporaryDirectory() as folder:
         out = Path(folder) / "run"
-        summary = _fly(scenario, out)
+        setup = _setup(scenario)
+        summary = _fly(setup, out)
         if summary["status"] == "failed":
             fail(f"the run failed: {summary['reason']}")
         telemetry = read_telemetry(out / "telemetry.csv")
-        validated = _setup(scenario).scenario
+        validated = setup.scenario
         missing = [c for c in mission.telemetry_columns(validated) if c not in telemetry]
         if missing:
             fail(f"its columns {missing} are not in the telemetry")
@@ -199,7 +206,7 @@ def check_determinism(mission: type[Mission], scenario: ScenarioSource) -> None:
     with tempfile.TemporaryDirectory() as folder:
         runs = [Path(folder) / name for name in ("first", "second")]
         for out in runs:
-            _fly(scenario, out)
+            _fly(_setup(scenario), out)
         for name in ("telemetry.csv", "events.jsonl"):
             if (runs[0] / name).read_bytes() != (runs[1] / name).read_bytes():
                 fail(f"{name} differs between two flights of the same scenario and seed")
