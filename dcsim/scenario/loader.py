@@ -150,7 +150,8 @@ def _without_moved_keys(
     """The document's data without the keys its mission moved elsewhere
     (``MissionSettings.moved_keys``), and one problem per such key naming its new place."""
     moved = model.model_fields["mission"].annotation.moved_keys
-    found = [(old, new) for old, new in moved.items() if _has_key(doc.data, old)]
+    present = ScenarioValues(doc.data, model).given
+    found = [(old, new) for old, new in moved.items() if present(*old)]
     if not found:
         return doc.data, []
     data = copy.deepcopy(doc.data)
@@ -163,15 +164,6 @@ def _without_moved_keys(
         del section[last]
         problems.append(doc.problem(old, f"this key has moved: give it as {format_key_path(new)}"))
     return data, problems
-
-
-def _has_key(data: Any, path: KeyPath) -> bool:
-    """Whether raw ``data`` has a value at key ``path``."""
-    for key in path:
-        if not isinstance(data, dict) or key not in data:
-            return False
-        data = data[key]
-    return True
 
 
 def _refuse_campaign(doc: ScenarioDocument) -> None:
@@ -389,9 +381,13 @@ def _attitude_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
 
 
 def _object_rules(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
+    """Ids unique across the mission's targets and the obstacles; their motions and
+    shapes."""
     found: list[tuple[KeyPath, str]] = []
     owners: dict[int, str] = {}
-    for section in (("mission", "targets"), ("obstacles",)):
+    targets_key = get.model.model_fields["mission"].annotation.targets_key
+    targets = [] if targets_key is None else [("mission", targets_key)]
+    for section in (*targets, ("obstacles",)):
         for index in get.items(*section):
             item = (*section, index)
             found += _checked(_unique_id_rule, get, item, owners)

@@ -606,6 +606,9 @@ class MissionSettings(Section):
 
     role_defaults: ClassVar[dict[str, PluginChoice | None]] = {}
     rules: ClassVar[tuple[Callable[..., list[tuple[tuple[str | int, ...], str]]], ...]] = ()
+    targets_key: ClassVar[str | None] = None
+    """The section's key holding the targets the mission puts into the world (a list of
+    objects, checked as the obstacles are); None when the mission has none."""
     moved_keys: ClassVar[dict[tuple[str, ...], tuple[str, ...]]] = {}
     """Keys the mission's scenarios once had elsewhere, by old key path: a file that
     still has one is refused with an error naming the new place."""
@@ -618,8 +621,8 @@ class MissionSettings(Section):
 
     def target_specs(self) -> list[SpaceObjectSpec]:
         """The objects the mission puts into the world as its targets, beside the
-        scenario's obstacles (none unless the mission has targets)."""
-        return []
+        scenario's obstacles: its field named by :attr:`targets_key` (none without one)."""
+        return [] if self.targets_key is None else list(getattr(self, self.targets_key))
 
 
 class StopSection(Section):

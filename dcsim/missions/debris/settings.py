@@ -44,6 +44,7 @@ class DebrisMissionSection(MissionSettings):
     """How the executer flies the debris-collection mission (the thesis's §5.2 and §5.4)."""
 
     rules: ClassVar[tuple[Rule, ...]] = RULES
+    targets_key: ClassVar[str | None] = "targets"
     moved_keys: ClassVar[dict[tuple[str, ...], tuple[str, ...]]] = {
         ("targets",): ("mission", "targets"),
         ("drop_point",): ("mission", "drop_point"),
@@ -114,7 +115,3 @@ class DebrisMissionSection(MissionSettings):
         le=1,
         description="Fraction of the drop tolerance within which the collector releases its cargo.",
     )
-
-    def target_specs(self) -> list[SpaceObjectSpec]:
-        """The targets to collect."""
-        return list(self.targets)
