@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 import click
 
 from dcsim import __version__
-from dcsim.bench.options import comma_numbers
+from dcsim.bench.options import comma_numbers, comma_words
 from dcsim.cli_campaign import campaign_group, cluster_choice, cluster_options
 from dcsim.errors import DcsimError, PluginLoadWarning, PluginNotFoundError, did_you_mean
 from dcsim.interfaces import PLUGIN_KINDS
@@ -744,9 +744,7 @@ def bench_controllers_command(
     from dcsim.scenario import packaged_scenario_path
 
     scenario = packaged_scenario_path("crowded_field.yaml")
-    names = [name.strip() for name in controllers.split(",") if name.strip()]
-    if not names:
-        raise click.BadParameter("name at least one controller", param_hint="--controllers")
+    names = comma_words(controllers, "--controllers")
     registry = PluginRegistry.discover()
     for name in names:  # unknown controllers and bad overrides fail here, before any run
         chosen = [f"controller.plugin={name}", "controller.params={}", *overrides]
@@ -1138,12 +1136,7 @@ def _write_records(
 
 def _names(text: str | None, option: str) -> list[str] | None:
     """The comma-separated names of an option (None when it is not given)."""
-    if text is None:
-        return None
-    names = [name.strip() for name in text.split(",") if name.strip()]
-    if not names:
-        raise click.BadParameter("name at least one", param_hint=option)
-    return names
+    return None if text is None else comma_words(text, option)
 
 
 @cli.group("robot")

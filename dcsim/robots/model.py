@@ -74,6 +74,10 @@ class RobotModel(Protocol):
         ...
 
 
+_CONFORMING: set[type] = set()
+"""Classes whose instances were found to be robot models."""
+
+
 def check_robot_model(owner: str, model: object) -> None:
     """Raise unless ``model`` is None or satisfies :class:`RobotModel`.
 
@@ -89,7 +93,10 @@ def check_robot_model(owner: str, model: object) -> None:
     TypeError
         Naming the members ``model`` lacks.
     """
-    if model is None or isinstance(model, RobotModel):
+    if model is None or type(model) in _CONFORMING:
+        return
+    if isinstance(model, RobotModel):
+        _CONFORMING.add(type(model))  # checked once per class: robot specs are made every tick
         return
     members = [name for name in vars(RobotModel) if not name.startswith("_")]
     missing = [name for name in members if not hasattr(model, name)]

@@ -37,7 +37,8 @@ def test_the_manipulator_model_is_a_robot_model():
 
 
 def test_a_scenario_robots_model_is_a_robot_model():
-    assert isinstance(reach_problem().model, RobotModel)
+    model = reach_problem().model
+    assert model is not None and isinstance(model, RobotModel)
 
 
 def test_a_model_missing_members_is_refused_naming_them():
