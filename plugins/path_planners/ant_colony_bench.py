@@ -935,7 +935,7 @@ def _span(specs: Sequence[str]) -> str:
 )
 @click.option(
     "--figure-scenario",
-    default="scenarios/ffsr_obstacles.yaml",
+    default=FIGURE_SCENARIO,
     show_default=True,
     help="The problem drawn by --figure.",
 )
