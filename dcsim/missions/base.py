@@ -4,7 +4,8 @@ A :class:`Mission` is the task side of a run (as dm_control splits a task from i
 physics): the runner owns the world, the sensors, the localiser and the controller and
 knows no mission; each control tick it hands the mission the estimate and the
 observations, and the mission answers with the reference the controller tracks. On
-the way it asks its planners, calls world services (grab, release) and reports events.
+the way it asks its planners, uses the world (attaching objects to the robot, say) and
+reports events.
 The mission also says which plugin roles it uses, which telemetry columns and summary
 fields it adds, and when it is finished.
 """
@@ -23,7 +24,6 @@ import numpy as np
 from dcsim.errors import PlanOutlastsRunWarning
 from dcsim.interfaces import Plugin
 from dcsim.messages import (
-    DropPoint,
     Observations,
     Reference,
     RobotSpec,
@@ -36,14 +36,13 @@ from dcsim.scenario.model import MissionSettings, Scenario
 
 if TYPE_CHECKING:
     from dcsim.world.objects import ObjectField
-    from dcsim.world.services import GrabResult, ReleaseResult
 
 Emit = Callable[..., None]
 """``emit(event_name, **data)`` records an event at the current time."""
 
 
 class MissionWorld(Protocol):
-    """What a mission may use of the world: its objects, the robot, and the services.
+    """What a mission may use of the world: its objects, the robot, and its payload.
 
     The runner's world (:class:`dcsim.world.World`) is one; a mission is typed against
     this, not against the PyBullet engine, so that it depends on no more of the world
@@ -54,7 +53,7 @@ class MissionWorld(Protocol):
     ----------
     field : ObjectField
         The targets and obstacles: their kinds, shapes, status (free, carried,
-        delivered) and counts.
+        removed) and counts.
     """
 
     field: ObjectField
@@ -72,19 +71,24 @@ class MissionWorld(Protocol):
         ...
 
     def carried_ids(self) -> list[int]:
-        """Ids of the targets the robot holds."""
+        """Ids of the objects the robot holds."""
         ...
 
     def cargo_protrusion(self) -> float:
-        """How far carried targets reach beyond the robot's surface, m (0 if none)."""
+        """How far carried objects reach beyond the robot's bounding sphere, m (0 if none)."""
         ...
 
-    def grab(self, target_id: int) -> GrabResult:
-        """Grab a target within reach, holding it rigidly (a fixed joint)."""
+    def surface_gap(self, object_id: int, within: float) -> float:
+        """Gap between the robot's base and free object ``object_id``, m (``inf`` beyond
+        ``within``, negative when they overlap)."""
         ...
 
-    def release(self, drop_point: DropPoint) -> ReleaseResult:
-        """Release every carried target if the robot is at ``drop_point``."""
+    def attach(self, object_id: int) -> None:
+        """Hold free object ``object_id`` rigidly where it is now (a fixed joint)."""
+        ...
+
+    def remove_payload(self) -> tuple[int, ...]:
+        """Take every object the robot holds out of the world; their ids."""
         ...
 
 
@@ -96,7 +100,7 @@ class Mission(ABC):
     scenario : Scenario
         The resolved scenario; ``scenario.mission`` is an instance of :attr:`Settings`.
     world : MissionWorld
-        The world, for its services (grab, release) and bookkeeping.
+        The world, for its payload and bookkeeping.
     plugins : mapping of str to Plugin
         The constructed plugin of each role in :attr:`roles`.
     emit : callable

@@ -1,8 +1,9 @@
-"""PyBullet bodies of a world: the collector, the objects' static bodies, carried targets.
+"""PyBullet bodies of a world's objects: static while free, dynamic once carried.
 
 Each body has its object's true shape: a sphere, a box (``GEOM_BOX``, half extents) or
 a cylinder (``GEOM_CYLINDER``, its axis the body z axis), turned by the shape's fixed
-orientation wherever it is placed. The collector is a sphere.
+orientation wherever it is placed. :func:`create_body` makes the free flyer's sphere
+too.
 
 Every body has collision filtering off: contacts are detected by closest-point queries
 (:func:`surface_gap`), never resolved, so bodies pass through each other. A free
@@ -16,7 +17,6 @@ from __future__ import annotations
 import numpy as np
 
 from dcsim.messages import Shape, ShapeKind
-from dcsim.scenario.model import RobotSection, point_to_cartesian
 from dcsim.world.objects import ObjectField
 from dcsim.world.pybullet_client import pb
 
@@ -71,29 +71,6 @@ def _collision_shape(client: int, shape: Shape) -> int:
             pb.GEOM_CYLINDER, radius=shape.radius, height=shape.height, physicsClientId=client
         )
     return pb.createCollisionShape(pb.GEOM_SPHERE, radius=shape.radius, physicsClientId=client)
-
-
-def create_collector(client: int, robot: RobotSection) -> int:
-    """The collector's sphere body at its initial state (position, attitude, velocities)."""
-    initial = robot.initial
-    body = create_body(
-        client,
-        Shape(ShapeKind.SPHERE, radius=robot.radius),
-        robot.mass,
-        point_to_cartesian(initial.position),
-        False,
-    )
-    attitude = np.asarray(initial.attitude) / np.linalg.norm(initial.attitude)
-    pb.resetBasePositionAndOrientation(
-        body,
-        point_to_cartesian(initial.position).tolist(),
-        attitude.tolist(),
-        physicsClientId=client,
-    )
-    pb.resetBaseVelocity(
-        body, list(initial.velocity), list(initial.angular_velocity), physicsClientId=client
-    )
-    return body
 
 
 def surface_gap(client: int, body_a: int, body_b: int, within: float) -> float:

@@ -4,15 +4,19 @@ One PyBullet DIRECT client per world, zero gravity, a fixed physics step; every 
 passes the client id, so several worlds live side by side in one process. The world
 composes its pieces:
 
-- :mod:`~dcsim.world.bodies`: the PyBullet bodies of the collector and the objects;
+- :mod:`~dcsim.world.robot_body`: the robot, one of two body types behind one
+  interface — :mod:`~dcsim.world.free_flyer` (a rigid sphere) and
+  :mod:`~dcsim.world.manipulator` (a floating-base arm);
+- :mod:`~dcsim.world.bodies`: the PyBullet bodies of the objects;
 - :mod:`~dcsim.world.environment`: Clohessy–Wiltshire forces and the propellant;
 - :mod:`~dcsim.world.sensors`: beacon ranges, object tracks, attitude and rate;
-- :mod:`~dcsim.world.services`: grab and release (the cargo);
+- :mod:`~dcsim.world.payload`: objects held by the robot (a mission attaches them);
 - :mod:`~dcsim.world.objects`: the targets and obstacles and their motion.
 
-- **Collector**: a rigid sphere driven by thrust (clipped to ``max_force`` and to the
+- **Robot**: its base is driven by thrust (clipped to ``max_force`` and to the
   propellant left) and torque (clipped to ``max_torque``, from reaction wheels: no
-  propellant). The body's mass is updated once per control period.
+  propellant); a manipulator's joints by joint torques. The base's mass is updated
+  once per control period.
 - **Objects**: targets and obstacles, spheres, boxes or cylinders of fixed orientation,
   follow their motion models exactly while free.
 - **Collisions**: every physics step, the collector and what it carries against every
@@ -33,29 +37,36 @@ import numpy as np
 from dcsim.geometry import clip_norm, length, row_lengths
 from dcsim.messages import (
     BeaconRange,
-    DropPoint,
     MotionInput,
     ObjectTrack,
     Observations,
     RobotSpec,
     RobotState,
 )
-from dcsim.robots.manipulator import ManipulatorModel
-from dcsim.scenario.model import ManipulatorSection, Scenario
-from dcsim.world.arm import ArmBody
-from dcsim.world.bodies import ObjectBodies, create_collector, surface_gap
+from dcsim.scenario.model import ManipulatorSection, RobotSection, Scenario
+from dcsim.world.bodies import ObjectBodies, surface_gap
 from dcsim.world.environment import (
     Propellant,
     apply_cw_force,
     apply_cw_force_on_link,
     cw_acceleration,
 )
+from dcsim.world.free_flyer import FreeFlyerBody
+from dcsim.world.manipulator import ManipulatorBody
 from dcsim.world.objects import ObjectField, ObjectStatus, build_objects
+from dcsim.world.payload import Payload
 from dcsim.world.pybullet_client import connect_direct, pb
+from dcsim.world.robot_body import RobotBody
 from dcsim.world.sensors import Sensors
-from dcsim.world.services import Cargo, GrabResult, ReleaseResult
 
 _BROAD_PHASE_SLACK = 1e-3  # m added to the swept reach of each control period
+
+
+def _build_robot_body(client: int, robot: RobotSection | ManipulatorSection) -> RobotBody:
+    """The body type of the scenario's robot, created at its initial state."""
+    if isinstance(robot, ManipulatorSection):
+        return ManipulatorBody(client, robot)
+    return FreeFlyerBody(client, robot)
 
 
 @dataclass
@@ -155,16 +166,14 @@ class World:
         self._disconnect = weakref.finalize(self, pb.disconnect, physicsClientId=self._client)
         self._state_cache: tuple[int, tuple[np.ndarray, ...]] | None = None
         pb.setTimeStep(self.physics_step, physicsClientId=self._client)
-        self._arm: ArmBody | None = None
-        if isinstance(robot, ManipulatorSection):
-            self._arm = ArmBody(self._client, robot)
-            self._arm_links = self._arm.link_masses()
-            self.collector = self._arm.body
-        else:
-            self.collector = create_collector(self._client, robot)
+        self._robot = _build_robot_body(self._client, robot)
+        self._links_mass = sum(mass for _, mass in self._robot.links)
+        self.collector = self._robot.body
         self._joint_torques = np.zeros(0)
         self._bodies = ObjectBodies(self._client, self.field)
-        self._cargo = Cargo(self._client, self.collector, self.field, self._bodies, robot)
+        self._payload = Payload(
+            self._client, self.collector, robot.radius, self.field, self._bodies
+        )
         self._contacts: set[tuple[int, int]] = set()
         self._candidates = np.zeros(0, dtype=int)
         self._period_mass = self.assembly_mass()
@@ -203,11 +212,11 @@ class World:
 
     @property
     def robot_changes(self) -> int:
-        """How many times the robot's mass or shape changed by a grab or a release.
+        """How many times the robot's mass or shape changed by an object attached or removed.
 
         Its :meth:`robot_spec` is new after each change.
         """
-        return self._cargo.changes
+        return self._payload.changes
 
     def collector_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """True ``(position, velocity, attitude [x, y, z, w], angular velocity)``.
@@ -231,23 +240,18 @@ class World:
         return self.dry_mass + self.propellant
 
     def assembly_mass(self) -> float:
-        """Mass of the collector and every target it carries, kg (a manipulator's arm
-        included)."""
-        mass = self.collector_mass() + self._cargo.mass
-        if self._arm is not None:
-            return mass + sum(m for _, m in self._arm_links)
-        return mass
+        """Mass of the robot (a manipulator's arm included) and every object it carries,
+        kg."""
+        return self.collector_mass() + self._payload.mass + self._links_mass
 
     @property
-    def arm(self) -> ArmBody | None:
-        """The manipulator's multibody and joints; None for a free flyer."""
-        return self._arm
+    def robot_body(self) -> RobotBody:
+        """The robot's body: a free flyer's sphere or a manipulator's multibody."""
+        return self._robot
 
     def joint_state(self) -> tuple[np.ndarray, np.ndarray]:
         """True joint angles (rad) and rates (rad/s), (n,) each; empty for a free flyer."""
-        if self._arm is None:
-            return np.zeros(0), np.zeros(0)
-        return self._arm.joint_state()
+        return self._robot.joint_state()
 
     def robot_state(self) -> RobotState:
         """The true state: base (centre of mass, world frame) and joints."""
@@ -271,60 +275,27 @@ class World:
         ValueError
             For a free flyer, which has no arm.
         """
-        if self._arm is None:
-            raise ValueError("a free flyer has no end effector")
-        return self._arm.model.forward_kinematics(self.robot_state().configuration).end_effector
+        return self._robot.end_effector(self.robot_state().configuration)
 
     def robot_spec(self) -> RobotSpec:
-        """The collector's current mass, inertia, limits and bounding radius (cargo included).
+        """The robot's current mass (cargo included), inertia, limits and bounding radius
+        (grown by the cargo's protrusion); a manipulator's joint limits and model.
 
-        The inertia is the collector body's own, as PyBullet holds it, about its centre
-        of mass in the body frame.
+        The inertia is the base's own, as PyBullet holds it, about its centre of mass in
+        the body frame.
         """
-        r = self.robot
-        inertia = pb.getDynamicsInfo(self.collector, -1, physicsClientId=self._client)[2]
-        if self._arm is not None:
-            return self._arm_spec(np.diag(inertia))
-        return RobotSpec(
-            mass=self.assembly_mass(),
-            inertia=np.diag(inertia),
-            radius=r.radius + self.cargo_protrusion(),
-            max_force=r.max_force,
-            max_torque=r.max_torque,
-            max_speed=r.max_speed,
-        )
-
-    def _arm_spec(self, inertia: np.ndarray) -> RobotSpec:
-        """A manipulator's spec: total mass, base inertia, limits, joint limits, model.
-
-        The model (:class:`~dcsim.robots.manipulator.ManipulatorModel`) has the base's
-        current mass (propellant used so far).
-        """
-        arm, r = self._arm, self.robot
-        model = arm.model
-        if model.robot.base.mass != self.collector_mass():
-            base = dataclasses.replace(model.robot.base, mass=self.collector_mass())
-            model = ManipulatorModel(dataclasses.replace(model.robot, base=base))
-        return RobotSpec(
-            mass=self.assembly_mass(),
-            inertia=inertia,
-            radius=r.radius,
-            max_force=r.max_force,
-            max_torque=r.max_torque,
-            max_speed=r.max_speed,
-            joint_position_limits=arm.position_limits,
-            joint_torque_limits=arm.torque_limits,
-            model=model,
+        return self._robot.spec(
+            self.assembly_mass(), self.collector_mass(), self.cargo_protrusion()
         )
 
     def carried_ids(self) -> list[int]:
         """Ids of the targets on board."""
-        return [self.field.objects[i].id for i in self._cargo.held]
+        return [self.field.objects[i].id for i in self._payload.held]
 
     def object_states(self) -> tuple[np.ndarray, np.ndarray]:
         """True positions and velocities (N, 3) of all objects; carried ones from physics."""
         positions, velocities = (a.copy() for a in self.field.free_states(self.time))
-        for index, (body, _) in self._cargo.held.items():
+        for index, (body, _) in self._payload.held.items():
             p, _ = pb.getBasePositionAndOrientation(body, physicsClientId=self._client)
             v, _ = pb.getBaseVelocity(body, physicsClientId=self._client)
             positions[index], velocities[index] = p, v
@@ -371,7 +342,7 @@ class World:
         """
         parts, columns = np.nonzero(pending)
         order = np.argsort(bounds[parts, columns], kind="stable")
-        carriers = [self.collector, *(body for body, _ in self._cargo.held.values())]
+        carriers = [self.collector, *(body for body, _ in self._payload.held.values())]
         for part, column in zip(parts[order], columns[order], strict=True):
             if bounds[part, column] >= nearest:
                 break
@@ -383,17 +354,17 @@ class World:
     def cargo_protrusion(self) -> float:
         """How far carried targets reach beyond the collector's surface, m (0 if none).
 
-        Cargo is held rigidly, so this changes only at a grab or a release.
+        Cargo is held rigidly, so this changes only when an object is attached or removed.
         """
-        return self._cargo.protrusion
+        return self._payload.protrusion
 
     def _assembly_spheres(self) -> list[tuple[np.ndarray, float]]:
         """Centre and bounding radius of the collector, then of each target it carries."""
-        return [(self.collector_state()[0], self.robot.radius), *self._cargo.spheres()]
+        return [(self.collector_state()[0], self.robot.radius), *self._payload.spheres()]
 
     def _assembly_is_sphere(self) -> np.ndarray:
         """Whether each part of :meth:`_assembly_spheres` is a sphere (the collector is)."""
-        return np.array([True, *self.field.is_sphere[list(self._cargo.held)]])
+        return np.array([True, *self.field.is_sphere[list(self._payload.held)]])
 
     def parameters(self) -> dict[str, float]:
         """Named scalar parameters of the world as a system (fixed for its lifetime)."""
@@ -426,10 +397,10 @@ class World:
             "propellant": self.propellant,
             "fuel_used": self.fuel_used,
             "delta_v": self.delta_v,
-            "carried": len(self._cargo.held),
+            "carried": len(self._payload.held),
             "captured": self.field.count(ObjectStatus.CARRIED)
-            + self.field.count(ObjectStatus.DELIVERED),
-            "delivered": self.field.count(ObjectStatus.DELIVERED),
+            + self.field.count(ObjectStatus.REMOVED),
+            "delivered": self.field.count(ObjectStatus.REMOVED),
             "collisions": len(self.collisions),
             "nearest_obstacle_distance": self.nearest_obstacle_distance(),
         }
@@ -448,8 +419,7 @@ class World:
         force = clip_norm(self.inputs.force, self.robot.max_force)
         torque = clip_norm(self.inputs.torque, self.robot.max_torque)
         self._period_mass = self.assembly_mass()
-        if self._arm is not None:
-            self._joint_torques = self._arm.clip_torques(self.inputs.joint_torques)
+        self._joint_torques = self._robot.clip_joint_torques(self.inputs.joint_torques)
         self._update_broad_phase(force)
         disturbance = tuple(float(f) for f in self.inputs.disturbance_force)
         total_torque = tuple(
@@ -462,12 +432,8 @@ class World:
         return started
 
     def _set_body_mass(self, mass: float) -> None:
-        if self._arm is not None:
-            if mass != self._body_mass:
-                self._arm.set_base_mass(mass)
-                self._body_mass = mass
-            return
-        pb.changeDynamics(self.collector, -1, mass=mass, physicsClientId=self._client)
+        """Give the robot's base ``mass``, kg (the orbital force on it uses it)."""
+        self._robot.set_base_mass(mass)
         self._body_mass = mass
 
     def _fly_period(
@@ -482,8 +448,8 @@ class World:
         client, body, mass, n = self._client, self.collector, self._body_mass, self._mean_motion
         get_pose, get_velocity = pb.getBasePositionAndOrientation, pb.getBaseVelocity
         apply_force, step = pb.applyExternalForce, pb.stepSimulation
-        cargo = [(c, self.field.objects[i].mass) for i, (c, _) in self._cargo.held.items()]
-        arm, links = self._arm, (self._arm_links if self._arm is not None else ())
+        cargo = [(c, self.field.objects[i].mass) for i, (c, _) in self._payload.held.items()]
+        robot, links = self._robot, self._robot.links
         apply_torque = torque != (0.0, 0.0, 0.0)
         check_contacts = len(self._candidates) > 0
         dx, dy, dz = disturbance
@@ -498,8 +464,7 @@ class World:
                     apply_cw_force(client, carried, carried_mass, n)
                 for link, link_mass in links:
                     apply_cw_force_on_link(client, body, link, link_mass, n)
-            if arm is not None:
-                arm.apply_joint_torques(self._joint_torques)
+            robot.apply_joint_torques(self._joint_torques)
             apply_force(body, -1, (fx, fy, fz), position, pb.WORLD_FRAME, client)
             if apply_torque:
                 pb.applyExternalTorque(body, -1, torque, pb.WORLD_FRAME, client)
@@ -536,7 +501,7 @@ class World:
         started = []
         carriers = [(self.collector, "collector", -1)] + [
             (body, f"target {self.field.objects[i].id}", i)
-            for i, (body, _) in self._cargo.held.items()
+            for i, (body, _) in self._payload.held.items()
         ]
         for index in self._candidates:
             if self.field.status[index] != ObjectStatus.FREE:
@@ -570,41 +535,55 @@ class World:
         """
         position, _, attitude, angular_velocity = self.collector_state()
         observed = self._sensors.observations(self.time, position, attitude, angular_velocity)
-        if self._arm is None:
+        if not self._robot.n_joints:
             return observed
-        angles, rates = self._arm.joint_state()  # noise-free encoders
+        angles, rates = self._robot.joint_state()  # noise-free encoders
         return dataclasses.replace(observed, joint_positions=angles, joint_velocities=rates)
 
     def motion_input(self) -> MotionInput:
         """Mean thrust acceleration applied over the last control period."""
         return MotionInput(acceleration=self._propellant.last_acceleration)
 
-    # ------------------------------------------------------------------ services
-    def grab(self, target_id: int) -> GrabResult:
-        """Try to grab target ``target_id`` (the thesis's Grab service).
+    # ------------------------------------------------------------------ payload
+    def surface_gap(self, object_id: int, within: float) -> float:
+        """Gap between the robot's base and free object ``object_id``, m.
 
-        Succeeds when the target is free, the collector has room, and the gap between
-        the two surfaces is at most ``robot.grab_distance``. The target is then attached
-        by a fixed constraint and moves with the collector.
+        Parameters
+        ----------
+        object_id : int
+            The object's id.
+        within : float
+            Largest gap looked for, m.
+
+        Returns
+        -------
+        float
+            The gap (negative when they overlap), or ``inf`` beyond ``within``.
+        """
+        body = self._bodies.place(self.field.index[object_id], self.time)
+        return surface_gap(self._client, self.collector, body, within)
+
+    def attach(self, object_id: int) -> None:
+        """Hold free object ``object_id`` rigidly where it is now, fixed to the robot's base.
+
+        It joins the robot's assembly: its mass, its orbital force and its collisions.
         """
         position, _, attitude, _ = self.collector_state()
-        result = self._cargo.grab(target_id, self.time, position, attitude)
-        if result.success:
-            index = self.field.index[target_id]
-            self._contacts = {pair for pair in self._contacts if pair[0] != index}
-        return result
+        index = self.field.index[object_id]
+        self._payload.attach(index, self.time, position, attitude)
+        self._contacts = {pair for pair in self._contacts if pair[0] != index}
 
-    def release(self, drop_point: DropPoint) -> ReleaseResult:
-        """Release every carried target if the collector is at ``drop_point``.
+    def remove_payload(self) -> tuple[int, ...]:
+        """Take every object the robot holds out of the world (status removed).
 
-        Released targets count as delivered and leave the world.
+        Returns
+        -------
+        tuple of int
+            Ids of the objects removed.
         """
-        result = self._cargo.release(self.collector_state()[0], drop_point, self.time)
-        if result.delivered:
-            pb.changeDynamics(
-                self.collector, -1, mass=self.collector_mass(), physicsClientId=self._client
-            )
-        return result
+        removed = self._payload.remove_all()
+        self._robot.set_base_mass(self.collector_mass())
+        return removed
 
     # ------------------------------------------------------------------ lifetime
     def close(self) -> None:

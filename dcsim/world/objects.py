@@ -14,11 +14,12 @@ from dcsim.scenario.model import Scenario
 
 
 class ObjectStatus(enum.IntEnum):
-    """Where an object is in its life: free in space, carried, or delivered."""
+    """Where an object is in its life: free in space, carried by the robot, or removed
+    from the world (the debris mission's delivered targets)."""
 
     FREE = 0
     CARRIED = 1
-    DELIVERED = 2
+    REMOVED = 2
 
 
 @dataclass(frozen=True)

@@ -124,7 +124,7 @@ def test_plant_joint_torque_turns_the_joint_and_the_base_reacts(reach_plant_fmu)
     assert np.array_equal(angles, limited.robot_state().joint_positions)
 
     # The base reacts: it turns against joint 2 and moves, the total momentum stays ~0.
-    model = world.arm.model
+    model = world.robot_spec().model
     axis = model.forward_kinematics(state.configuration).joint_axes[1]
     assert state.angular_velocity @ axis < 0
     base_momentum = world.robot.mass * np.linalg.norm(state.velocity)

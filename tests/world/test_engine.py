@@ -14,6 +14,7 @@ from dcsim.api import (
     StaticMotion,
     mean_motion,
 )
+from dcsim.missions.debris.services import GrabResult, grab, release
 from dcsim.scenario import ScenarioDocument, validate
 from dcsim.world import World, WorldInputs
 from dcsim.world.environment import STANDARD_GRAVITY
@@ -25,6 +26,11 @@ N = mean_motion(6_778_137.0)
 def world_from(text: str, seed: int = 0) -> World:
     scenario = validate(ScenarioDocument.from_text(textwrap.dedent(text), "test.yaml"))
     return World(scenario, np.random.default_rng(seed))
+
+
+def grab_target(world: World, target_id: int) -> GrabResult:
+    """The debris mission's grab, with the world's robot's capacity and grab distance."""
+    return grab(world, target_id, world.robot.capacity, world.robot.grab_distance)
 
 
 FIELD = """\
@@ -98,9 +104,9 @@ def test_beacons_report_the_nearest_within_range_with_noise():
 
 def test_grab_within_reach_fails_beyond_and_beyond_capacity():
     world = world_from(FIELD)
-    far = world.grab(3)
+    far = grab_target(world, 3)
     assert not far.success and "out of reach" in far.reason
-    near = world.grab(1)  # 2.5 m between centres: a 1.5 m gap... too far
+    near = grab_target(world, 1)  # 2.5 m between centres: a 1.5 m gap... too far
     assert not near.success
     world_close = world_from(
         FIELD.replace(
@@ -108,17 +114,19 @@ def test_grab_within_reach_fails_beyond_and_beyond_capacity():
             "position: [1.8, 0, 0], velocity: [0, -0.004073, 0]",
         )
     )
-    grabbed = world_close.grab(1)
+    grabbed = grab_target(world_close, 1)
     assert grabbed.success and grabbed.gap == pytest.approx(0.8, abs=1e-6)
-    full = world_close.grab(2)  # 2.2 m: a 1.2 m gap would be out of reach anyway; capacity first
+    full = grab_target(
+        world_close, 2
+    )  # 2.2 m: a 1.2 m gap would be out of reach anyway; capacity first
     assert not full.success and "capacity 1 reached" in full.reason
-    assert not world_close.grab(9).success  # an obstacle is no target
-    assert world_close.grab(1).reason == "target is not free"
+    assert not grab_target(world_close, 9).success  # an obstacle is no target
+    assert grab_target(world_close, 1).reason == "target is not free"
 
 
 def test_grabbed_target_leaves_the_field_and_rides_with_the_collector():
     world = world_from(FIELD.replace("position: [0, 2.2, 0]", "position: [0, 1.9, 0]"))
-    assert world.grab(2).success
+    assert grab_target(world, 2).success
     assert 2 not in [t.id for t in world.object_tracks()]
 
     def offset_in_collector_frame() -> np.ndarray:
@@ -139,7 +147,7 @@ def test_grabbed_target_leaves_the_field_and_rides_with_the_collector():
 def test_cargo_protrusion_is_how_far_cargo_sticks_out_of_the_collector():
     world = world_from(FIELD.replace("position: [0, 2.2, 0]", "position: [0, 1.9, 0]"))
     assert world.cargo_protrusion() == 0.0
-    grabbed = world.grab(2)
+    grabbed = grab_target(world, 2)
     assert grabbed.success
     # The gap to the target plus its diameter (0.5 m radius); the robot's bounding radius
     # grows by as much, and stays so while the assembly flies.
@@ -156,14 +164,14 @@ def test_cargo_protrusion_is_how_far_cargo_sticks_out_of_the_collector():
 def test_release_only_at_the_drop_point():
     world = world_from(FIELD.replace("position: [0, 2.2, 0]", "position: [0, 1.9, 0]"))
     here = DropPoint(StaticMotion([0.0, 0.0, 0.0]), tolerance=0.5)
-    assert world.release(here).reason == "nothing carried"
-    assert world.grab(2).success
-    assert world.release(here).delivered == (2,)
+    assert release(world, here).reason == "nothing carried"
+    assert grab_target(world, 2).success
+    assert release(world, here).delivered == (2,)
     assert world.outputs()["delivered"] == 1 and world.outputs()["carried"] == 0
     assert world.cargo_protrusion() == 0.0 and world.robot_spec().radius == 0.5
     away = world_from(FIELD.replace("position: [0, 2.2, 0]", "position: [0, 1.9, 0]"))
-    assert away.grab(2).success
-    refused = away.release(DropPoint(StaticMotion([9.0, 0.0, 0.0]), tolerance=0.5))
+    assert grab_target(away, 2).success
+    refused = release(away, DropPoint(StaticMotion([9.0, 0.0, 0.0]), tolerance=0.5))
     assert refused.delivered == () and "from the drop point" in refused.reason
     assert away.cargo_protrusion() > 1.0  # still on board
 

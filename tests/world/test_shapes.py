@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from dcsim.api import ShapeKind
+from dcsim.missions.debris.services import grab
 from dcsim.scenario import ScenarioDocument, validate
 from dcsim.world import World, WorldInputs
 
@@ -143,7 +144,7 @@ def test_grab_gap_and_cargo_use_the_target_shape():
     )
     before = world.nearest_obstacle_distance()  # the collector alone
     assert before == pytest.approx(np.hypot(1.2, 3.0) - 1.0, abs=1e-12)
-    grabbed = world.grab(1)
+    grabbed = grab(world, 1, world.robot.capacity, world.robot.grab_distance)
     assert grabbed.success and grabbed.gap == pytest.approx(0.5, abs=1e-12)  # face, not sphere
     # The carried box's top face is 1.5 m below the obstacle (its bounding sphere: 1.46 m),
     # and stays so: it is held as it was turned.

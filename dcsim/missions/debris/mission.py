@@ -47,6 +47,7 @@ from dcsim.messages import (
     Trajectory,
 )
 from dcsim.missions.base import Emit, Mission, MissionWorld
+from dcsim.missions.debris.services import grab, release
 from dcsim.missions.debris.settings import DebrisMissionSection
 from dcsim.scenario.model import Scenario
 from dcsim.world.objects import ObjectStatus
@@ -71,14 +72,14 @@ _INSTANT = {Mode.DEVISE_PLAN, Mode.SELECT_NEXT, Mode.GRAB}
 
 
 class DebrisMission(Mission):
-    """The executer: turns estimates and tracks into references and world service calls.
+    """The executer: turns estimates and tracks into references, grabs and releases.
 
     Parameters
     ----------
     scenario : Scenario
         The resolved scenario (mission settings, robot limits).
     world : MissionWorld
-        Provides the grab and release services.
+        The world: its objects and the payload the grab and release services use.
     plugins : mapping of str to Plugin
         The plugin of each role in :attr:`roles`.
     emit : callable
@@ -176,7 +177,7 @@ class DebrisMission(Mission):
     def progress(self) -> str:
         """Targets delivered out of all, and captured."""
         field = self.world.field
-        delivered = field.count(ObjectStatus.DELIVERED)
+        delivered = field.count(ObjectStatus.REMOVED)
         captured = field.count(ObjectStatus.CARRIED) + delivered
         return f"delivered {delivered}/{int(field.is_target.sum())}, captured {captured}"
 
@@ -190,7 +191,7 @@ class DebrisMission(Mission):
         if (
             self.settings.stop_on_all_delivered
             and targets
-            and field.count(ObjectStatus.DELIVERED) == targets
+            and field.count(ObjectStatus.REMOVED) == targets
         ):
             return "completed", "all targets delivered"
         return None
@@ -198,15 +199,15 @@ class DebrisMission(Mission):
     def goal_met(self) -> bool:
         """Whether every target was delivered."""
         field = self.world.field
-        return field.count(ObjectStatus.DELIVERED) == int(field.is_target.sum())
+        return field.count(ObjectStatus.REMOVED) == int(field.is_target.sum())
 
     def summary_fields(self) -> dict[str, Any]:
         """Targets, and how many were captured and delivered."""
         field = self.world.field
         return {
             "targets": int(field.is_target.sum()),
-            "captured": field.count(ObjectStatus.CARRIED) + field.count(ObjectStatus.DELIVERED),
-            "delivered": field.count(ObjectStatus.DELIVERED),
+            "captured": field.count(ObjectStatus.CARRIED) + field.count(ObjectStatus.REMOVED),
+            "delivered": field.count(ObjectStatus.REMOVED),
         }
 
     def _go(self, mode: Mode, reason: str) -> None:
@@ -389,7 +390,9 @@ class DebrisMission(Mission):
         return self._follow(lambda: self._standoff(track, self.time))
 
     def _grab(self) -> Reference:
-        result = self.world.grab(self.task.target_id)
+        result = grab(
+            self.world, self.task.target_id, self.robot.capacity, self.robot.grab_distance
+        )
         self.emit(
             "grab",
             target=result.target_id,
@@ -430,7 +433,7 @@ class DebrisMission(Mission):
         )
         distance = length(self.estimate.position - drop.state_at(self.time)[0])
         if distance <= self.settings.release_fraction * drop.tolerance:
-            result = self.world.release(drop)
+            result = release(self.world, drop)
             if result.delivered or not self.world.carried_ids():
                 self.emit("release", delivered=list(result.delivered), reason=result.reason)
                 self.trajectory = None

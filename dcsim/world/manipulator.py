@@ -11,15 +11,19 @@ for every body of the world.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
+from dcsim.messages import RobotSpec
 from dcsim.robots.manipulator import ManipulatorModel
 from dcsim.scenario.model import ManipulatorSection, point_to_cartesian
 from dcsim.world.pybullet_client import load_urdf, pb
+from dcsim.world.robot_body import base_spec_fields
 
 
-class ArmBody:
-    """The manipulator's multibody and its joints.
+class ManipulatorBody:
+    """The manipulator's multibody and its joints (a :class:`~dcsim.world.robot_body.RobotBody`).
 
     Parameters
     ----------
@@ -34,12 +38,19 @@ class ArmBody:
         The multibody's id (its base is index -1).
     joints : list of int
         PyBullet joint indices of the revolute joints, from the base outwards.
+    links : tuple of (int, float)
+        PyBullet link index and mass (kg) of every arm link with mass.
     torque_limits : ndarray (n,)
         Largest joint torque magnitudes, N·m (``inf``: unlimited).
+    position_limits : ndarray (n, 2)
+        Lower and upper joint angle limits, rad.
+    model : ManipulatorModel
+        The arm's kinematics and dynamics with its initial base mass.
     """
 
     def __init__(self, client: int, robot: ManipulatorSection) -> None:
         self._client = client
+        self.section = robot
         self.robot = robot.dh_robot()
         self.model = ManipulatorModel(self.robot)
         self.body = load_urdf(client, self.model.urdf())
@@ -64,6 +75,8 @@ class ArmBody:
             physicsClientId=client,
         )
         self._reset(robot)
+        self.links = self._link_masses()
+        self._base_mass = robot.mass
 
     def _reset(self, robot: ManipulatorSection) -> None:
         """Put the body at the scenario's initial state."""
@@ -84,7 +97,7 @@ class ArmBody:
         """Number of joints."""
         return len(self.joints)
 
-    def clip_torques(self, torques: np.ndarray) -> np.ndarray:
+    def clip_joint_torques(self, torques: np.ndarray) -> np.ndarray:
         """Joint torques (n,) clipped to the limits, N·m (zeros when none are given).
 
         Raises
@@ -114,7 +127,7 @@ class ArmBody:
         states = pb.getJointStates(self.body, self.joints, physicsClientId=self._client)
         return np.array([s[0] for s in states]), np.array([s[1] for s in states])
 
-    def link_masses(self) -> list[tuple[int, float]]:
+    def _link_masses(self) -> tuple[tuple[int, float], ...]:
         """PyBullet link index and mass of every link with mass (the arm's links)."""
         client = self._client
         found = []
@@ -122,10 +135,15 @@ class ArmBody:
             mass = pb.getDynamicsInfo(self.body, link, physicsClientId=client)[0]
             if mass > 0:
                 found.append((link, mass))
-        return found
+        return tuple(found)
 
     def set_base_mass(self, mass: float) -> None:
-        """Change the base's mass (propellant used), keeping the file's inertia."""
+        """Change the base's mass (propellant used), kg, keeping the file's inertia.
+
+        PyBullet is called only when the mass differs from the one it holds.
+        """
+        if mass == self._base_mass:
+            return
         pb.changeDynamics(
             self.body,
             -1,
@@ -133,3 +151,26 @@ class ArmBody:
             localInertiaDiagonal=self.robot.base.inertia.tolist(),
             physicsClientId=self._client,
         )
+        self._base_mass = mass
+
+    def spec(self, assembly_mass: float, base_mass: float, protrusion: float) -> RobotSpec:
+        """Total mass, the base's inertia, limits, joint limits and the model.
+
+        The model (:class:`~dcsim.robots.manipulator.ManipulatorModel`) has the base's
+        mass ``base_mass`` (propellant used so far).
+        """
+        inertia = pb.getDynamicsInfo(self.body, -1, physicsClientId=self._client)[2]
+        model = self.model
+        if model.robot.base.mass != base_mass:
+            base = dataclasses.replace(model.robot.base, mass=base_mass)
+            model = ManipulatorModel(dataclasses.replace(model.robot, base=base))
+        return RobotSpec(
+            **base_spec_fields(self.section, assembly_mass, np.diag(inertia), protrusion),
+            joint_position_limits=self.position_limits,
+            joint_torque_limits=self.torque_limits,
+            model=model,
+        )
+
+    def end_effector(self, configuration: np.ndarray) -> np.ndarray:
+        """End-effector position (origin of DH frame n) at ``configuration``, world frame, m."""
+        return self.model.forward_kinematics(configuration).end_effector
