@@ -1,5 +1,5 @@
 """``python -m dcsim``: the same as the ``dcsim`` command."""
 
-from dcsim.cli import main
+from dcsim.cli.main import main
 
 main()

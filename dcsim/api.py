@@ -93,14 +93,6 @@ from dcsim.bench.figures import pyplot
 from dcsim.bench.figures import save as save_figure
 from dcsim.bench.layered_optimum import LayeredOptimum, layered_optimum, optimality_gap
 from dcsim.bench.options import comma_numbers, comma_words, plugin_spec
-from dcsim.clearance import (
-    Clearance,
-    body_surface_distance,
-    min_clearance,
-    path_clearance,
-    resolution_step,
-    surface_distance,
-)
 from dcsim.errors import (
     DcsimError,
     DuplicatePluginError,
@@ -131,17 +123,6 @@ from dcsim.geometry import (
     spherical_to_cartesian,
     unit,
 )
-from dcsim.hookspecs import hookimpl
-from dcsim.interfaces import (
-    PLUGIN_KINDS,
-    Controller,
-    Localiser,
-    PathPlanner,
-    PathPlannerParams,
-    Plugin,
-    TaskPlanner,
-)
-from dcsim.kinematics import cruise_speed, rest_to_rest_time, shortest_leg
 from dcsim.messages import (
     BeaconRange,
     Bounds,
@@ -184,8 +165,18 @@ from dcsim.motion import (
     mean_motion,
 )
 from dcsim.params import PluginParams, quantity
-from dcsim.plancost import leg_delta_v, legs_delta_v, plan_cost, plan_delta_v, plan_duration
-from dcsim.registry import PluginRegistry
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.registry.hookspecs import hookimpl
+from dcsim.registry.interfaces import (
+    PLUGIN_KINDS,
+    Controller,
+    Localiser,
+    PathPlanner,
+    PathPlannerParams,
+    Plugin,
+    TaskPlanner,
+)
+from dcsim.rest_to_rest import cruise_speed, rest_to_rest_time, shortest_leg
 from dcsim.robots.dh import DHLink, DHRobot, ManipulatorBase, thesis_manipulator
 from dcsim.robots.loading import load_reach_problem, load_robot_model
 from dcsim.robots.manipulator import (
@@ -196,9 +187,24 @@ from dcsim.robots.manipulator import (
 )
 from dcsim.robots.model import RobotModel
 from dcsim.robots.urdf import urdf_text as manipulator_urdf
-from dcsim.runs import RunResult, close_run, load_scenario, open_run, read_run, run
+from dcsim.run.scripting import RunResult, close_run, load_scenario, open_run, read_run, run
 from dcsim.scenario.loader import packaged_scenario_path
 from dcsim.scenario.model import MissionSettings
+from dcsim.yardsticks.clearance import (
+    Clearance,
+    body_surface_distance,
+    min_clearance,
+    path_clearance,
+    resolution_step,
+    surface_distance,
+)
+from dcsim.yardsticks.plan_cost import (
+    leg_delta_v,
+    legs_delta_v,
+    plan_cost,
+    plan_delta_v,
+    plan_duration,
+)
 
 if TYPE_CHECKING:
     import pandas
@@ -206,15 +212,15 @@ if TYPE_CHECKING:
     from dcsim.bench.path_problems import BenchProblem
     from dcsim.bench.path_problems import expand_specs as expand_bench_specs
     from dcsim.bench.path_problems import load_problem as load_bench_problem
-    from dcsim.shape_outlines import outline as shape_outline
-    from dcsim.shape_outlines import wireframe as shape_wireframe
+    from dcsim.report.outlines import outline as shape_outline
+    from dcsim.report.outlines import wireframe as shape_wireframe
 
 _LAZY = {
     "BenchProblem": ("dcsim.bench.path_problems", "BenchProblem"),
     "expand_bench_specs": ("dcsim.bench.path_problems", "expand_specs"),
     "load_bench_problem": ("dcsim.bench.path_problems", "load_problem"),
-    "shape_outline": ("dcsim.shape_outlines", "outline"),
-    "shape_wireframe": ("dcsim.shape_outlines", "wireframe"),
+    "shape_outline": ("dcsim.report.outlines", "outline"),
+    "shape_wireframe": ("dcsim.report.outlines", "wireframe"),
 }
 """Names loaded on first use: their modules load the missions and the world engine, or
 SciPy's spatial algorithms, which a plugin that does not use them need not wait for."""

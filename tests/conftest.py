@@ -18,9 +18,9 @@ from pathlib import Path
 
 import pytest
 
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 
 REPO = Path(__file__).resolve().parents[1]
 DCSIM = Path(sys.executable).with_name("dcsim")
@@ -68,7 +68,7 @@ def default_run(tmp_path_factory) -> tuple[Runner, dict, Path]:
     Tests that read it are marked ``SHARES_DEFAULT_RUN``.
     """
     out = tmp_path_factory.mktemp("default")
-    runner = Runner(prepare_run(None, registry=PluginRegistry.discover()), out)
+    runner = Runner(setup_run(None, registry=PluginRegistry.discover()), out)
     return runner, runner.run(), out
 
 

@@ -59,9 +59,9 @@ from typing import Any
 
 import pytest
 
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 from tests.conftest import REPO
 
 pytestmark = pytest.mark.xdist_group("behaviour-kept")  # one worker flies the flights once
@@ -106,7 +106,7 @@ def read_events(directory: Path) -> list[dict[str, Any]]:
 
 def fly(out: Path, scenario: str, seconds: float, overrides: tuple[str, ...] = ()) -> Path:
     """Fly the first ``seconds`` of a shipped scenario into the run directory ``out``."""
-    setup = prepare_run(
+    setup = setup_run(
         REPO / "scenarios" / f"{scenario}.yaml",
         [f"world.duration={seconds}", *overrides],
         registry=PluginRegistry.discover(),

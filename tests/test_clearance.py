@@ -5,13 +5,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from dcsim.clearance import (
-    min_clearance,
-    path_clearance,
-    resolution_step,
-    sample_times,
-    surface_distance,
-)
 from dcsim.messages import (
     GoalRegion,
     ObjectKind,
@@ -23,6 +16,13 @@ from dcsim.messages import (
     Trajectory,
 )
 from dcsim.motion import LinearMotion, StaticMotion
+from dcsim.yardsticks.clearance import (
+    min_clearance,
+    path_clearance,
+    resolution_step,
+    sample_times,
+    surface_distance,
+)
 
 SQRT2 = np.sqrt(2.0)
 QUARTER_TURN_Z = [0.0, 0.0, np.sin(np.pi / 4), np.cos(np.pi / 4)]

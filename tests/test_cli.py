@@ -249,7 +249,7 @@ def test_debug_shows_the_traceback(dcsim_cli):
 
 @pytest.mark.parametrize("group", [(), ("bench",), ("campaign",), ("fmu",), ("robot",)])
 def test_every_help_lists_its_commands_with_whole_one_line_descriptions(dcsim_cli, group):
-    from dcsim.cli import cli
+    from dcsim.cli.main import cli
 
     found = cli
     context = click.Context(cli)  # the plugin packages' commands too

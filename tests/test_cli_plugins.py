@@ -8,8 +8,8 @@ from types import ModuleType
 
 import click
 
-from dcsim.cli_plugins import plugin_commands
-from dcsim.registry import PluginOrigin, PluginRegistry
+from dcsim.cli.plugin_commands import plugin_commands
+from dcsim.registry.discovery import PluginOrigin, PluginRegistry
 from tests.conftest import make_distribution
 
 HELLO = """

@@ -73,7 +73,7 @@ def test_wheel_carries_the_default_scenario_plugins_and_entry_points(wheel):
     assert not any(n.startswith("plugins/") for n in names)
     assert (
         "pd = dcsim_plugins.controllers.pd" in entry_points
-        and "dcsim = dcsim.cli:main" in entry_points
+        and "dcsim = dcsim.cli.main:main" in entry_points
     )
 
 

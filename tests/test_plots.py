@@ -17,12 +17,12 @@ from matplotlib.collections import PolyCollection
 from dcsim.api import Shape, ShapeKind
 from dcsim.missions.debris import DebrisMission
 from dcsim.missions.debris.plots import timeline_figure, trajectory_figure
-from dcsim.plots import FrameAxes, estimation_figure, motion_figure
-from dcsim.recording import SIGMA_COLUMNS, read_telemetry
-from dcsim.registry import PluginRegistry
-from dcsim.runner import PLOT_POINTS, Runner
-from dcsim.runsetup import prepare_run
-from dcsim.shape_outlines import outline, wireframe
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.report.outlines import outline, wireframe
+from dcsim.report.plots import FrameAxes, estimation_figure, motion_figure
+from dcsim.run.loop import PLOT_POINTS, Runner
+from dcsim.run.recording import SIGMA_COLUMNS, read_telemetry
+from dcsim.run.setup import setup_run
 from tests.conftest import REPO, SHARES_DEFAULT_RUN
 
 THESIS = REPO / "scenarios" / "thesis_debris_field.yaml"
@@ -89,7 +89,7 @@ def test_wireframes_lie_on_the_shapes():
 def thesis_run(tmp_path_factory):
     """The thesis's geocentric field (r = 150 km) flown for 5 s into a run directory."""
     out = tmp_path_factory.mktemp("thesis") / "run"
-    setup = prepare_run(THESIS, ["world.duration=5"], registry=PluginRegistry.discover())
+    setup = setup_run(THESIS, ["world.duration=5"], registry=PluginRegistry.discover())
     Runner(setup, out).run()
     return setup.scenario, out
 

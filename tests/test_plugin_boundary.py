@@ -23,9 +23,9 @@ from dcsim.api import (
     Trajectory,
     quantity,
 )
-from dcsim.plugin_outputs import output_problem
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.registry.answers import output_problem
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 from tests.conftest import REPO
 from tests.test_runner import registry_with
 
@@ -105,7 +105,7 @@ class InfCostTaskPlanner(TaskPlanner):
 
 def fly(tmp_path, overrides, *classes, duration=5.0):
     out = tmp_path / "run"
-    setup = prepare_run(
+    setup = setup_run(
         REPO / "scenarios" / "default.yaml",
         [f"world.duration={duration}", *overrides],
         registry=registry_with(*classes),
@@ -233,8 +233,8 @@ def test_debug_prints_the_plugin_s_traceback_and_keeps_exit_1(tmp_path):
     )
     script = (
         "import sys\n"
-        "from dcsim import cli as module\n"
-        "from dcsim.registry import PluginOrigin, PluginRegistry\n"
+        "from dcsim.cli import main as module\n"
+        "from dcsim.registry.discovery import PluginOrigin, PluginRegistry\n"
         "import raiser_pkg\n"
         "discover = PluginRegistry.discover\n"
         "def with_raiser(*args, **kwargs):\n"

@@ -23,7 +23,7 @@ from dcsim.api import (
     read_run,
     run,
 )
-from dcsim.rundir import RunDirectoryError
+from dcsim.run.directory import RunDirectoryError
 from tests.conftest import REPO
 
 SHORT = ["world.duration=30"]

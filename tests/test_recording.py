@@ -14,18 +14,18 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from dcsim.recording import FLUSH_ROWS, Recorder, column_unit, header_name, read_telemetry
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
-from dcsim.scenario import load_scenario
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.recording import FLUSH_ROWS, Recorder, column_unit, header_name, read_telemetry
+from dcsim.run.setup import setup_run
+from dcsim.scenario import read_scenario
 from tests.conftest import DCSIM
 
 LONG_RUN = ["world.duration=100000", "mission.stop_on_all_delivered=false"]
 
 
 def long_runner(out):
-    setup = prepare_run(None, LONG_RUN, registry=PluginRegistry.discover())
+    setup = setup_run(None, LONG_RUN, registry=PluginRegistry.discover())
     runner = Runner(setup, out)
     runner.open()
     return runner
@@ -83,7 +83,7 @@ def test_a_killed_run_leaves_a_readable_repeatable_run_directory(tmp_path):
     assert child.returncode == -signal.SIGKILL
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "running" and summary["scenario"] == "default"
-    repeated = load_scenario(out / "scenario.yaml")
+    repeated = read_scenario(out / "scenario.yaml")
     assert repeated.world.duration == 100000 and not repeated.mission.stop_on_all_delivered
     table = read_telemetry(telemetry)
     assert len(table["time"]) > 20 and table["time"][0] == 0.0
@@ -153,7 +153,7 @@ def test_an_existing_run_is_replaced_only_with_force(dcsim_cli, tmp_path):
 DISK_FULL = """
 import resource, sys
 resource.setrlimit(resource.RLIMIT_FSIZE, (60_000, 60_000))
-from dcsim.cli import main
+from dcsim.cli.main import main
 sys.argv = ["dcsim", "run", "--out", sys.argv[1], "--set", "world.duration=600",
             "--set", "mission.stop_on_all_delivered=false"]
 main()

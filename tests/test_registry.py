@@ -20,7 +20,7 @@ from dcsim.api import (
     hookimpl,
     quantity,
 )
-from dcsim.registry import PluginOrigin, check_plugin_class
+from dcsim.registry.discovery import PluginOrigin, check_plugin_class
 
 ORIGIN = PluginOrigin("test-dist", "0.0", "test")
 

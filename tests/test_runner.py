@@ -26,10 +26,10 @@ from dcsim.api import (
     quantity,
 )
 from dcsim.geometry import quaternion_conjugate, quaternion_multiply, rotation_vector
-from dcsim.recording import SIGMA_COLUMNS
-from dcsim.registry import PluginOrigin
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.registry.discovery import PluginOrigin
+from dcsim.run.loop import Runner
+from dcsim.run.recording import SIGMA_COLUMNS
+from dcsim.run.setup import setup_run
 from tests.conftest import DCSIM, REPO, SHARES_DEFAULT_RUN
 
 TEST_ORIGIN = PluginOrigin("tests", "0", "tests")
@@ -121,7 +121,7 @@ def scenario_file(tmp_path, text: str):
 
 
 def run(path=None, overrides=(), out=None, registry=None, seed=None):
-    setup = prepare_run(path, overrides, seed, registry=registry or PluginRegistry.discover())
+    setup = setup_run(path, overrides, seed, registry=registry or PluginRegistry.discover())
     runner = Runner(setup, out)
     return runner, runner.run()
 
@@ -293,7 +293,7 @@ def test_a_localiser_s_own_estimate_class_gets_the_attitude_readings():
     assert summary["status"] == "completed", summary["reason"]
     estimate = runner.estimate
     assert type(estimate) is SpreadEstimate and estimate.spread >= 0
-    attitude = runner.world.collector_state()[2]
+    attitude = runner.world.base_state()[2]
     assert estimate.attitude.tolist() == attitude.tolist()
 
 

@@ -9,14 +9,14 @@ import numpy as np
 import pytest
 
 from dcsim.api import ScenarioError, Shape, ShapeKind
-from dcsim.registry import PluginRegistry
+from dcsim.registry.discovery import PluginRegistry
 from dcsim.scenario import (
     ScenarioDocument,
     default_scenario_path,
     dump_scenario,
     format_key_path,
-    load_scenario,
     parse_key_path,
+    read_scenario,
     validate,
 )
 from dcsim.scenario.model import SphericalMotionSpec
@@ -38,7 +38,7 @@ def write(tmp_path: Path, text: str) -> Path:
 
 def problems(path, overrides=(), registry=None) -> list[str]:
     with pytest.raises(ScenarioError) as info:
-        load_scenario(path, overrides, registry)
+        read_scenario(path, overrides, registry)
     return [p.describe(info.value.filename) for p in info.value.problems]
 
 
@@ -48,7 +48,7 @@ def problems(path, overrides=(), registry=None) -> list[str]:
     ids=lambda p: p.name,
 )
 def test_shipped_scenarios_resolve_and_round_trip(path, registry):
-    scenario = load_scenario(path, registry=registry)
+    scenario = read_scenario(path, registry=registry)
     again = ScenarioDocument.from_text(dump_scenario(scenario), "resolved.yaml")
     assert load_scenario_from(again, registry) == scenario
 
@@ -61,11 +61,11 @@ def load_scenario_from(doc, registry):
 
 def test_packaged_default_is_the_repository_default():
     assert default_scenario_path().read_text() == (REPO / "scenarios" / "default.yaml").read_text()
-    assert load_scenario().name == "default"
+    assert read_scenario().name == "default"
 
 
 def test_resolution_fills_plugin_defaults(registry):
-    scenario = load_scenario(registry=registry)
+    scenario = read_scenario(registry=registry)
     assert scenario.controller.params == {
         "bandwidth": 0.2,
         "damping": 0.9,
@@ -78,7 +78,7 @@ def test_resolution_fills_plugin_defaults(registry):
 
 
 def test_thesis_scenario_is_geocentric_near_150_km():
-    scenario = load_scenario(REPO / "scenarios" / "thesis_debris_field.yaml")
+    scenario = read_scenario(REPO / "scenarios" / "thesis_debris_field.yaml")
     assert scenario.world.frame == "geocentric"
     assert scenario.beacons.report_nearest == 3
     motions = [o.motion for o in [*scenario.mission.targets, *scenario.obstacles]]
@@ -157,7 +157,7 @@ def test_object_shapes_build_and_fill_in_the_bounding_radius(tmp_path):
           - {id: 4, radius: 2, shape: {type: sphere, radius: 2}, motion: {type: static, position: [0, 0, 9]}}
         """,
     )
-    sphere, box, cylinder, given = load_scenario(path).obstacles
+    sphere, box, cylinder, given = read_scenario(path).obstacles
     assert sphere.shape is None and sphere.build_shape() == Shape(ShapeKind.SPHERE, radius=0.7)
     assert box.radius == 3.0  # |(1, 2, 2)|, filled in
     assert box.build_shape() == Shape(ShapeKind.BOX, half_extents=[1.0, 2.0, 2.0])
@@ -167,8 +167,8 @@ def test_object_shapes_build_and_fill_in_the_bounding_radius(tmp_path):
     np.testing.assert_allclose(built.orientation, [0, 0.5**0.5, 0, 0.5**0.5])  # normalised
     assert given.radius == 2.0 and given.build_shape().kind is ShapeKind.SPHERE
     # Written back out, radius and shape both appear and agree.
-    again = ScenarioDocument.from_text(dump_scenario(load_scenario(path)), "resolved.yaml")
-    assert validate(again).obstacles == load_scenario(path).obstacles
+    again = ScenarioDocument.from_text(dump_scenario(read_scenario(path)), "resolved.yaml")
+    assert validate(again).obstacles == read_scenario(path).obstacles
 
 
 def test_shape_errors_name_their_key_paths(tmp_path):
@@ -231,7 +231,7 @@ def test_yaml_syntax_error_and_duplicate_keys(tmp_path):
 def test_empty_file_is_an_error_and_an_empty_mapping_the_defaults(tmp_path):
     path = write(tmp_path, "# nothing yet\n")
     assert problems(path) == [f"{path}:1:1: the file is empty; a scenario is a mapping of sections"]
-    scenario = load_scenario(write(tmp_path, "{}"))
+    scenario = read_scenario(write(tmp_path, "{}"))
     assert scenario.name == "unnamed" and scenario.world.frame == "lvlh"
 
 
@@ -259,7 +259,7 @@ def test_plugin_choice_errors_point_at_the_file(tmp_path, registry):
 
 def test_overrides_apply_and_are_validated(tmp_path, registry):
     base = REPO / "scenarios" / "default.yaml"
-    scenario = load_scenario(
+    scenario = read_scenario(
         base,
         [
             "mission.targets[1].motion.position=[1, 2, 3]",
@@ -368,11 +368,11 @@ def test_malformed_key_paths_are_rejected(bad):
 def test_an_override_ending_in_plus_appends_to_a_list(tmp_path):
     base = REPO / "scenarios" / "default.yaml"
     item = "{id: 99, radius: 1.0, motion: {type: static, position: [50, 0, 0]}}"
-    scenario = load_scenario(base, [f"mission.targets[+]={item}", "mission.targets[4].radius=2"])
+    scenario = read_scenario(base, [f"mission.targets[+]={item}", "mission.targets[4].radius=2"])
     targets = scenario.mission.targets
     assert [t.id for t in targets][-1] == 99 and targets[4].radius == 2
     bare = write(tmp_path, "world:\n  seed: 1\n")
-    assert len(load_scenario(bare, [f"obstacles[+]={item}"]).obstacles) == 1  # list created
+    assert len(read_scenario(bare, [f"obstacles[+]={item}"]).obstacles) == 1  # list created
     assert problems(base, ["mission.targets[+]={id: 98, radius: -1, motion: {type: static}}"])[
         0
     ] == (
@@ -398,12 +398,12 @@ def test_spherical_points_convert_to_cartesian(tmp_path):
     )
     from dcsim.scenario.model import point_to_cartesian
 
-    position = point_to_cartesian(load_scenario(path).robot.initial.position)
+    position = point_to_cartesian(read_scenario(path).robot.initial.position)
     np.testing.assert_allclose(position, [0.0, 2.0, 0.0], atol=1e-12)
 
 
 def test_docs_key_reference_matches_the_schema():
-    from dcsim.docgen import block
+    from dcsim.report.docgen import block
     from dcsim.scenario.reference import BEGIN, END, render_reference
 
     text = (REPO / "docs" / "scenarios.md").read_text()

@@ -18,7 +18,7 @@ from click.testing import CliRunner
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from dcsim.cli import cli
+from dcsim.cli.main import cli
 from tests.conftest import REPO
 
 SHIPPED = sorted(

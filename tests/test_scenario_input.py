@@ -7,10 +7,10 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner, Result
 
-from dcsim.cli import cli
+from dcsim.cli.main import cli
 from dcsim.errors import ScenarioError
-from dcsim.registry import PluginRegistry
-from dcsim.scenario import load_scenario
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.scenario import read_scenario
 from tests.conftest import REPO
 
 DEFAULT = REPO / "scenarios" / "default.yaml"
@@ -32,7 +32,7 @@ def write(tmp_path: Path, content: str | bytes, name: str = "scenario.yaml") -> 
 
 def problems(path: Path, overrides: tuple[str, ...] = (), registry=None) -> list[str]:
     with pytest.raises(ScenarioError) as info:
-        load_scenario(path, overrides, registry)
+        read_scenario(path, overrides, registry)
     return [p.describe(info.value.filename) for p in info.value.problems]
 
 
@@ -118,7 +118,7 @@ def test_nan_and_infinities_are_errors(tmp_path, text, expected):
 
 
 def test_null_still_means_no_limit(tmp_path):
-    scenario = load_scenario(
+    scenario = read_scenario(
         write(tmp_path, "beacons: {max_range: null}\nstop: {max_wall_time: null}\n")
     )
     assert scenario.beacons.max_range is None and scenario.stop.max_wall_time is None
@@ -183,7 +183,7 @@ def test_the_largest_step_counts_and_seed_are_allowed(tmp_path):
         tmp_path,
         "world: {physics_step: 1.0e-3, control_period: 100, duration: 100000, seed: 2147483647}\n",
     )
-    assert load_scenario(path).world.seed == 2**31 - 1
+    assert read_scenario(path).world.seed == 2**31 - 1
 
 
 def test_a_tiny_physics_step_reports_both_step_counts(tmp_path):

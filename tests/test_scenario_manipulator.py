@@ -10,7 +10,7 @@ import pytest
 
 from dcsim.errors import ScenarioError
 from dcsim.robots.dh import thesis_manipulator
-from dcsim.scenario import load_scenario
+from dcsim.scenario import read_scenario
 from dcsim.scenario.model import ManipulatorSection, RobotSection
 from tests.conftest import REPO
 
@@ -31,12 +31,12 @@ def problems(tmp_path: Path, text: str) -> list[str]:
     path = tmp_path / "scenario.yaml"
     path.write_text(text, encoding="utf-8")
     with pytest.raises(ScenarioError) as info:
-        load_scenario(path)
+        read_scenario(path)
     return [p.describe("s") for p in info.value.problems]
 
 
 def test_the_fixture_is_the_thesis_robot_in_radians():
-    robot = load_scenario(FIXTURE).robot
+    robot = read_scenario(FIXTURE).robot
     assert isinstance(robot, ManipulatorSection)
     ours, thesis = robot.dh_robot(), thesis_manipulator()
     for name in ("a", "alpha", "d", "mass", "theta_offset", "torque_limit"):
@@ -51,7 +51,7 @@ def test_the_fixture_is_the_thesis_robot_in_radians():
 
 
 def test_a_robot_without_type_is_the_free_flyer():
-    assert isinstance(load_scenario(REPO / "scenarios" / "default.yaml").robot, RobotSection)
+    assert isinstance(read_scenario(REPO / "scenarios" / "default.yaml").robot, RobotSection)
 
 
 def test_limits_in_degrees_become_radians(tmp_path):
@@ -59,7 +59,7 @@ def test_limits_in_degrees_become_radians(tmp_path):
     path.write_text(
         ARM.replace("mass: 5.0,", "mass: 5.0, position_limits_deg: [-90, 45], torque_limit: 3,", 1)
     )
-    link = load_scenario(path).robot.dh_robot().links[0]
+    link = read_scenario(path).robot.dh_robot().links[0]
     assert link.joint_limits == pytest.approx((-math.pi / 2, math.pi / 4))
     assert link.torque_limit == 3.0
 

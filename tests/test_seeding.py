@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from dcsim.runsetup import prepare_run
-from dcsim.seeding import component_rng
+from dcsim.run.seeding import component_rng
+from dcsim.run.setup import setup_run
 
 
 def test_same_seed_and_component_give_the_same_stream():
@@ -24,7 +24,7 @@ def test_components_and_seeds_get_different_streams():
 
 
 def test_plugins_receive_their_role_generator():
-    setup = prepare_run(seed=11)
+    setup = setup_run(seed=11)
     for role, plugin in setup.plugins.items():
         assert np.array_equal(plugin.rng.random(4), component_rng(11, role).random(4))
     assert setup.scenario.world.seed == 11

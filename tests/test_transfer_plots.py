@@ -10,10 +10,10 @@ import pytest
 
 from dcsim.missions.transfer import TransferMission
 from dcsim.missions.transfer.plots import build_scene, path_figure, read_planned, timeline_figure
-from dcsim.recording import read_telemetry
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.recording import read_telemetry
+from dcsim.run.setup import setup_run
 from tests.conftest import REPO
 
 STATION = REPO / "scenarios" / "station_inspection.yaml"
@@ -30,7 +30,7 @@ def registry():
 def station_run(tmp_path_factory, registry):
     """A station flight to goal 1, written to a run directory."""
     out = tmp_path_factory.mktemp("station") / "run"
-    setup = prepare_run(STATION, [GOAL_1], registry=registry)
+    setup = setup_run(STATION, [GOAL_1], registry=registry)
     summary = Runner(setup, out).run()
     return setup.scenario, out, summary
 
@@ -50,7 +50,7 @@ def test_a_transfer_run_writes_its_path_and_timeline(station_run):
 
 
 def test_a_run_that_never_gets_a_plan_still_writes_both(tmp_path, registry):
-    setup = prepare_run(
+    setup = setup_run(
         REPO / "scenarios" / "ffsr_obstacles_planar.yaml",
         ["path_planner.plugin=straight-line"],  # it refuses: the spheres are in the way
         registry=registry,

@@ -28,10 +28,11 @@ from pathlib import Path
 import yaml
 
 from dcsim.campaign import ClusterOptions, campaign_cases, load_campaign, run_campaign
-from dcsim.campaign.cases import Case, case_setup
+from dcsim.campaign.cases import Case, case_document
 from dcsim.campaign.spec import Campaign
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 
 TIMING_COLUMNS = ("case_wall_time_s", "wall_time_s", "real_time_factor")
 """Columns that hold wall times, left out when tables are compared."""
@@ -165,7 +166,8 @@ def _run_directly(
     walls = []
     for case in cases:
         began = time.perf_counter()
-        Runner(case_setup(campaign.base, case, registry), out / case.name, plots=False).run()
+        setup = setup_run(case_document(campaign.base, case), registry=registry)
+        Runner(setup, out / case.name, plots=False).run()
         walls.append(time.perf_counter() - began)
     return walls
 

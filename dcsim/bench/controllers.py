@@ -21,8 +21,8 @@ import yaml
 from dcsim.bench.figures import pyplot, save
 from dcsim.campaign.engine import ClusterOptions, TaskOutcome, dask_client, run_tasks
 from dcsim.errors import DcsimError
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 
 FIELD_COUNT = 60
 """Obstacles in the crowded field."""
@@ -98,7 +98,7 @@ def fly(case: ControllerCase) -> ControllerRun:
         f"controller.plugin={case.controller}",
         "controller.params={}",
     ]
-    setup = prepare_run(case.scenario, [*chosen, *case.overrides], case.seed)
+    setup = setup_run(case.scenario, [*chosen, *case.overrides], case.seed)
     summary = Runner(setup, None).run()
     if summary["status"] != "completed":
         raise RuntimeError(

@@ -23,9 +23,9 @@ from pathlib import Path
 
 from dcsim.fmu.export import export_fmu
 from dcsim.fmu.instance import FmuInstance
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 
 
 @dataclass(frozen=True)
@@ -106,7 +106,7 @@ def _native(
     scenario: str | Path | None, overrides: Sequence[str], registry: PluginRegistry
 ) -> tuple[int, float]:
     """Ticks flown and their wall time, s (opening and closing the run not counted)."""
-    runner = Runner(prepare_run(scenario, overrides, registry=registry))
+    runner = Runner(setup_run(scenario, overrides, registry=registry))
     runner.open()
     ticks, started = 0, time.perf_counter()
     while not runner.ended:

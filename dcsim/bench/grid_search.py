@@ -27,9 +27,9 @@ import numpy as np
 
 from dcsim.bench.path_planners import Flight, fly
 from dcsim.bench.path_problems import BenchProblem, load_problem
-from dcsim.clearance import path_clearance
 from dcsim.messages import CostWeights, NoPath, PathProblem, Trajectory
-from dcsim.registry import PluginRegistry
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.yardsticks.clearance import path_clearance
 
 FOOT = 0.3048
 """One foot, m."""

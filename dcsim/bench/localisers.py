@@ -24,7 +24,7 @@ import numpy as np
 
 from dcsim.bench.figures import pyplot, save
 from dcsim.messages import BeaconRange, MotionInput, Prior
-from dcsim.registry import PluginRegistry
+from dcsim.registry.discovery import PluginRegistry
 
 BEACONS = np.array(
     [

@@ -34,11 +34,11 @@ import numpy as np
 
 from dcsim.bench.reference_models import BulletModel, PinocchioModel, pin, random_state
 from dcsim.bench.world import PHASES
-from dcsim.registry import PluginRegistry
+from dcsim.registry.discovery import PluginRegistry
 from dcsim.robots.dh import thesis_manipulator
 from dcsim.robots.manipulator import ManipulatorModel
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 
 OURS, BULLET, PINOCCHIO = "dcsim", "PyBullet", "Pinocchio"
 IMPLEMENTATIONS = (OURS, BULLET, PINOCCHIO)
@@ -238,7 +238,7 @@ def scenario_speed(
     path: str | Path, overrides: Sequence[str] = (), registry: PluginRegistry | None = None
 ) -> ScenarioSpeed:
     """Run the scenario at ``path`` once (recording in memory) and time it."""
-    runner = Runner(prepare_run(path, overrides, registry=registry))
+    runner = Runner(setup_run(path, overrides, registry=registry))
     summary = runner.run()
     sim_time = summary["sim_time_s"]
     phases = {phase: runner.laps.totals.get(phase, 0.0) / sim_time for phase in PHASES}

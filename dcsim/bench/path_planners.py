@@ -14,8 +14,9 @@ the bench starts its clock (``PathProblem.deadline``, ``time.monotonic()`` secon
 Per run: planning time; the status (``solved`` — a trajectory, ``no path``, ``error``,
 ``timeout``); whether the trajectory ends inside the goal region within its tolerances
 (exact) or not (approximate); its length, duration and delta-v as the planner reports
-them; its clearance from the independent swept check (:func:`dcsim.clearance.path_clearance`,
-true shapes, a tenth of the robot radius); the planner's statistics; and the peak of
+them; its clearance from the independent swept check
+(:func:`dcsim.yardsticks.clearance.path_clearance`, true shapes, a tenth of the robot
+radius); the planner's statistics; and the peak of
 Python memory allocated during a plan call (tracemalloc: numpy arrays included, a C++
 library's own allocations not). The memory is measured on a second call, of a fresh
 instance with the same generator, after the timed one: tracemalloc's bookkeeping slows a
@@ -43,16 +44,16 @@ import numpy as np
 
 from dcsim.bench.options import plugin_spec
 from dcsim.bench.path_problems import BenchProblem
-from dcsim.clearance import path_clearance
 from dcsim.errors import DcsimError
 from dcsim.messages import NoPath, PathProblem, Trajectory
-from dcsim.registry import PluginRegistry, RegisteredPlugin
-from dcsim.runner import Runner
-from dcsim.runsetup import build_run
+from dcsim.registry.discovery import PluginRegistry, RegisteredPlugin
+from dcsim.run.loop import Runner
+from dcsim.run.seeding import component_rng
+from dcsim.run.setup import RunSetup
 from dcsim.scenario import ScenarioDocument, resolve_plugins, validate
-from dcsim.seeding import component_rng
 from dcsim.testing.contracts import TIME_SLACK
 from dcsim.testing.kind_checks import START_TOLERANCES
+from dcsim.yardsticks.clearance import path_clearance
 
 STATUSES = ("solved", "no path", "error", "timeout")
 """A run's status: a trajectory in time, "no path", an exception or a crash, too late."""
@@ -378,7 +379,7 @@ def fly(
     ):
         flown.apply_override(assignment)
     scenario = resolve_plugins(flown, validate(flown), registry)
-    summary = Runner(build_run(scenario, registry)).run()
+    summary = Runner(RunSetup.from_scenario(scenario, registry)).run()
     return Flight(
         bool(summary["reached"]),
         float(summary["delta_v_mps"]),

@@ -38,8 +38,8 @@ from dcsim.bench.asteroids import escape_scenario
 from dcsim.errors import DcsimError
 from dcsim.messages import PathProblem, RobotState
 from dcsim.missions.transfer.mission import transfer_problem
+from dcsim.run.seeding import component_rng
 from dcsim.scenario import Scenario, ScenarioDocument, validate
-from dcsim.seeding import component_rng
 from dcsim.world import World
 
 LENGTH = 60.0
@@ -230,7 +230,7 @@ def initial_problem(scenario: Scenario) -> PathProblem:
             "the path-planner bench takes transfer scenarios (mission.type: transfer)"
         )
     with World(scenario, component_rng(scenario.world.seed, "world")) as world:
-        position, velocity, attitude, angular_velocity = world.collector_state()
+        position, velocity, attitude, angular_velocity = world.base_state()
         start = RobotState(world.time, position, attitude, velocity, angular_velocity)
         obstacles = world.observations().obstacles()
         return transfer_problem(scenario, start, obstacles, world.robot_spec())

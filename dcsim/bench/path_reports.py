@@ -47,7 +47,7 @@ from dcsim.bench.path_planners import (
     planner_choice,
 )
 from dcsim.messages import PathProblem
-from dcsim.registry import RegisteredPlugin
+from dcsim.registry.discovery import RegisteredPlugin
 
 _RUN_PROPERTIES = (
     ("seed", "INTEGER"),

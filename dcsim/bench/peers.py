@@ -6,7 +6,7 @@ span, navigation fed the true state:
 
 - **dcsim**: the ``hold`` mission (the attitude held is the goal; ``hold_position``
   false for the attitude-only row) with the ``pd`` controller, no localiser, through
-  the normal runner (:class:`~dcsim.runner.Runner`, recording in memory), PyBullet
+  the normal runner (:class:`~dcsim.run.loop.Runner`, recording in memory), PyBullet
   stepping at the scenario's physics step;
 - **Basilisk**: the modules of :mod:`dcsim.bench.basilisk_loop`, the dynamics task at
   the same step unless told otherwise.
@@ -55,11 +55,11 @@ from dcsim.geometry import (
     rotation_vector,
 )
 from dcsim.missions.hold.settings import HoldMissionSection
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import build_run
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.seeding import component_rng
+from dcsim.run.setup import RunSetup
 from dcsim.scenario.model import Scenario, scenario_model
-from dcsim.seeding import component_rng
 from dcsim.world import World
 
 GOAL_ATTITUDE = (0.0, 0.0, 0.3826834323650898, 0.9238795325112867)
@@ -275,7 +275,9 @@ def flyer_inertia(case: SlewCase) -> np.ndarray:
 def fly_dcsim(case: SlewCase, hold_position: bool, registry: PluginRegistry) -> Flight:
     """Fly ``case`` through dcsim's runner and return its record."""
     began, cpu_began = time.perf_counter(), time.process_time()
-    runner = Runner(build_run(slew_scenario(case, hold_position), registry), keep_rows=True)
+    runner = Runner(
+        RunSetup.from_scenario(slew_scenario(case, hold_position), registry), keep_rows=True
+    )
     summary = runner.run()
     wall, cpu = time.perf_counter() - began, time.process_time() - cpu_began
     if summary["status"] != "completed":

@@ -23,9 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 
 _FMU_STEPS = 10  # control periods flown per FMU cycle
 
@@ -113,7 +113,7 @@ def soak(
         Receives a line of text at every sample.
     """
     registry = PluginRegistry.discover()
-    setup = prepare_run(
+    setup = setup_run(
         None,
         # One simulated second per tick is more than the ticks need at the default
         # 0.1 s control period, and stays within the scenario's bound on physics steps.

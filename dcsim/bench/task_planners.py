@@ -42,7 +42,7 @@ from dcsim.api import (
 )
 from dcsim.bench.figures import pyplot, save
 from dcsim.bench.optimal_plans import LegRules, optimal_grid_plan, optimal_static_plan
-from dcsim.registry import PluginRegistry
+from dcsim.registry.discovery import PluginRegistry
 
 AREA = 50.0
 """Half-width of the cube the targets start in, m."""

@@ -29,15 +29,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dcsim.interfaces import Localiser
 from dcsim.messages import BeaconRange, MotionInput, Prior
 from dcsim.motion import mean_motion
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import build_run, prepare_run
-from dcsim.scenario import load_scenario
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.registry.interfaces import Localiser
+from dcsim.run.loop import Runner
+from dcsim.run.seeding import component_rng
+from dcsim.run.setup import RunSetup, setup_run
+from dcsim.scenario import read_scenario
 from dcsim.scenario.model import Scenario
-from dcsim.seeding import component_rng
 from dcsim.world import World
 from dcsim.world.pybullet_client import pb
 
@@ -96,7 +96,7 @@ def field_scenario(objects: int, duration: float, seed: int = 0) -> Scenario:
         obstacles.append(
             {"id": i, "radius": 1.0, "motion": cw(position.tolist(), rng.normal(0, 0.01))}
         )
-    return load_scenario(
+    return read_scenario(
         {
             "name": f"bench-{objects}",
             "world": {"frame": "lvlh", "orbit": {"radius": ORBIT_RADIUS}, "duration": duration},
@@ -124,7 +124,7 @@ def bare_stepping(scenario: Scenario) -> float:
 
 def closed_loop(scenario: Scenario, registry: PluginRegistry) -> tuple[float, dict[str, float]]:
     """Wall seconds per simulated second of the full runner, in all and by phase."""
-    runner = Runner(build_run(scenario, registry))
+    runner = Runner(RunSetup.from_scenario(scenario, registry))
     start = time.perf_counter()
     runner.run()
     elapsed = time.perf_counter() - start
@@ -220,7 +220,7 @@ def loop_floor(
     -------
     LoopFloor
     """
-    setup = prepare_run(registry=registry)
+    setup = setup_run(registry=registry)
     with World(setup.scenario, component_rng(0, "world")) as world:
         ticks = round(sim_time / world.control_period)
         steps = ticks * world.steps_per_control
@@ -228,7 +228,7 @@ def loop_floor(
         forced = _best(lambda: _step_with_forces(world, steps), repeats)
         ranges = world.beacon_ranges()
         localiser = setup.plugins["localiser"]
-        position = world.collector_state()[0]
+        position = world.base_state()[0]
         _localise(localiser, ranges, position, 1, world.control_period)  # imports on first use
         timed = _best(
             lambda: _localise(localiser, ranges, position, ticks, world.control_period), repeats
@@ -250,7 +250,7 @@ def _step_bare(world: World, steps: int) -> None:
 def _step_with_forces(world: World, steps: int) -> None:
     """``steps`` physics steps with the collector's state read and a force applied before
     each, as the world steps a control period."""
-    client, body = world.client, world.collector
+    client, body = world.client, world.robot_id
     for _ in range(steps):
         position = pb.getBasePositionAndOrientation(body, physicsClientId=client)[0]
         pb.getBaseVelocity(body, physicsClientId=client)

@@ -36,10 +36,8 @@ from dcsim.campaign.spec import (
     UniformDispersion,
 )
 from dcsim.errors import CampaignError, Problem, ScenarioError
-from dcsim.registry import PluginRegistry
-from dcsim.runsetup import RunSetup, build_run
-from dcsim.scenario import ScenarioDocument, dump_scenario, parse_key_path, resolve_plugins
-from dcsim.scenario import validate as validate_scenario
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.scenario import ScenarioDocument, dump_scenario, parse_key_path, read_scenario
 from dcsim.scenario.model import MAX_SEED
 
 SEED_KEY = "world.seed"
@@ -138,18 +136,6 @@ def case_document(base: ScenarioDocument, case: Case) -> ScenarioDocument:
     return document
 
 
-def case_setup(base: ScenarioDocument, case: Case, registry: PluginRegistry) -> RunSetup:
-    """The resolved scenario and constructed plugins of ``case``: what its run flies.
-
-    Raises
-    ------
-    ScenarioError
-        If the case is not a valid scenario (or names a plugin not installed here).
-    """
-    document = case_document(base, case)
-    return build_run(resolve_plugins(document, validate_scenario(document), registry), registry)
-
-
 def draw_value(
     dispersion: Dispersion, nominal: Any, campaign_seed: int, draw: int, path: str
 ) -> Any:
@@ -216,7 +202,7 @@ def _resolved_data(
         document = copy.deepcopy(campaign.base)
         for assignment in fixed:
             document.apply_override(assignment)
-        scenario = resolve_plugins(document, validate_scenario(document), registry)
+        scenario = read_scenario(document, registry=registry)
     except ScenarioError as error:
         raise CampaignError(
             campaign.filename,
@@ -283,7 +269,7 @@ def _check_cases(campaign: Campaign, cases: Sequence[Case], registry: PluginRegi
     for case in cases:
         try:
             document = case_document(campaign.base, case)
-            resolve_plugins(document, validate_scenario(document), registry)
+            read_scenario(document, registry=registry)
         except ScenarioError as error:
             invalid += 1
             if invalid <= MAX_REPORTED:

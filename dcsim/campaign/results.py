@@ -21,7 +21,7 @@ import yaml
 from dcsim.campaign.cases import Case
 from dcsim.campaign.spec import Campaign, NormalDispersion, UniformDispersion
 from dcsim.errors import CampaignError, Problem
-from dcsim.recording import column_name, column_unit
+from dcsim.run.recording import column_name, column_unit
 from dcsim.scenario import parse_key_path
 from dcsim.scenario.loader import key_unit
 from dcsim.scenario.model import frame_axes
@@ -48,7 +48,7 @@ def metric_names(campaign: Campaign, mission_type: str) -> list[str]:
         If a named metric is not a field of the mission's run summary.
     """
     from dcsim.missions import mission_class  # missions load the world engine
-    from dcsim.runner import SUMMARY_FIGURES
+    from dcsim.run.loop import SUMMARY_FIGURES
 
     known = [*SUMMARY_FIGURES, *mission_class(mission_type).summary_names]
     named = campaign.spec.metrics

@@ -28,15 +28,16 @@ from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any, TextIO
 
 from dcsim import __version__
-from dcsim.campaign.cases import Case, campaign_cases, case_setup
+from dcsim.campaign.cases import Case, campaign_cases, case_document
 from dcsim.campaign.engine import ClusterOptions, TaskOutcome, dask_client, run_tasks, running_count
 from dcsim.campaign.progress import CampaignProgress
 from dcsim.campaign.results import metric_names, results_table, write_results
 from dcsim.campaign.spec import Campaign, load_campaign, parse_campaign
 from dcsim.campaign.worker import CaseTask, run_case
 from dcsim.errors import DcsimError
-from dcsim.registry import PluginRegistry
-from dcsim.rundir import prepare_run_directory
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.directory import prepare_run_directory
+from dcsim.run.setup import setup_run
 from dcsim.scenario import ScenarioDocument, validate
 
 if TYPE_CHECKING:
@@ -175,7 +176,7 @@ def replay_case(directory: Path, index: int, out: Path | None = None) -> Replay:
     CampaignDirectoryError
         If ``directory`` is not a campaign directory, or has no case ``index``.
     """
-    from dcsim.runner import Runner  # the world engine loads PyBullet
+    from dcsim.run.loop import Runner  # the world engine loads PyBullet
 
     campaign, count = load_campaign_directory(directory)
     if not 0 <= index < count:
@@ -184,7 +185,7 @@ def replay_case(directory: Path, index: int, out: Path | None = None) -> Replay:
     case = campaign_cases(campaign, registry, index + 1)[index]
     out = out if out is not None else directory / "reruns" / case.name
     prepare_run_directory(out, force=True)
-    setup = case_setup(campaign.base, case, registry)
+    setup = setup_run(case_document(campaign.base, case), registry=registry)
     summary = Runner(setup, out, plots=campaign.spec.case_plots).run()
     recorded = directory / CASES_DIR / case.name
     identical = {

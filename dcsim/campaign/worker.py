@@ -20,10 +20,11 @@ from pathlib import Path
 from typing import Any
 
 from dcsim import __version__
-from dcsim.campaign.cases import Case, case_setup
+from dcsim.campaign.cases import Case, case_document
 from dcsim.errors import DcsimError
-from dcsim.recording import to_json
-from dcsim.registry import PluginRegistry
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.recording import to_json
+from dcsim.run.setup import setup_run
 from dcsim.scenario import ScenarioDocument
 
 CASE_FILE = "case.json"
@@ -116,10 +117,14 @@ def read_case_result(directory: Path) -> dict[str, Any] | None:
 
 def _run(task: CaseTask, out: Path) -> dict[str, Any]:
     """Run the case into ``out``; its summary (one saying why, if it could not start)."""
-    from dcsim.runner import Runner  # the world engine loads PyBullet
+    from dcsim.run.loop import Runner  # the world engine loads PyBullet
 
     try:
-        runner = Runner(case_setup(task.base, task.case, _registry()), out, plots=task.plots)
+        runner = Runner(
+            setup_run(case_document(task.base, task.case), registry=_registry()),
+            out,
+            plots=task.plots,
+        )
     except DcsimError as error:  # e.g. a plugin not installed on this worker
         return {"status": "failed", "reason": str(error)}
     try:

@@ -11,8 +11,8 @@ from pathlib import Path
 from dcsim.fmu.instance import FmuError
 from dcsim.fmu.slaves import SCENARIO_RESOURCE
 from dcsim.fmu.variables import DEFAULT_BEACONS
-from dcsim.registry import PluginRegistry
-from dcsim.scenario import dump_scenario, load_scenario
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.scenario import dump_scenario, read_scenario
 
 _SCRIPT = '''"""FMU slave of dcsim scenario {name!r} ({variant}), written by `dcsim fmu export`."""
 
@@ -72,7 +72,7 @@ def export_fmu(
     if beacons < 1:
         raise FmuError(f"beacons must be at least 1, got {beacons}")
     registry = registry if registry is not None else PluginRegistry.discover()
-    resolved = load_scenario(scenario, overrides, registry)
+    resolved = read_scenario(scenario, overrides, registry)
     text = dump_scenario(resolved)
     variant = "plant" if plant_only else "closed-loop"
     # Python caches slave modules by name per process: a unique name per content.

@@ -10,7 +10,6 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from dcsim.docgen import update_block
 from dcsim.fmu.variables import (
     DEFAULT_BEACONS,
     FmuVariable,
@@ -19,7 +18,8 @@ from dcsim.fmu.variables import (
     joint_torque_inputs,
     plant_variables,
 )
-from dcsim.scenario import load_scenario
+from dcsim.report.docgen import update_block
+from dcsim.scenario import read_scenario
 
 MANIPULATOR_SCENARIO = (
     Path(__file__).resolve().parents[2] / "scenarios" / "space_manipulator_reach.yaml"
@@ -54,8 +54,8 @@ def generated_blocks() -> list[tuple[str, str, str]]:
     joint torque inputs, then the joint and end-effector outputs of both variants) for
     :data:`MANIPULATOR_SCENARIO`.
     """
-    default = load_scenario()
-    robot = load_scenario(MANIPULATOR_SCENARIO).robot
+    default = read_scenario()
+    robot = read_scenario(MANIPULATOR_SCENARIO).robot
     return [
         (BEGIN_CLOSED, END_CLOSED, variables_table(closed_loop_variables(default))),
         (BEGIN_PLANT, END_PLANT, variables_table(plant_variables(default, DEFAULT_BEACONS))),

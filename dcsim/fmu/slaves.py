@@ -2,7 +2,7 @@
 
 An exported FMU carries a tiny script defining a subclass of :class:`ClosedLoopSlave` or
 :class:`PlantSlave`, and the resolved scenario as the resource ``scenario.yaml``. The
-slaves are thin adapters: the closed-loop one drives the :class:`~dcsim.runner.Runner`
+slaves are thin adapters: the closed-loop one drives the :class:`~dcsim.run.loop.Runner`
 that ``dcsim run`` uses, the plant one a :class:`~dcsim.world.World`. A slave declares
 its variables when it is instantiated, from that scenario (:mod:`dcsim.fmu.variables`):
 a manipulator's joints are variables of its FMUs.
@@ -48,11 +48,11 @@ from dcsim.fmu.variables import (
 )
 from dcsim.messages import RobotState
 from dcsim.robots.manipulator import ManipulatorModel
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
-from dcsim.scenario import Scenario, load_scenario
+from dcsim.run.loop import Runner
+from dcsim.run.seeding import component_rng
+from dcsim.run.setup import setup_run
+from dcsim.scenario import Scenario, read_scenario
 from dcsim.scenario.model import ManipulatorSection, point_to_cartesian
-from dcsim.seeding import component_rng
 from dcsim.world import World, WorldInputs
 
 SCENARIO_RESOURCE = "scenario.yaml"
@@ -105,7 +105,7 @@ class _ScenarioSlave(Fmi2Slave):
         super().__init__(**kwargs)
         release_own_library(self.resources, self.modelName)  # see dcsim.fmu.native
         self.scenario_path = Path(self.resources) / SCENARIO_RESOURCE
-        self.scenario: Scenario = load_scenario(self.scenario_path)
+        self.scenario: Scenario = read_scenario(self.scenario_path)
         self.variables: list[FmuVariable] = self._declare()
         self._joints = joint_count(self.scenario.robot)
         self.author = "dcsim"
@@ -344,7 +344,7 @@ class ClosedLoopSlave(_ScenarioSlave):
         return closed_loop_variables(self.scenario)
 
     def _open(self) -> None:
-        setup = prepare_run(self.scenario_path, self._overrides(), seed=self.values["seed"])
+        setup = setup_run(self.scenario_path, self._overrides(), seed=self.values["seed"])
         self.runner = Runner(setup, keep_rows=False)
         self.runner.open()
 
@@ -402,7 +402,7 @@ class PlantSlave(_ScenarioSlave):
         return values
 
     def _open(self) -> None:
-        scenario = load_scenario(
+        scenario = read_scenario(
             self.scenario_path, [*self._overrides(), f"world.seed={self.values['seed']}"]
         )
         self.world = World(scenario, component_rng(scenario.world.seed, "world"))

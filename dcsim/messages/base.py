@@ -9,7 +9,7 @@ compared element-wise).
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
-from typing import Any, TypeVar
+from typing import Any, TypeVar, dataclass_transform
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -29,7 +29,8 @@ def array_field(
     shape : tuple of int
         Required shape; ``-1`` accepts any length along that axis.
     default : array_like, optional
-        Default value; omit for a required field.
+        Default value; omit for a required field (give None, with ``optional``, for a
+        field that is None unless given).
     optional : bool
         If true the field may be None (its default unless ``default`` is given), meaning
         "not given"; otherwise None is rejected.
@@ -161,6 +162,7 @@ class Message:
     __hash__ = None  # type: ignore[assignment]
 
 
+@dataclass_transform(frozen_default=True, eq_default=False, field_specifiers=(field, array_field))
 def message(cls: T) -> T:
     """Class decorator making ``cls`` a frozen message dataclass."""
     return dataclass(frozen=True, eq=False)(cls)

@@ -58,8 +58,8 @@ class GoalRegion(Message):
     tolerance: float = 0.0
     velocity: Vector = array_field(default=(0.0, 0.0, 0.0))
     time: float | None = None
-    half_extents: Vector | None = array_field(optional=True)
-    attitude: Vector | None = array_field(shape=(4,), optional=True)
+    half_extents: Vector | None = array_field(default=None, optional=True)
+    attitude: Vector | None = array_field(shape=(4,), default=None, optional=True)
     attitude_tolerance: float = _INF
     velocity_tolerance: float = _INF
     time_tolerance: float = _INF
@@ -278,10 +278,10 @@ class Trajectory(Message):
     times: Vector = array_field(shape=(-1,))
     positions: Vector = array_field(shape=(-1, 3))
     velocities: Vector = array_field(shape=(-1, 3))
-    attitudes: Vector | None = array_field(shape=(-1, 4), optional=True)
-    angular_velocities: Vector | None = array_field(shape=(-1, 3), optional=True)
-    forces: Vector | None = array_field(shape=(-1, 3), optional=True)
-    torques: Vector | None = array_field(shape=(-1, 3), optional=True)
+    attitudes: Vector | None = array_field(shape=(-1, 4), default=None, optional=True)
+    angular_velocities: Vector | None = array_field(shape=(-1, 3), default=None, optional=True)
+    forces: Vector | None = array_field(shape=(-1, 3), default=None, optional=True)
+    torques: Vector | None = array_field(shape=(-1, 3), default=None, optional=True)
     delta_v: float = 0.0
     length: float = 0.0
     duration: float = 0.0

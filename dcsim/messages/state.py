@@ -173,7 +173,7 @@ class Reference(Message):
     position: Vector = array_field()
     velocity: Vector = array_field(default=(0.0, 0.0, 0.0))
     acceleration: Vector = array_field(default=(0.0, 0.0, 0.0))
-    attitude: Vector | None = array_field(shape=(4,), optional=True)
+    attitude: Vector | None = array_field(shape=(4,), default=None, optional=True)
     angular_velocity: Vector = array_field(default=(0.0, 0.0, 0.0))
     angular_acceleration: Vector = array_field(default=(0.0, 0.0, 0.0))
     joint_positions: Vector = array_field(shape=(-1,), default=())

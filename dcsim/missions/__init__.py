@@ -23,9 +23,9 @@ import importlib.metadata as md
 import warnings
 
 from dcsim.errors import PluginLoadWarning
-from dcsim.interfaces import PLUGIN_KINDS
 from dcsim.missions.base import Mission
-from dcsim.registry import BUILTIN_DISTRIBUTION
+from dcsim.registry.discovery import BUILTIN_DISTRIBUTION
+from dcsim.registry.interfaces import PLUGIN_KINDS
 from dcsim.scenario.model import Scenario
 
 MISSION_GROUP = "dcsim.missions"

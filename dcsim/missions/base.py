@@ -22,7 +22,6 @@ from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 import numpy as np
 
 from dcsim.errors import PlanOutlastsRunWarning
-from dcsim.interfaces import Plugin
 from dcsim.messages import (
     Observations,
     Reference,
@@ -31,7 +30,8 @@ from dcsim.messages import (
     StateEstimate,
     Surroundings,
 )
-from dcsim.plugin_calls import call_plugin
+from dcsim.registry.calls import call_plugin
+from dcsim.registry.interfaces import Plugin
 from dcsim.scenario.model import MissionSettings, Scenario
 
 if TYPE_CHECKING:
@@ -126,7 +126,7 @@ class Mission(ABC):
         (:meth:`telemetry_columns` gives them for a scenario).
     units : mapping of str to str
         The unit suffix of each of its columns that has a unit (a key of
-        :data:`dcsim.recording.UNITS`: ``m``, ``mps``, ``rad``...), written into the
+        :data:`dcsim.run.recording.UNITS`: ``m``, ``mps``, ``rad``...), written into the
         header of ``telemetry.csv`` (:meth:`telemetry_units` gives them for a scenario).
     robots : tuple of str
         The robot types (``robot.type``) it can fly; a scenario pairing it with another
@@ -226,10 +226,10 @@ class Mission(ABC):
 
         The default draws what every run shows: the motion (speed, thrust, attitude,
         angular rate) and the estimation error with its ±3σ envelope
-        (:func:`dcsim.plots.write_plots`); a mission adds its own pictures by overriding
+        (:func:`dcsim.report.plots.write_plots`); a mission adds its own pictures by overriding
         this. ``telemetry`` is thinned for plotting.
         """
-        from dcsim.plots import write_plots  # on use: it loads matplotlib
+        from dcsim.report.plots import write_plots  # on use: it loads matplotlib
 
         return write_plots(out_dir, self.scenario, telemetry)
 

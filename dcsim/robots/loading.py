@@ -12,7 +12,7 @@ from numpy.typing import ArrayLike
 from dcsim.errors import DcsimError, RobotTypeError
 from dcsim.messages import PathProblem, RobotState
 from dcsim.robots.manipulator import ManipulatorModel
-from dcsim.scenario import load_scenario
+from dcsim.scenario import read_scenario
 from dcsim.scenario.model import ManipulatorSection, point_to_cartesian
 
 
@@ -44,7 +44,7 @@ def load_robot_model(path: str | Path, overrides: Sequence[str] = ()) -> Manipul
     RobotTypeError
         If its robot is not a manipulator.
     """
-    robot = load_scenario(path, overrides).robot
+    robot = read_scenario(path, overrides).robot
     if not isinstance(robot, ManipulatorSection):
         raise RobotTypeError(
             f"{path}: robot.type is '{robot.type}', which has no arm model; "
@@ -80,7 +80,7 @@ def load_reach_problem(
     """
     from dcsim.missions.reach.mission import reach_problem  # the missions load the world engine
 
-    scenario = load_scenario(path, overrides)
+    scenario = read_scenario(path, overrides)
     model = load_robot_model(path, overrides)
     if scenario.mission.type != "reach":
         raise DcsimError(f"{path}: mission.type is '{scenario.mission.type}', not 'reach'")

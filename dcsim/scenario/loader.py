@@ -29,7 +29,7 @@ from pydantic import BaseModel, TypeAdapter, ValidationError
 
 from dcsim.errors import DcsimError, PluginParameterError, Problem, ScenarioError, did_you_mean
 from dcsim.params import describe_error, field_unit, short_repr
-from dcsim.registry import PluginRegistry
+from dcsim.registry.discovery import PluginRegistry
 from dcsim.scenario.document import KeyPath, ScenarioDocument, format_key_path
 from dcsim.scenario.model import (
     MAX_PHYSICS_STEPS,
@@ -55,8 +55,9 @@ def packaged_scenario_path(name: str) -> Path:
     return Path(str(resources.files("dcsim") / "scenarios" / name))
 
 
-ScenarioSource = str | Path | Mapping[str, Any] | None
-"""A scenario file's path, the scenario's data as a mapping, or None for the packaged one."""
+ScenarioSource = str | Path | Mapping[str, Any] | ScenarioDocument | None
+"""A scenario file's path, the scenario's data as a mapping, a parsed document (copied:
+overrides never change it), or None for the packaged one."""
 
 MAPPING_NAME = "scenario mapping"
 """How errors name a scenario given as a mapping rather than a file."""
@@ -76,6 +77,8 @@ def scenario_document(source: ScenarioSource = None) -> ScenarioDocument:
     """
     if source is None:
         return ScenarioDocument.from_file(default_scenario_path())
+    if isinstance(source, ScenarioDocument):
+        return copy.deepcopy(source)
     if not isinstance(source, Mapping):
         return ScenarioDocument.from_file(source)
     try:
@@ -88,7 +91,7 @@ def scenario_document(source: ScenarioSource = None) -> ScenarioDocument:
     return doc
 
 
-def load_scenario(
+def read_scenario(
     path: ScenarioSource = None,
     overrides: Sequence[str] = (),
     registry: PluginRegistry | None = None,

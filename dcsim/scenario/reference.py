@@ -16,8 +16,8 @@ from typing import Annotated, Any, Literal, Union, get_args, get_origin
 from pydantic import BaseModel
 from pydantic_core import PydanticUndefined
 
-from dcsim.docgen import update_block
 from dcsim.params import field_bounds, field_unit
+from dcsim.report.docgen import update_block
 from dcsim.scenario.model import (
     MissionSettings,
     MotionSpec,

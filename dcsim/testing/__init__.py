@@ -29,8 +29,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from dcsim.interfaces import PLUGIN_KINDS, Plugin
-from dcsim.registry import PluginRegistry
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.registry.interfaces import PLUGIN_KINDS, Plugin
 from dcsim.testing import kind_checks  # noqa: F401  (registers the kind-specific checks)
 from dcsim.testing.contracts import METADATA_CHECK, Check, ContractViolation, checks_for
 

@@ -20,15 +20,15 @@ from typing import Any, NoReturn
 import numpy as np
 
 from dcsim.errors import PluginInterfaceError, PluginParameterError
-from dcsim.interfaces import PLUGIN_KINDS, Controller, Localiser, Plugin
 from dcsim.messages import (
     Reference,
     StateEstimate,
     Surroundings,
     Trajectory,
 )
-from dcsim.plugin_outputs import ANSWERS, output_problem
-from dcsim.registry import check_plugin_class
+from dcsim.registry.answers import ANSWERS, output_problem
+from dcsim.registry.discovery import check_plugin_class
+from dcsim.registry.interfaces import PLUGIN_KINDS, Controller, Localiser, Plugin
 from dcsim.testing import problems
 
 SEED = 1234
@@ -280,7 +280,7 @@ def run_plugin(plugin_class: type[Plugin], inputs: list, what: str) -> list:
 
 def checked_answer(kind: str, output: Any, what: str, joints: int | None = None) -> Any:
     """``output`` when it is an answer a plugin of ``kind`` may give (the check a run makes
-    at the plugin boundary, :func:`dcsim.plugin_outputs.output_problem`); otherwise a
+    at the plugin boundary, :func:`dcsim.registry.answers.output_problem`); otherwise a
     violation saying what was wrong on ``what`` and what was expected."""
     answer = ANSWERS[kind]
     problem = output_problem(kind, answer.method, output, joints)

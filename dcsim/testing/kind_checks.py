@@ -8,14 +8,12 @@ from collections.abc import Callable
 
 import numpy as np
 
-from dcsim.clearance import RESOLUTION, path_clearance
 from dcsim.geometry import (
     quaternion_conjugate,
     quaternion_from_rotation_vector,
     quaternion_multiply,
     rotation_vector,
 )
-from dcsim.interfaces import Plugin
 from dcsim.messages import (
     NoPath,
     PathProblem,
@@ -25,6 +23,7 @@ from dcsim.messages import (
     Surroundings,
     Trajectory,
 )
+from dcsim.registry.interfaces import Plugin
 from dcsim.testing import problems
 from dcsim.testing.contracts import (
     LOCALISER_ERROR_BOUND,
@@ -38,6 +37,7 @@ from dcsim.testing.contracts import (
     standard_inputs,
 )
 from dcsim.testing.manipulator import simulate
+from dcsim.yardsticks.clearance import RESOLUTION, path_clearance
 
 START_TOLERANCES = (1e-6, 1e-9, 1e-6)
 """How far a trajectory may start from the start state: position (m), time (s), attitude (rad)."""
@@ -403,8 +403,8 @@ def _check_margin(trajectory: Trajectory, problem: PathProblem, what: str) -> No
     "against every obstacle's true shape (sphere, or turned box or cylinder) moving by its "
     "predicted motion, the robot's sphere never comes closer than the problem's "
     f"safety_margin ({problems.SAFETY_MARGIN:g} m on the standard problem); checked by "
-    "`dcsim.clearance.path_clearance` at every sample of the trajectory and at steps over "
-    f"which no gap changes by more than {RESOLUTION:g} robot radius",
+    "`dcsim.yardsticks.clearance.path_clearance` at every sample of the trajectory and at "
+    f"steps over which no gap changes by more than {RESOLUTION:g} robot radius",
     kinds=("path_planner",),
     robots=("free-flyer",),
 )

@@ -17,8 +17,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from dcsim.geometry import quaternion_multiply
-from dcsim.interfaces import Controller
 from dcsim.messages import Command, Reference, RobotSpec, StateEstimate, Surroundings
+from dcsim.registry.interfaces import Controller
 from dcsim.robots.dh import thesis_manipulator
 from dcsim.robots.manipulator import manipulator_model
 

@@ -25,12 +25,12 @@ from pathlib import Path
 from typing import Any
 
 from dcsim.errors import ScenarioError
-from dcsim.interfaces import PLUGIN_KINDS
 from dcsim.missions import Mission, mission_types, register_mission
-from dcsim.recording import read_telemetry
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import RunSetup, prepare_run
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.registry.interfaces import PLUGIN_KINDS
+from dcsim.run.loop import Runner
+from dcsim.run.recording import read_telemetry
+from dcsim.run.setup import RunSetup, setup_run
 from dcsim.scenario.loader import ROBOT_TYPES, scenario_document
 from dcsim.scenario.model import MissionSettings
 from dcsim.testing.contracts import ContractViolation, fail
@@ -107,7 +107,7 @@ def _registry() -> PluginRegistry:
 def _setup(scenario: ScenarioSource) -> RunSetup:
     """The scenario's run set-up: validated, its plugins made (afresh for each flight)."""
     try:
-        return prepare_run(_document(scenario), registry=_registry())
+        return setup_run(_document(scenario), registry=_registry())
     except ScenarioError as error:
         fail(f"its scenario does not validate: {error}")
 
@@ -160,7 +160,7 @@ def check_section_validation(mission: type[Mission], scenario: ScenarioSource) -
     data = _document(scenario)
     data.setdefault("mission", {})["no_such_key_xyz"] = 1
     try:
-        prepare_run(data, registry=_registry())
+        setup_run(data, registry=_registry())
     except ScenarioError as error:
         if "mission.no_such_key_xyz" not in str(error):
             fail(f"an unknown mission key was refused without being named: {error}")

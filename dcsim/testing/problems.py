@@ -12,7 +12,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from dcsim.geometry import quaternion_from_rotation_vector
-from dcsim.interfaces import Plugin
 from dcsim.messages import (
     BeaconRange,
     Bounds,
@@ -33,6 +32,7 @@ from dcsim.messages import (
     TaskRequest,
 )
 from dcsim.motion import LinearMotion, StaticMotion
+from dcsim.registry.interfaces import Plugin
 from dcsim.scenario.loader import packaged_scenario_path
 from dcsim.testing.manipulator import thesis_robot
 

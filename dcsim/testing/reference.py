@@ -5,8 +5,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from dcsim.docgen import update_block
-from dcsim.interfaces import PLUGIN_KINDS
+from dcsim.registry.interfaces import PLUGIN_KINDS
+from dcsim.report.docgen import update_block
 from dcsim.testing import checks_for
 
 BEGIN = "<!-- BEGIN GENERATED CHECK LIST (make docs) -->"

@@ -1,4 +1,4 @@
-"""The world as a steppable system: the collector's dynamics, collisions, state and outputs.
+"""The world as a steppable system: the robot's dynamics, collisions, state and outputs.
 
 One PyBullet DIRECT client per world, zero gravity, a fixed physics step; every call
 passes the client id, so several worlds live side by side in one process. The world
@@ -19,7 +19,7 @@ composes its pieces:
   once per control period.
 - **Objects**: targets and obstacles, spheres, boxes or cylinders of fixed orientation,
   follow their motion models exactly while free.
-- **Collisions**: every physics step, the collector and what it carries against every
+- **Collisions**: every physics step, the robot and what it carries against every
   free object that the control period's broad phase (swept bounding spheres) found
   within reach, from PyBullet's closest-point queries on the true shapes. A collision
   is reported once, when contact starts. Contacts are detected, not resolved: bodies
@@ -80,9 +80,9 @@ class WorldInputs:
     torque : ndarray (3,)
         Commanded torque, world frame, N·m (clipped to the limit).
     disturbance_force : ndarray (3,)
-        External force on the collector, N (not clipped, uses no propellant).
+        External force on the robot's base, N (not clipped, uses no propellant).
     disturbance_torque : ndarray (3,)
-        External torque on the collector, N·m.
+        External torque on the robot's base, N·m.
     joint_torques : ndarray (n,)
         Commanded joint torques of a manipulator, N·m (clipped to the limits); empty
         for none (and for a free flyer, which has no joints).
@@ -97,7 +97,7 @@ class WorldInputs:
 
 @dataclass(frozen=True)
 class CollisionEvent:
-    """Contact starting between the collector (or a carried target) and an object.
+    """Contact starting between the robot (or a carried target) and an object.
 
     Attributes
     ----------
@@ -106,7 +106,7 @@ class CollisionEvent:
     object_id : int
         The object hit.
     body : str
-        ``"collector"`` or ``"target <id>"`` for a carried target.
+        ``"collector"`` for the robot or ``"target <id>"`` for a carried target.
     penetration : float
         Depth of the overlap when detected, m.
     """
@@ -142,6 +142,8 @@ class World:
         The targets and obstacles.
     collisions : list of CollisionEvent
         Every collision so far.
+    robot_id : int
+        The robot's PyBullet body id (its base is link -1).
     """
 
     def __init__(self, scenario: Scenario, rng: np.random.Generator) -> None:
@@ -168,11 +170,11 @@ class World:
         pb.setTimeStep(self.physics_step, physicsClientId=self._client)
         self._robot = _build_robot_body(self._client, robot)
         self._links_mass = sum(mass for _, mass in self._robot.links)
-        self.collector = self._robot.body
+        self.robot_id = self._robot.body
         self._joint_torques = np.zeros(0)
         self._bodies = ObjectBodies(self._client, self.field)
         self._payload = Payload(
-            self._client, self.collector, robot.radius, self.field, self._bodies
+            self._client, self.robot_id, robot.radius, self.field, self._bodies
         )
         self._contacts: set[tuple[int, int]] = set()
         self._candidates = np.zeros(0, dtype=int)
@@ -218,31 +220,32 @@ class World:
         """
         return self._payload.changes
 
-    def collector_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """True ``(position, velocity, attitude [x, y, z, w], angular velocity)``.
+    def base_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """True ``(position, velocity, attitude [x, y, z, w], angular velocity)`` of the
+        robot's base, world frame.
 
         Read from PyBullet once per physics step; sensors, outputs and the broad phase of
         one tick share the reading.
         """
         if self._state_cache is None or self._state_cache[0] != self._steps:
             position, attitude = pb.getBasePositionAndOrientation(
-                self.collector, physicsClientId=self._client
+                self.robot_id, physicsClientId=self._client
             )
-            velocity, angular = pb.getBaseVelocity(self.collector, physicsClientId=self._client)
+            velocity, angular = pb.getBaseVelocity(self.robot_id, physicsClientId=self._client)
             state = tuple(np.array(v) for v in (position, velocity, attitude, angular))
             for array in state:
                 array.setflags(write=False)
             self._state_cache = (self._steps, state)
         return self._state_cache[1]
 
-    def collector_mass(self) -> float:
-        """Collector mass, propellant included, kg."""
+    def base_mass(self) -> float:
+        """Mass of the robot's base, propellant included, kg."""
         return self.dry_mass + self.propellant
 
     def assembly_mass(self) -> float:
         """Mass of the robot (a manipulator's arm included) and every object it carries,
         kg."""
-        return self.collector_mass() + self._payload.mass + self._links_mass
+        return self.base_mass() + self._payload.mass + self._links_mass
 
     @property
     def robot_body(self) -> RobotBody:
@@ -255,7 +258,7 @@ class World:
 
     def robot_state(self) -> RobotState:
         """The true state: base (centre of mass, world frame) and joints."""
-        position, velocity, attitude, angular = self.collector_state()
+        position, velocity, attitude, angular = self.base_state()
         angles, rates = self.joint_state()
         return RobotState(
             time=self.time,
@@ -285,7 +288,7 @@ class World:
         the body frame.
         """
         return self._robot.spec(
-            self.assembly_mass(), self.collector_mass(), self.cargo_protrusion()
+            self.assembly_mass(), self.base_mass(), self.cargo_protrusion()
         )
 
     def carried_ids(self) -> list[int]:
@@ -302,7 +305,7 @@ class World:
         return positions, velocities
 
     def nearest_obstacle_distance(self) -> float:
-        """Smallest surface gap between the collector (and cargo) and a free obstacle, m.
+        """Smallest surface gap between the robot (and cargo) and a free obstacle, m.
 
         Pairs of spheres are measured from their centres and radii, all at once. A pair
         with a box or a cylinder is measured by PyBullet's closest points, only if its
@@ -342,7 +345,7 @@ class World:
         """
         parts, columns = np.nonzero(pending)
         order = np.argsort(bounds[parts, columns], kind="stable")
-        carriers = [self.collector, *(body for body, _ in self._payload.held.values())]
+        carriers = [self.robot_id, *(body for body, _ in self._payload.held.values())]
         for part, column in zip(parts[order], columns[order], strict=True):
             if bounds[part, column] >= nearest:
                 break
@@ -352,18 +355,19 @@ class World:
         return nearest
 
     def cargo_protrusion(self) -> float:
-        """How far carried targets reach beyond the collector's surface, m (0 if none).
+        """How far carried objects reach beyond the robot's bounding sphere, m (0 if none).
 
         Cargo is held rigidly, so this changes only when an object is attached or removed.
         """
         return self._payload.protrusion
 
     def _assembly_spheres(self) -> list[tuple[np.ndarray, float]]:
-        """Centre and bounding radius of the collector, then of each target it carries."""
-        return [(self.collector_state()[0], self.robot.radius), *self._payload.spheres()]
+        """Centre and bounding radius of the robot, then of each object it carries."""
+        return [(self.base_state()[0], self.robot.radius), *self._payload.spheres()]
 
     def _assembly_is_sphere(self) -> np.ndarray:
-        """Whether each part of :meth:`_assembly_spheres` is a sphere (the collector is)."""
+        """Whether each part of :meth:`_assembly_spheres` is a sphere (the robot's part is
+        its bounding sphere)."""
         return np.array([True, *self.field.is_sphere[list(self._payload.held)]])
 
     def parameters(self) -> dict[str, float]:
@@ -386,7 +390,7 @@ class World:
 
     def outputs(self) -> dict[str, object]:
         """Named outputs of the world as a system (true state and bookkeeping)."""
-        position, velocity, attitude, angular = self.collector_state()
+        position, velocity, attitude, angular = self.base_state()
         return {
             "time": self.time,
             "position": position,
@@ -427,7 +431,7 @@ class World:
         )
         thrusts = self._propellant.burn(force, self._period_mass)
         started = self._fly_period(thrusts, disturbance, total_torque)
-        self._set_body_mass(self.collector_mass())
+        self._set_body_mass(self.base_mass())
         self.collisions += started
         return started
 
@@ -445,7 +449,7 @@ class World:
         """The control period's physics steps: thrust, disturbance and orbital forces on
         the assembly (and the arm's joint torques), the broad phase's candidates checked
         for contact after each step. What cannot change within the period is read once."""
-        client, body, mass, n = self._client, self.collector, self._body_mass, self._mean_motion
+        client, body, mass, n = self._client, self.robot_id, self._body_mass, self._mean_motion
         get_pose, get_velocity = pb.getBasePositionAndOrientation, pb.getBaseVelocity
         apply_force, step = pb.applyExternalForce, pb.stepSimulation
         cargo = [(c, self.field.objects[i].mass) for i, (c, _) in self._payload.held.items()]
@@ -481,7 +485,7 @@ class World:
             self._candidates = free
             return
         period = self.control_period
-        position, velocity, _, _ = self.collector_state()
+        position, velocity, _, _ = self.base_state()
         spheres = self._assembly_spheres()
         reach = max(length(c - position) + r for c, r in spheres)
         push = length(force) + length(self.inputs.disturbance_force)
@@ -499,7 +503,7 @@ class World:
 
     def _detect_collisions(self) -> list[CollisionEvent]:
         started = []
-        carriers = [(self.collector, "collector", -1)] + [
+        carriers = [(self.robot_id, "collector", -1)] + [
             (body, f"target {self.field.objects[i].id}", i)
             for i, (body, _) in self._payload.held.items()
         ]
@@ -522,18 +526,18 @@ class World:
     # ------------------------------------------------------------------ sensors
     def beacon_ranges(self) -> list[BeaconRange]:
         """Noisy ranges to the nearest beacons within range (the thesis's Beacon topic)."""
-        return self._sensors.beacon_ranges(self.collector_state()[0])
+        return self._sensors.beacon_ranges(self.base_state()[0])
 
     def object_tracks(self) -> list[ObjectTrack]:
         """Tracks of the free objects within sensor range (the thesis's Objects topic)."""
-        return self._sensors.object_tracks(self.time, self.collector_state()[0])
+        return self._sensors.object_tracks(self.time, self.base_state()[0])
 
     def observations(self) -> Observations:
         """Every sensor's reading now: beacon ranges, object tracks, attitude and rate.
 
         The star tracker and the gyros are noise-free.
         """
-        position, _, attitude, angular_velocity = self.collector_state()
+        position, _, attitude, angular_velocity = self.base_state()
         observed = self._sensors.observations(self.time, position, attitude, angular_velocity)
         if not self._robot.n_joints:
             return observed
@@ -561,14 +565,14 @@ class World:
             The gap (negative when they overlap), or ``inf`` beyond ``within``.
         """
         body = self._bodies.place(self.field.index[object_id], self.time)
-        return surface_gap(self._client, self.collector, body, within)
+        return surface_gap(self._client, self.robot_id, body, within)
 
     def attach(self, object_id: int) -> None:
         """Hold free object ``object_id`` rigidly where it is now, fixed to the robot's base.
 
         It joins the robot's assembly: its mass, its orbital force and its collisions.
         """
-        position, _, attitude, _ = self.collector_state()
+        position, _, attitude, _ = self.base_state()
         index = self.field.index[object_id]
         self._payload.attach(index, self.time, position, attitude)
         self._contacts = {pair for pair in self._contacts if pair[0] != index}
@@ -582,7 +586,7 @@ class World:
             Ids of the objects removed.
         """
         removed = self._payload.remove_all()
-        self._robot.set_base_mass(self.collector_mass())
+        self._robot.set_base_mass(self.base_mass())
         return removed
 
     # ------------------------------------------------------------------ lifetime

@@ -15,12 +15,12 @@ from dcsim.bench.controllers import (
 )
 from dcsim.campaign import ClusterOptions
 from dcsim.errors import DcsimError
-from dcsim.scenario import load_scenario, packaged_scenario_path
+from dcsim.scenario import packaged_scenario_path, read_scenario
 from tests.conftest import REPO
 
 
 def test_the_scenario_file_holds_the_seed_0_field():
-    scenario = load_scenario(REPO / "scenarios" / "crowded_field.yaml")
+    scenario = read_scenario(REPO / "scenarios" / "crowded_field.yaml")
     assert len(scenario.obstacles) >= 50
     written = [o.model_dump(exclude_none=True) for o in scenario.obstacles]
     for entry, generated in zip(written, crowded_obstacles(0), strict=True):
@@ -36,7 +36,7 @@ def test_every_seed_draws_another_field_inside_the_slab():
     positions = np.array([o["motion"]["position"] for o in first])
     assert np.all(positions >= low) and np.all(positions <= high)
     # The field travels as a scenario override that validates.
-    scenario = load_scenario(packaged_scenario_path("crowded_field.yaml"), [field_override(3)])
+    scenario = read_scenario(packaged_scenario_path("crowded_field.yaml"), [field_override(3)])
     assert [o.id for o in scenario.obstacles] == [o["id"] for o in crowded_obstacles(3)]
 
 

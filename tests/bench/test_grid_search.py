@@ -18,7 +18,7 @@ from dcsim.bench.grid_search import (
     tables,
 )
 from dcsim.bench.path_problems import load_problem
-from dcsim.registry import PluginRegistry
+from dcsim.registry.discovery import PluginRegistry
 from tests.conftest import REPO
 
 STATION = REPO / "scenarios" / "station_inspection.yaml"

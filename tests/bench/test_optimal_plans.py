@@ -123,7 +123,7 @@ def test_grid_optimum_equals_exhaustive_search_over_the_grid():
 
 
 def _feasible(request, plan):
-    from dcsim.plancost import plan_nodes
+    from dcsim.yardsticks.plan_cost import plan_nodes
 
     times, positions, _ = plan_nodes(request, plan)
     distance = np.linalg.norm(np.diff(positions, axis=0), axis=1)

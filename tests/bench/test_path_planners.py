@@ -28,10 +28,10 @@ from dcsim.bench.path_planners import (
     select_planners,
 )
 from dcsim.bench.path_problems import expand_specs, load_problem
-from dcsim.cli import cli
+from dcsim.cli.main import cli
 from dcsim.errors import DcsimError
 from dcsim.messages import NoPath, Trajectory
-from dcsim.registry import PluginOrigin, PluginRegistry, RegisteredPlugin
+from dcsim.registry.discovery import PluginOrigin, PluginRegistry, RegisteredPlugin
 from tests.conftest import REPO
 
 

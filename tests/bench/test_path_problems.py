@@ -9,10 +9,10 @@ from dcsim_plugins.path_planners.straight_line import StraightLinePlanner
 from dcsim.bench.path_problems import FAMILIES, KEEP_OUT, load_problem
 from dcsim.errors import DcsimError
 from dcsim.messages import ShapeKind
-from dcsim.registry import PluginOrigin, PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import build_run
-from dcsim.scenario import load_scenario
+from dcsim.registry.discovery import PluginOrigin, PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.setup import RunSetup
+from dcsim.scenario import read_scenario
 
 
 @pytest.mark.parametrize("family", list(FAMILIES))
@@ -53,11 +53,11 @@ def test_a_transfer_scenario_gives_the_problem_the_mission_poses(transfer_file):
     bench = load_problem(str(transfer_file))
     registry = PluginRegistry.discover()
     registry.register_class(SpyPlanner, PluginOrigin("tests", "0", "spy"))
-    scenario = load_scenario(
+    scenario = read_scenario(
         transfer_file, ["path_planner.plugin=spy", "world.duration=0.2"], registry
     )
     SpyPlanner.seen.clear()
-    Runner(build_run(scenario, registry)).run()
+    Runner(RunSetup.from_scenario(scenario, registry)).run()
     assert bench.name == "two_obstacles"
     assert SpyPlanner.seen[0] == bench.problem
     assert [o.id for o in bench.problem.obstacles] == [1, 2]  # 3 is beyond sensor range

@@ -10,7 +10,7 @@ from dcsim_plugins.controllers.pd import design_gains
 
 from dcsim.bench import peers
 from dcsim.bench.basilisk_loop import basilisk_missing, mrp_from_quaternion, quaternion_from_mrp
-from dcsim.registry import PluginRegistry
+from dcsim.registry.discovery import PluginRegistry
 
 BASILISK = basilisk_missing()
 needs_basilisk = pytest.mark.skipif(BASILISK is not None, reason=str(BASILISK))

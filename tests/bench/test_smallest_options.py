@@ -23,7 +23,7 @@ from dcsim.bench.task_planners import (
     plot_strategies,
     strategy_table,
 )
-from dcsim.cli import cli
+from dcsim.cli.main import cli
 from tests.conftest import REPO
 
 SCENARIOS = REPO / "scenarios"

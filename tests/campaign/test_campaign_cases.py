@@ -14,7 +14,7 @@ from dcsim.campaign import campaign_cases, load_campaign
 from dcsim.campaign.cases import case_document, draw_seed, override_text
 from dcsim.campaign.results import axis_label, metric_names
 from dcsim.errors import CampaignError
-from dcsim.registry import PluginRegistry
+from dcsim.registry.discovery import PluginRegistry
 from dcsim.scenario import validate
 from dcsim.scenario.yamltext import compose
 

@@ -21,9 +21,9 @@ from dcsim.campaign import ClusterOptions, load_campaign, replay_case, run_campa
 from dcsim.campaign.cases import campaign_cases
 from dcsim.campaign.engine import ClusterError, dask_client
 from dcsim.campaign.run import read_journal
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 from tests.conftest import make_distribution
 
 REPO = Path(__file__).resolve().parents[2]
@@ -100,7 +100,7 @@ def test_campaign_results_equal_direct_runs(twelve, tmp_path):
     assert list(table["status"]) == ["completed"] * 12
     for case in cases:
         direct = tmp_path / case.name
-        summary = Runner(prepare_run(DEFAULT, case.overrides), direct, plots=False).run()
+        summary = Runner(setup_run(DEFAULT, case.overrides), direct, plots=False).run()
         recorded = out / "cases" / case.name
         for name in ("telemetry.csv", "events.jsonl", "scenario.yaml"):
             assert filecmp.cmp(recorded / name, direct / name, shallow=False), (case.index, name)
@@ -346,7 +346,7 @@ def test_the_python_api_passes_the_connect_timeout_on(tmp_path):
 
 
 def test_the_command_line_s_connect_timeout_reaches_the_cluster_options():
-    from dcsim.cli_campaign import cluster_choice
+    from dcsim.cli.campaign import cluster_choice
 
     chosen = cluster_choice("tcp://127.0.0.1:8786", None, 3, 2.5)
     assert chosen.scheduler_wait == 2.5

@@ -15,11 +15,11 @@ from dcsim.fmu.export import export_fmu
 from dcsim.fmu.instance import FmuCallError, FmuError, FmuInstance
 from dcsim.fmu.variables import closed_loop_variables, plant_variables
 from dcsim.missions.debris import DebrisMission
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
-from dcsim.scenario import load_scenario
+from dcsim.run.loop import Runner
+from dcsim.run.seeding import component_rng
+from dcsim.run.setup import setup_run
+from dcsim.scenario import read_scenario
 from dcsim.scenario.model import point_to_cartesian
-from dcsim.seeding import component_rng
 from dcsim.world import World, WorldInputs
 from tests.conftest import SHARES_DEFAULT_RUN
 
@@ -29,7 +29,7 @@ VECTORS = {"position": "x y z", "velocity": "vx vy vz", "attitude": "qx qy qz qw
 
 def native(seed: int, duration: float) -> dict[str, np.ndarray]:
     """Telemetry of `dcsim run` on the default scenario, cut to ``duration`` seconds."""
-    runner = Runner(prepare_run(None, [f"world.duration={duration}"], seed))
+    runner = Runner(setup_run(None, [f"world.duration={duration}"], seed))
     runner.run()
     return runner.recorder.telemetry()
 
@@ -111,7 +111,7 @@ def test_fmpy_validation_finds_no_problems(variant, request):
 
 
 def test_variables_are_those_documented(closed_loop_fmu, plant_fmu):
-    scenario = load_scenario()
+    scenario = read_scenario()
     variants = (
         (closed_loop_fmu, closed_loop_variables(scenario)),
         (plant_fmu, plant_variables(scenario, 4)),
@@ -124,8 +124,8 @@ def test_variables_are_those_documented(closed_loop_fmu, plant_fmu):
 
 
 def test_docs_list_the_variables():
-    from dcsim.docgen import block
     from dcsim.fmu import reference as r
+    from dcsim.report.docgen import block
 
     text = (Path(__file__).resolve().parents[2] / "docs" / "fmu.md").read_text()
     for begin, end, table in r.generated_blocks():
@@ -136,10 +136,10 @@ def test_every_free_flyer_scenario_has_the_default_scenarios_variables():
     def signature(variables):
         return [(v.name, v.causality, v.type) for v in variables]
 
-    default = load_scenario()
+    default = read_scenario()
     expected = signature(closed_loop_variables(default)), signature(plant_variables(default, 4))
     scenarios = sorted((Path(__file__).resolve().parents[2] / "scenarios").glob("*.yaml"))
-    free_flyers = [s for s in map(load_scenario, scenarios) if s.robot.type == "free-flyer"]
+    free_flyers = [s for s in map(read_scenario, scenarios) if s.robot.type == "free-flyer"]
     assert {s.mission.type for s in free_flyers} == {"debris", "transfer"}
     for scenario in free_flyers:
         got = signature(closed_loop_variables(scenario)), signature(plant_variables(scenario, 4))
@@ -266,7 +266,7 @@ def test_plant_parameters_reach_the_world(plant_fmu):
 
 
 def test_plant_state_is_the_worlds_and_beacons_are_nearest_first(plant_fmu):
-    scenario = load_scenario()
+    scenario = read_scenario()
     world = World(scenario, component_rng(scenario.world.seed, "world"))
     force = np.array([0.5, -1.0, 0.3])
     with FmuInstance(plant_fmu) as fmu:
@@ -289,7 +289,7 @@ def test_plant_state_is_the_worlds_and_beacons_are_nearest_first(plant_fmu):
 
 
 def test_plant_collision_flag_marks_the_step_a_contact_starts(plant_fmu):
-    scenario = load_scenario()
+    scenario = read_scenario()
     obstacle = point_to_cartesian(scenario.obstacles[0].motion.position)  # id 10, at rest
     push = 5.0 * obstacle / np.linalg.norm(obstacle)
     flags, counts = [], []
@@ -333,10 +333,10 @@ def test_an_fmu_that_cannot_start_is_reported_with_its_reason(closed_loop_fmu, t
 def _slave_of_default_scenario(tmp_path):
     """The closed-loop slave itself, in this process, on the default scenario."""
     from dcsim.fmu.slaves import SCENARIO_RESOURCE, ClosedLoopSlave
-    from dcsim.registry import PluginRegistry
+    from dcsim.registry.discovery import PluginRegistry
     from dcsim.scenario import dump_scenario
 
-    resolved = load_scenario(None, registry=PluginRegistry.discover())
+    resolved = read_scenario(None, registry=PluginRegistry.discover())
     (tmp_path / SCENARIO_RESOURCE).write_text(dump_scenario(resolved))
     return ClosedLoopSlave(instance_name="test", resources=str(tmp_path))
 

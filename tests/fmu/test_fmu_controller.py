@@ -8,9 +8,9 @@ from dcsim_plugins.controllers.fmu_controller import SIGNALS, FmuController, Fmu
 
 from dcsim.api import Reference, RobotSpec, StateEstimate, Surroundings
 from dcsim.errors import PluginParameterError
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 from dcsim.testing import checks_for
 from tests.conftest import SHARES_DEFAULT_RUN
 
@@ -18,7 +18,7 @@ TOLERANCE = 1e-9  # m, m/s: the FMU computes pd's gains in closed form, pd with 
 
 
 def fly(overrides):
-    runner = Runner(prepare_run(None, overrides, registry=PluginRegistry.discover()))
+    runner = Runner(setup_run(None, overrides, registry=PluginRegistry.discover()))
     return runner.run(), runner.recorder.telemetry()
 
 

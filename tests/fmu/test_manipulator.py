@@ -18,10 +18,10 @@ from dcsim.fmu.variables import (
     plant_variables,
 )
 from dcsim.missions.reach import ReachMission
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
-from dcsim.scenario import load_scenario
-from dcsim.seeding import component_rng
+from dcsim.run.loop import Runner
+from dcsim.run.seeding import component_rng
+from dcsim.run.setup import setup_run
+from dcsim.scenario import read_scenario
 from dcsim.world import World, WorldInputs
 
 REACH = Path(__file__).resolve().parents[2] / "scenarios" / "space_manipulator_reach.yaml"
@@ -46,7 +46,7 @@ def reach_plant_fmu(tmp_path_factory) -> Path:
 def test_both_variants_are_valid_and_declare_the_scenarios_arm(
     reach_closed_loop_fmu, reach_plant_fmu
 ):
-    scenario = load_scenario(REACH, SHORT)
+    scenario = read_scenario(REACH, SHORT)
     variants = (
         (reach_closed_loop_fmu, closed_loop_variables(scenario)),
         (reach_plant_fmu, plant_variables(scenario, 4)),
@@ -65,7 +65,7 @@ def test_both_variants_are_valid_and_declare_the_scenarios_arm(
 
 
 def test_closed_loop_reproduces_dcsim_run_tick_by_tick(reach_closed_loop_fmu):
-    runner = Runner(prepare_run(REACH, SHORT))
+    runner = Runner(setup_run(REACH, SHORT))
     runner.run()
     telemetry = runner.recorder.telemetry()
     columns = {
@@ -93,7 +93,7 @@ def test_closed_loop_reproduces_dcsim_run_tick_by_tick(reach_closed_loop_fmu):
 
 def _world_joints(torques: np.ndarray, periods: int) -> World:
     """The reach scenario's world driven directly by joint torques over ``periods``."""
-    scenario = load_scenario(REACH)
+    scenario = read_scenario(REACH)
     world = World(scenario, component_rng(scenario.world.seed, "world"))
     for _ in range(periods):
         world.step(WorldInputs(joint_torques=torques))

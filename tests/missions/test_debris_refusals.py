@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 
 REFUSAL = "no path: moving obstacles need ompl-control or a time-aware planner"
 """ompl-geometric's answer among the default scenario's drifting obstacles."""
@@ -20,7 +20,7 @@ def registry():
 @pytest.mark.parametrize("attempts", [1, 3])
 def test_the_run_stops_with_the_planners_reason(registry, attempts):
     overrides = ["path_planner={plugin: ompl-geometric}", f"mission.max_plan_attempts={attempts}"]
-    runner = Runner(prepare_run(None, overrides, registry=registry))
+    runner = Runner(setup_run(None, overrides, registry=registry))
     summary = runner.run()
     refusals = [e for e in runner.recorder.events if e["event"] == "no_path"]
     assert [e["reason"] for e in refusals] == [REFUSAL] * attempts

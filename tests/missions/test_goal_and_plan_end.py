@@ -13,9 +13,9 @@ import textwrap
 import pytest
 
 from dcsim.errors import PlanOutlastsRunWarning
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 from tests.conftest import REPO
 
 FFSR = REPO / "scenarios" / "ffsr_obstacles.yaml"
@@ -31,7 +31,7 @@ def registry():
 
 def fly(registry, path, *overrides: str) -> tuple[dict, list[dict]]:
     """The summary and the events of a run of ``path`` with ``overrides``."""
-    runner = Runner(prepare_run(path, overrides, registry=registry))
+    runner = Runner(setup_run(path, overrides, registry=registry))
     summary = runner.run()
     return summary, runner.recorder.events
 

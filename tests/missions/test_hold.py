@@ -16,9 +16,9 @@ from dcsim.geometry import (
 )
 from dcsim.missions.hold import HoldMission
 from dcsim.missions.hold.mission import attitude_error
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 
 GOAL = [0.0, 0.0, 0.38268343236508984, 0.9238795325112867]  # 45° about +z
 
@@ -45,7 +45,7 @@ def fly(tmp_path, registry, hold: bool, duration: float = 40.0, extra: str = "")
     path = tmp_path / "slew.yaml"
     text = SLEW.format(duration=duration, goal=GOAL, hold=str(hold).lower())
     path.write_text(textwrap.dedent(text) + extra)
-    runner = Runner(prepare_run(path, registry=registry))
+    runner = Runner(setup_run(path, registry=registry))
     return runner, runner.run()
 
 
@@ -84,7 +84,7 @@ def test_a_given_position_is_held_and_the_initial_attitude_by_default(tmp_path, 
         "robot: {initial: {position: [0, 0, 0], attitude: [0, 0, 1, 0]}}\n"
         "mission: {type: hold, position: [2, 0, 0]}\n"
     )
-    runner = Runner(prepare_run(path, registry=registry))
+    runner = Runner(setup_run(path, registry=registry))
     summary = runner.run()
     assert runner.recorder.rows[0]["position_error"] == pytest.approx(2.0)
     assert summary["final_position_error_m"] < 0.05
@@ -96,7 +96,7 @@ def test_a_zero_attitude_is_refused_with_its_key(tmp_path, registry):
     path = tmp_path / "hold.yaml"
     path.write_text("mission: {type: hold, attitude: [0, 0, 0, 0], speed: 1}\n")
     with pytest.raises(ScenarioError) as error:
-        prepare_run(path, registry=registry)
+        setup_run(path, registry=registry)
     text = str(error.value)
     assert "mission.attitude" in text and "the quaternion must not be zero" in text
     assert "mission.speed: unknown key" in text
@@ -117,5 +117,5 @@ def test_a_hold_run_draws_the_pictures_every_run_has_and_no_debris_ones(tmp_path
     path = tmp_path / "slew.yaml"
     path.write_text(textwrap.dedent(SLEW.format(duration=2.0, goal=GOAL, hold="true")))
     out = tmp_path / "run"
-    Runner(prepare_run(path, registry=registry), out).run()
+    Runner(setup_run(path, registry=registry), out).run()
     assert sorted(p.name for p in (out / "plots").iterdir()) == ["estimation.png", "motion.png"]

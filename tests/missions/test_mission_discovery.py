@@ -11,9 +11,9 @@ import pytest
 from dcsim.errors import PluginLoadWarning
 from dcsim.missions import MISSION_GROUP, mission_class, mission_types
 from dcsim.missions import _installed as installed_missions
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 
 MODULE = '''
 from typing import Literal
@@ -90,7 +90,7 @@ def test_an_installed_distribution_s_mission_is_a_mission_type(site, tmp_path):
             """
         )
     )
-    summary = Runner(prepare_run(scenario, registry=PluginRegistry.discover())).run()
+    summary = Runner(setup_run(scenario, registry=PluginRegistry.discover())).run()
     assert (summary["mission"], summary["status"], summary["reason"]) == (
         "patrol",
         "completed",

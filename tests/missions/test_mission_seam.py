@@ -12,9 +12,9 @@ from pydantic import Field
 
 from dcsim.api import Controller, Reference, ScenarioError
 from dcsim.missions import Mission, mission_class, register_mission
-from dcsim.registry import PluginOrigin, PluginRegistry
-from dcsim.runner import SUMMARY_FIGURES, Runner
-from dcsim.runsetup import prepare_run
+from dcsim.registry.discovery import PluginOrigin, PluginRegistry
+from dcsim.run.loop import SUMMARY_FIGURES, Runner
+from dcsim.run.setup import setup_run
 from dcsim.scenario.model import MissionSettings
 from tests.conftest import REPO
 
@@ -91,7 +91,7 @@ HOLD_SCENARIO = """\
 
 
 def test_a_registered_mission_flies_through_the_runner(tmp_path):
-    setup = prepare_run(scenario_file(tmp_path, HOLD_SCENARIO), registry=PluginRegistry.discover())
+    setup = setup_run(scenario_file(tmp_path, HOLD_SCENARIO), registry=PluginRegistry.discover())
     assert set(setup.plugins) == {"localiser", "controller"}
     out = tmp_path / "run"
     summary = Runner(setup, out).run()
@@ -108,7 +108,7 @@ def test_a_registered_mission_flies_through_the_runner(tmp_path):
 def test_a_mission_section_is_validated_by_its_own_settings(tmp_path):
     path = scenario_file(tmp_path, HOLD_SCENARIO.replace("hold_for: 4", "hold_for: -1, reach: 2"))
     with pytest.raises(ScenarioError) as error:
-        prepare_run(path, registry=PluginRegistry.discover())
+        setup_run(path, registry=PluginRegistry.discover())
     text = str(error.value)
     assert "mission.hold_for: -1 is not allowed" in text
     assert "mission.reach: unknown key" in text
@@ -119,7 +119,7 @@ def test_an_unknown_mission_type_names_the_known_ones(tmp_path):
     with pytest.raises(
         ScenarioError, match=r"mission.type: unknown mission type 'rescue'; known: debris"
     ):
-        prepare_run(path, registry=PluginRegistry.discover())
+        setup_run(path, registry=PluginRegistry.discover())
 
 
 def test_a_mission_type_cannot_be_taken_twice():
@@ -148,7 +148,7 @@ def test_a_plugin_that_does_not_support_the_robot_is_refused(tmp_path):
     registry.register_class(ArmOnlyController, TEST_ORIGIN)
     path = scenario_file(tmp_path, "controller: {plugin: arm-only}\n")
     with pytest.raises(ScenarioError) as error:
-        prepare_run(path, registry=registry)
+        setup_run(path, registry=registry)
     assert (
         "controller.plugin: controller plugin 'arm-only' does not support robot type "
         "'free-flyer' (it supports: manipulator)"
@@ -160,7 +160,7 @@ def test_a_plugin_that_does_not_support_the_robot_is_refused(tmp_path):
     ["default.yaml", "station_inspection.yaml", "space_manipulator_reach.yaml"],
 )
 def test_a_mission_declares_the_fields_of_its_summary(scenario):
-    runner = Runner(prepare_run(REPO / "scenarios" / scenario, ["world.duration=1"]))
+    runner = Runner(setup_run(REPO / "scenarios" / scenario, ["world.duration=1"]))
     runner.open()
     mission = runner.mission
     assert tuple(mission.summary_fields()) == type(mission).summary_names

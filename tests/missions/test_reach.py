@@ -11,10 +11,10 @@ import pytest
 from dcsim_plugins.path_planners.end_effector_line import EndEffectorLinePlanner
 
 from dcsim.api import Trajectory, manipulator_model, thesis_manipulator
-from dcsim.recording import read_telemetry
 from dcsim.robots.joint_path import JointPath, SingularPath
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.run.loop import Runner
+from dcsim.run.recording import read_telemetry
+from dcsim.run.setup import setup_run
 from dcsim.testing.problems import reach_problem
 
 SCENARIO = Path(__file__).parents[2] / "scenarios" / "space_manipulator_reach.yaml"
@@ -30,7 +30,7 @@ def read_run(out: Path) -> tuple[dict, dict[str, np.ndarray]]:
 
 def fly(out: Path, *overrides: str) -> tuple[dict, dict[str, np.ndarray]]:
     """Run the shipped reach scenario; return its summary and telemetry columns."""
-    Runner(prepare_run(SCENARIO, list(overrides)), out).run()
+    Runner(setup_run(SCENARIO, list(overrides)), out).run()
     return read_run(out)
 
 
@@ -204,7 +204,7 @@ mission: {type: reach, target: [1.2, 0.3, 0.2]}
 def test_an_arm_of_two_joints_is_refused_with_a_reason(tmp_path):
     scenario = tmp_path / "two_links.yaml"
     scenario.write_text(TWO_LINKS)
-    summary = Runner(prepare_run(scenario), None).run()
+    summary = Runner(setup_run(scenario), None).run()
     assert summary["status"] == "stopped"
     assert "at least three links" in summary["reason"]
 

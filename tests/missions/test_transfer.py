@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from dcsim.api import NoPath, PathPlanner, Trajectory
-from dcsim.recording import SIGMA_COLUMNS, read_telemetry
-from dcsim.registry import PluginOrigin, PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.registry.discovery import PluginOrigin, PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.recording import SIGMA_COLUMNS, read_telemetry
+from dcsim.run.setup import setup_run
 
 TEST_ORIGIN = PluginOrigin("tests", "0", "test module")
 
@@ -95,7 +95,7 @@ def run_transfer(tmp_path, planner: type, overrides=()):
     path = tmp_path / "scenario.yaml"
     path.write_text(textwrap.dedent(BASE % planner.name))
     out = tmp_path / "run"
-    summary = Runner(prepare_run(path, overrides, registry=registry), out).run()
+    summary = Runner(setup_run(path, overrides, registry=registry), out).run()
     events = [json.loads(text) for text in (out / "events.jsonl").read_text().splitlines()]
     return summary, events, out
 

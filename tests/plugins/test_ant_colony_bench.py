@@ -9,7 +9,7 @@ from dcsim_plugins.path_planners import ant_colony_bench as bench
 from dcsim_plugins.path_planners.ant_colony import AntColonyPlanner
 
 from dcsim.api import layered_optimum, load_bench_problem
-from dcsim.cli import cli
+from dcsim.cli.main import cli
 from tests.conftest import REPO
 
 PNG = b"\x89PNG\r\n\x1a\n"

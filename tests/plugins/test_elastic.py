@@ -27,8 +27,8 @@ from dcsim.api import (
     rotate,
     unit,
 )
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 
 ROBOT = RobotSpec(
     mass=100.0, inertia=10.0 * np.eye(3), radius=0.5, max_force=5.0, max_torque=0.5, max_speed=0.5
@@ -255,7 +255,7 @@ def fly(tmp_path, controller_name, obstacle_at, obstacle_v):
             controller=controller_name, obstacle_at=obstacle_at, obstacle_v=obstacle_v
         )
     )
-    return Runner(prepare_run(path), None).run()
+    return Runner(setup_run(path), None).run()
 
 
 @pytest.mark.parametrize(

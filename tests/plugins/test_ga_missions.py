@@ -8,15 +8,15 @@ from __future__ import annotations
 
 import pytest
 
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 
 SEEDS = range(20)
 
 
 def fly(planner: str, seed: int) -> dict:
     """Summary of the default scenario with ``planner`` and ``seed`` (nothing written)."""
-    setup = prepare_run(None, [f"task_planner.plugin={planner}"], seed)
+    setup = setup_run(None, [f"task_planner.plugin={planner}"], seed)
     return Runner(setup, None).run()
 
 

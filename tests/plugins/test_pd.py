@@ -8,7 +8,7 @@ from dcsim_plugins.controllers.pd import PDController, design_gains
 from scipy.spatial.transform import Rotation
 
 from dcsim.api import Reference, RobotSpec, StateEstimate, Surroundings
-from dcsim.scenario import load_scenario
+from dcsim.scenario import read_scenario
 from dcsim.world import World, WorldInputs
 
 ROBOT = RobotSpec(
@@ -84,7 +84,7 @@ def test_slews_a_free_flyer_in_pybullet_to_a_held_attitude_within_its_torque_lim
     start = Rotation.from_euler("xyz", [60, -30, 100], degrees=True)
     target = Rotation.from_euler("xyz", [-20, 10, 0], degrees=True)
     quaternion = ",".join(f"{q:.17g}" for q in start.as_quat())
-    scenario = load_scenario(
+    scenario = read_scenario(
         None,
         [
             f"robot.initial.attitude=[{quaternion}]",
@@ -98,16 +98,16 @@ def test_slews_a_free_flyer_in_pybullet_to_a_held_attitude_within_its_torque_lim
     world = World(scenario, np.random.default_rng(0))
     try:
         pd.reset(world.robot_spec())
-        home = world.collector_state()[0].copy()
+        home = world.base_state()[0].copy()
         reference = Reference(time=0.0, position=home, attitude=target.as_quat())
         peak_torque = 0.0
         for _ in range(1500):
-            position, velocity, attitude, angular = world.collector_state()
+            position, velocity, attitude, angular = world.base_state()
             estimate = StateEstimate(world.time, position, attitude, velocity, angular)
             command = pd.command(world.time, estimate, reference, Surroundings())
             peak_torque = max(peak_torque, float(np.linalg.norm(command.torque)))
             world.step(WorldInputs(force=command.force, torque=command.torque))
-        _, _, attitude, angular = world.collector_state()
+        _, _, attitude, angular = world.base_state()
     finally:
         world.close()
     assert (Rotation.from_quat(attitude) * target.inv()).magnitude() < 1e-3

@@ -10,7 +10,7 @@ from dcsim_plugins.path_planners import q_learning_bench as bench
 from dcsim_plugins.path_planners.q_learning import QLearningPlanner
 
 from dcsim.api import load_reach_problem, optimal_values, packaged_scenario_path
-from dcsim.cli import cli
+from dcsim.cli.main import cli
 
 PNG = b"\x89PNG\r\n\x1a\n"
 SCENARIO = packaged_scenario_path("space_manipulator_reach.yaml")

@@ -118,7 +118,7 @@ def test_single_burn_arc_is_the_world_free_drift():
     for _ in range(round(duration / 0.1)):
         world.step()
     assert world.time == pytest.approx(duration)
-    position, velocity, _, _ = world.collector_state()
+    position, velocity, _, _ = world.base_state()
     expected, expected_velocity = motion.propagate(START, departure, duration)
     np.testing.assert_allclose(expected, END, atol=1e-9)
     np.testing.assert_allclose(expected_velocity, arrival, atol=1e-12)

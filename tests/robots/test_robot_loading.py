@@ -8,9 +8,9 @@ import pytest
 from click.testing import CliRunner
 
 from dcsim.api import RobotTypeError, load_robot_model, thesis_manipulator
-from dcsim.cli import cli
+from dcsim.cli.main import cli
 from dcsim.errors import ScenarioError
-from dcsim.runsetup import prepare_run
+from dcsim.run.setup import setup_run
 from dcsim.world.pybullet_client import connect_direct, pb
 from tests.conftest import REPO
 
@@ -59,7 +59,7 @@ def test_robot_urdf_command_refuses_a_free_flyer(tmp_path):
 
 def test_a_mission_and_plugins_that_cannot_fly_a_manipulator_are_refused():
     with pytest.raises(ScenarioError) as info:
-        prepare_run(FIXTURE)
+        setup_run(FIXTURE)
     messages = [p.describe("s") for p in info.value.problems]
     assert any(
         "mission.type: mission type 'debris' does not support robot type 'manipulator'" in m

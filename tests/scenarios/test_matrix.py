@@ -18,10 +18,10 @@ import pytest
 
 from dcsim.errors import ScenarioError
 from dcsim.missions import scenario_roles
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
-from dcsim.scenario import load_scenario
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
+from dcsim.scenario import read_scenario
 from tests.conftest import REPO
 
 pytestmark = pytest.mark.slow
@@ -50,7 +50,7 @@ def cases() -> list:
     """One pytest parameter per case: the scenario file and its overrides."""
     params = []
     for path in sorted((REPO / "scenarios").glob("*.yaml")):
-        scenario = load_scenario(path)
+        scenario = read_scenario(path)
         roles = scenario_roles(scenario)
         params.append(pytest.param(path, None, None, id=f"{path.stem}:as-shipped"))
         for role in (r for r in VARIED if r in roles):
@@ -71,7 +71,7 @@ def refused_before_the_run(path, role: str, plugin: str) -> str:
     """The scenario error of a plugin that needs a setting, checked to name it."""
     expected = REFUSED_BEFORE_THE_RUN[(role, plugin)]
     with pytest.raises(ScenarioError) as error:
-        prepare_run(path, [f"{role}={{plugin: {plugin}}}"], registry=REGISTRY)
+        setup_run(path, [f"{role}={{plugin: {plugin}}}"], registry=REGISTRY)
     assert expected in str(error.value)
     return f"refused before the run: {expected}"
 
@@ -95,7 +95,7 @@ def test_each_case_meets_its_goal_or_refuses_with_a_reason(path, role, plugin, r
         record_property("outcome", refused_before_the_run(path, role, plugin))
         return
     overrides = [] if role is None else [f"{role}={{plugin: {plugin}}}"]
-    runner = Runner(prepare_run(path, overrides, registry=REGISTRY), None, keep_rows=False)
+    runner = Runner(setup_run(path, overrides, registry=REGISTRY), None, keep_rows=False)
     summary = runner.run()
     record_property("outcome", f"{summary['status']} ({summary['reason']}), {summary['outcome']}")
     record_property("sim_time_s", summary["sim_time_s"])

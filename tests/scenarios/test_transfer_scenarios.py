@@ -13,12 +13,12 @@ import yaml
 from click.testing import CliRunner
 
 from dcsim.api import Shape, ShapeKind
-from dcsim.cli import cli
+from dcsim.cli.main import cli
 from dcsim.geometry import quaternion_conjugate, rotate
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
-from dcsim.scenario import load_scenario
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
+from dcsim.scenario import read_scenario
 from dcsim.world.objects import build_objects
 from tests.conftest import REPO
 
@@ -81,7 +81,7 @@ def segment(start, end, count: int = 2001) -> np.ndarray:
 
 def static_objects(path, overrides=()):
     """The scenario and its objects with their positions at t = 0."""
-    scenario = load_scenario(path, overrides)
+    scenario = read_scenario(path, overrides)
     return scenario, [(o, o.motion.state_at(0.0)[0]) for o in build_objects(scenario)]
 
 
@@ -95,7 +95,7 @@ def test_every_transfer_scenario_validates():
     "path", TRANSFER_FILES, ids=["station", "asteroids", "ffsr", "ffsr-planar"]
 )
 def test_each_file_flies_its_sources_planner_to_the_goal(path, registry):
-    setup = prepare_run(path, registry=registry)
+    setup = setup_run(path, registry=registry)
     assert setup.scenario.path_planner.plugin == SOURCE_PLANNERS[path]
     assert setup.scenario.controller.plugin == "pd"
     runner = Runner(setup, None)
@@ -120,7 +120,7 @@ def test_the_asteroid_escape_repeats_exactly(registry):
     """ompl-control is seeded from the scenario and stops at its first solution."""
 
     def records():
-        runner = Runner(prepare_run(ASTEROIDS, registry=registry), None)
+        runner = Runner(setup_run(ASTEROIDS, registry=registry), None)
         runner.run()
         return runner.recorder.events, runner.recorder.rows
 
@@ -142,7 +142,7 @@ def test_the_asteroid_escape_repeats_exactly(registry):
     ids=["station-goal3", "station-goal1", "station-goal2", "asteroids", "ffsr", "ffsr-planar"],
 )
 def test_straight_line_ends_clearly(path, overrides, status, reason, registry):
-    setup = prepare_run(path, (STRAIGHT_LINE, *overrides), registry=registry)
+    setup = setup_run(path, (STRAIGHT_LINE, *overrides), registry=registry)
     assert setup.scenario.controller.plugin == "pd"
     summary = Runner(setup, None).run()
     assert (summary["status"], summary["reason"][: len(reason)]) == (status, reason)
@@ -155,7 +155,7 @@ def test_straight_line_ends_clearly(path, overrides, status, reason, registry):
 @pytest.mark.parametrize("goal", [1, 2], ids=["goal1", "goal2"])
 def test_the_papers_planners_reach_goals_1_and_2_within_the_run(planner, goal, registry):
     overrides = (f"path_planner.plugin={planner}", GOAL_OVERRIDES[goal])
-    summary = Runner(prepare_run(STATION, overrides, registry=registry), None).run()
+    summary = Runner(setup_run(STATION, overrides, registry=registry), None).run()
     assert (summary["reason"], summary["goal_met"], summary["collisions"]) == (
         "goal reached",
         True,
@@ -165,14 +165,14 @@ def test_the_papers_planners_reach_goals_1_and_2_within_the_run(planner, goal, r
 
 def test_station_goals_are_the_papers_in_metres():
     for number, override in GOAL_OVERRIDES.items():
-        goal = load_scenario(STATION, [override]).mission.goal.position
+        goal = read_scenario(STATION, [override]).mission.goal.position
         np.testing.assert_allclose(goal, np.array(PAPER_GOALS[number]) * GRID, atol=1e-3)
-    third = load_scenario(STATION).mission.goal.position
+    third = read_scenario(STATION).mission.goal.position
     np.testing.assert_allclose(third, np.array(PAPER_GOALS[3]) * GRID, atol=1e-3)
 
 
 def test_station_has_fourteen_fixed_components_and_one_moving_cylinder():
-    scenario = load_scenario(STATION)
+    scenario = read_scenario(STATION)
     fixed = [spec for spec in scenario.obstacles if spec.motion.type == "static"]
     moving = [spec for spec in scenario.obstacles if spec.motion.type != "static"]
     assert len(fixed) == 14
@@ -195,7 +195,7 @@ def test_station_goal_3_is_behind_the_logistics_module_and_goals_1_2_beside_the_
     third = segment(start, scenario.mission.goal.position)
     assert gap(LOGISTICS_ID, third).min() < 0.0  # the segment runs through the module
     for override in GOAL_OVERRIDES.values():
-        goal = np.array(load_scenario(STATION, [override]).mission.goal.position)
+        goal = np.array(read_scenario(STATION, [override]).mission.goal.position)
         assert 0.0 < gap(NODE_ID, goal[None])[0] < BESIDE
         direct = segment(start, goal)
         clearance = min(surface_distance(o.shape, c, direct).min() for o, c in objects)

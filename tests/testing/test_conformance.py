@@ -368,8 +368,8 @@ def test_pytest_option_runs_the_suite_against_an_installed_plugin(tmp_path):
 def test_docs_list_every_check_and_every_hook():
     import inspect
 
-    from dcsim import hookspecs
-    from dcsim.docgen import block
+    from dcsim.registry import hookspecs
+    from dcsim.report.docgen import block
     from dcsim.testing.reference import BEGIN, END, render_checks
     from tests.conftest import REPO
 

@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from dcsim.scaffold import ScaffoldError, new_plugin
+from dcsim.registry.scaffold import ScaffoldError, new_plugin
 from dcsim.testing import check_plugin
 from dcsim.testing.missions import check_mission
 

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from dcsim.viewer.page import PAGE_NAME
+from dcsim.report.viewer.page import PAGE_NAME
 
 CHROMIUM_ARGS = [
     "--headless",
@@ -264,7 +264,7 @@ def test_play_runs_the_frames_and_pause_stops_them(visit):
 
 
 def test_without_plotly_the_page_is_refused_saying_how_to_install_it(monkeypatch, run_dir):
-    from dcsim.viewer import ViewError, write_view
+    from dcsim.report.viewer import ViewError, write_view
 
     monkeypatch.setitem(sys.modules, "plotly.offline", None)  # import fails
     with pytest.raises(ViewError, match="needs the plotly package: pip install plotly"):

@@ -7,7 +7,7 @@ import shutil
 import numpy as np
 import pytest
 
-from dcsim.viewer.records import ViewError, plain_name, read_run, read_table
+from dcsim.report.viewer.records import ViewError, plain_name, read_run, read_table
 from tests.conftest import REPO
 
 PLAIN = "time,x,y,z,mode,fuel_used,nearest_obstacle\n0.0,1.5,2.0,3.0,LOCALIZE,0.0,inf\n0.1,1.6,2.1,3.2,GRAB,0.01,4.5\n"

@@ -9,13 +9,13 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from dcsim.api import Shape, ShapeKind
-from dcsim.registry import PluginRegistry
-from dcsim.runner import Runner
-from dcsim.runsetup import prepare_run
-from dcsim.viewer.meshes import shape_mesh
-from dcsim.viewer.page import scene_json
-from dcsim.viewer.records import read_run
-from dcsim.viewer.scene import build_scene, frame_rows
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.report.viewer.meshes import shape_mesh
+from dcsim.report.viewer.page import scene_json
+from dcsim.report.viewer.records import read_run
+from dcsim.report.viewer.scene import build_scene, frame_rows
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 from dcsim.world.objects import build_objects
 from tests.conftest import REPO, SHARES_DEFAULT_RUN
 
@@ -182,7 +182,7 @@ def test_the_scene_s_json_is_plain_rounded_and_safe_inside_a_script(default_scen
 
 
 def run_into(out, scenario, *overrides):
-    Runner(prepare_run(scenario, overrides, registry=PluginRegistry.discover()), out).run()
+    Runner(setup_run(scenario, overrides, registry=PluginRegistry.discover()), out).run()
     return read_run(out)
 
 

@@ -96,7 +96,7 @@ def test_beacons_report_the_nearest_within_range_with_noise():
         world.step()
         for r in world.beacon_ranges():
             errors.append(
-                r.range - np.linalg.norm(world.beacons[r.beacon_id] - world.collector_state()[0])
+                r.range - np.linalg.norm(world.beacons[r.beacon_id] - world.base_state()[0])
             )
     assert np.std(errors) == pytest.approx(0.1, rel=0.15)
     assert abs(np.mean(errors)) < 0.02
@@ -130,7 +130,7 @@ def test_grabbed_target_leaves_the_field_and_rides_with_the_collector():
     assert 2 not in [t.id for t in world.object_tracks()]
 
     def offset_in_collector_frame() -> np.ndarray:
-        position, _, attitude, _ = world.collector_state()
+        position, _, attitude, _ = world.base_state()
         rotation = np.array(pb.getMatrixFromQuaternion(attitude)).reshape(3, 3)
         return rotation.T @ (world.object_states()[0][1] - position)
 
@@ -138,10 +138,10 @@ def test_grabbed_target_leaves_the_field_and_rides_with_the_collector():
     for _ in range(200):
         world.step(WorldInputs(force=np.array([5.0, 0.0, 0.0])))
     np.testing.assert_allclose(offset_in_collector_frame(), before, atol=1e-4)
-    assert world.collector_state()[1][0] > 0.05  # the assembly moved
+    assert world.base_state()[1][0] > 0.05  # the assembly moved
     # Thrust through the collector's centre, off the assembly's centre of mass, turns it.
-    assert abs(world.collector_state()[3][2]) > 1e-3
-    assert world.assembly_mass() == pytest.approx(world.collector_mass() + 5.0)
+    assert abs(world.base_state()[3][2]) > 1e-3
+    assert world.assembly_mass() == pytest.approx(world.base_mass() + 5.0)
 
 
 def test_cargo_protrusion_is_how_far_cargo_sticks_out_of_the_collector():
@@ -188,10 +188,10 @@ def test_thrust_bookkeeping_matches_impulse_over_mass():
         world.step(WorldInputs(force=force))
     applied = 4.0 * force / 5.0
     expected_velocity = sum(applied * 0.1 / m for m in masses)
-    np.testing.assert_allclose(world.collector_state()[1], expected_velocity, rtol=1e-9)
+    np.testing.assert_allclose(world.base_state()[1], expected_velocity, rtol=1e-9)
     assert world.delta_v == pytest.approx(sum(4.0 * 0.1 / m for m in masses), rel=1e-12)
     assert world.fuel_used == pytest.approx(4.0 * 50.0 / (250 * STANDARD_GRAVITY), rel=1e-12)
-    assert world.collector_mass() == pytest.approx(100 - world.fuel_used)
+    assert world.base_mass() == pytest.approx(100 - world.fuel_used)
 
 
 def test_thrust_stops_when_the_propellant_runs_out():
@@ -204,7 +204,7 @@ def test_thrust_stops_when_the_propellant_runs_out():
     burn_time = 0.001 * 100 * STANDARD_GRAVITY / 10.0  # 0.098 s of full thrust
     assert world.propellant == 0.0
     assert world.fuel_used == pytest.approx(0.001)
-    assert world.collector_state()[1][0] == pytest.approx(10.0 * burn_time / 10.0, rel=1e-3)
+    assert world.base_state()[1][0] == pytest.approx(10.0 * burn_time / 10.0, rel=1e-3)
 
 
 def test_free_collector_drifts_as_clohessy_wiltshire_says():
@@ -215,7 +215,7 @@ def test_free_collector_drifts_as_clohessy_wiltshire_says():
     for _ in range(6000):  # 600 s, a tenth of an orbit
         world.step()
     expected = ClohessyWiltshireMotion((10, -5, 3), (0.01, 0.02, -0.005), N).state_at(600.0)
-    position, velocity, _, _ = world.collector_state()
+    position, velocity, _, _ = world.base_state()
     drift = np.linalg.norm(expected[0] - np.array([10, -5, 3]))
     assert drift > 10.0  # the check would be empty if nothing moved
     np.testing.assert_allclose(position, expected[0], atol=2e-3)

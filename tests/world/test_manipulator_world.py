@@ -8,7 +8,7 @@ import pytest
 import yaml
 
 from dcsim.robots.manipulator import ManipulatorModel
-from dcsim.scenario import load_scenario
+from dcsim.scenario import read_scenario
 from dcsim.world import World, WorldInputs
 from dcsim.world.pybullet_client import pb
 from tests.conftest import REPO
@@ -27,7 +27,7 @@ def scenario(tmp_path, **changes):
         node[last] = value
     path = tmp_path / "arm.yaml"
     path.write_text(yaml.safe_dump(data))
-    return load_scenario(path)
+    return read_scenario(path)
 
 
 def world(tmp_path, **changes) -> World:
@@ -71,8 +71,8 @@ def test_end_effector_of_the_world_is_the_models(tmp_path):
     )
     w.step(WorldInputs(force=np.array([5.0, 0, 0]), joint_torques=np.full(6, 3.0)))
     q, _ = q_qd(w)
-    end = pb.getNumJoints(w.collector, physicsClientId=w.client) - 1
-    link = pb.getLinkState(w.collector, end, computeForwardKinematics=1, physicsClientId=w.client)
+    end = pb.getNumJoints(w.robot_id, physicsClientId=w.client) - 1
+    link = pb.getLinkState(w.robot_id, end, computeForwardKinematics=1, physicsClientId=w.client)
     model = w.robot_spec().model
     np.testing.assert_allclose(link[4], model.forward_kinematics(q).end_effector, atol=1e-12)
     np.testing.assert_array_equal(w.end_effector(), model.forward_kinematics(q).end_effector)
@@ -88,7 +88,7 @@ def test_mass_matrix_of_the_world_is_the_models(tmp_path):
     q, _ = q_qd(w)
     joints = q[7:].tolist()
     ours = w.robot_spec().model.mass_matrix(np.r_[np.zeros(3), 0, 0, 0, 1, q[7:]])
-    theirs = np.array(pb.calculateMassMatrix(w.collector, joints, physicsClientId=w.client))
+    theirs = np.array(pb.calculateMassMatrix(w.robot_id, joints, physicsClientId=w.client))
     order = [3, 4, 5, 0, 1, 2, *range(6, 12)]  # ours [v, ω, θ̇] → PyBullet's [ω, v, θ̇]
     np.testing.assert_allclose(ours[np.ix_(order, order)], theirs, rtol=0, atol=1e-9 * 1100)
 

@@ -29,7 +29,6 @@ from typing import Any
 import numpy as np
 
 from dcsim.geometry import length, unit
-from dcsim.interfaces import Plugin
 from dcsim.messages import (
     DropPoint,
     DropVisit,
@@ -49,6 +48,7 @@ from dcsim.messages import (
 from dcsim.missions.base import Emit, Mission, MissionWorld
 from dcsim.missions.debris.services import grab, release
 from dcsim.missions.debris.settings import DebrisMissionSection
+from dcsim.registry.interfaces import Plugin
 from dcsim.scenario.model import Scenario
 from dcsim.world.objects import ObjectStatus
 

@@ -1,5 +1,5 @@
 """A debris run's own pictures, drawn into its ``plots/`` folder beside
-``motion.png`` and ``estimation.png`` (:mod:`dcsim.plots`):
+``motion.png`` and ``estimation.png`` (:mod:`dcsim.report.plots`):
 
 ``trajectory.png``
     The collector's path, true and estimated, in 3-D and in two side views (in the
@@ -30,7 +30,8 @@ from matplotlib.lines import Line2D  # noqa: E402
 
 from dcsim.messages import ObjectKind, Shape  # noqa: E402
 from dcsim.motion import MotionSet  # noqa: E402
-from dcsim.plots import (  # noqa: E402
+from dcsim.report.outlines import outline  # noqa: E402
+from dcsim.report.plots import (  # noqa: E402
     ESTIMATED_COLOUR,
     OBSTACLE_COLOUR,
     TRUE_COLOUR,
@@ -42,7 +43,6 @@ from dcsim.plots import (  # noqa: E402
     write_plots,
 )
 from dcsim.scenario.model import Scenario  # noqa: E402
-from dcsim.shape_outlines import outline  # noqa: E402
 from dcsim.world.objects import SpaceObject, build_objects  # noqa: E402
 
 NAMED_OBSTACLES = 20
@@ -62,7 +62,7 @@ def write_debris_plots(
     safety_distance: float,
 ) -> list[Path]:
     """Draw ``trajectory.png`` and ``timeline.png``, then the pictures every run has
-    (:func:`dcsim.plots.write_plots`), into ``out_dir/plots``.
+    (:func:`dcsim.report.plots.write_plots`), into ``out_dir/plots``.
 
     Parameters
     ----------

@@ -19,10 +19,10 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from dcsim.geometry import length
-from dcsim.interfaces import Plugin
 from dcsim.messages import Observations, Reference, StateEstimate
 from dcsim.missions.base import Emit, Mission, MissionWorld
 from dcsim.missions.hold.settings import HoldMissionSection
+from dcsim.registry.interfaces import Plugin
 from dcsim.scenario.model import Scenario, point_to_cartesian
 
 

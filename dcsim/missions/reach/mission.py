@@ -36,7 +36,6 @@ from typing import Any
 import numpy as np
 
 from dcsim.geometry import facing_axis, sight_angle
-from dcsim.interfaces import Plugin
 from dcsim.messages import (
     GoalRegion,
     NoPath,
@@ -49,6 +48,7 @@ from dcsim.messages import (
 )
 from dcsim.missions.base import Emit, Mission, MissionWorld
 from dcsim.missions.reach.settings import ReachMissionSection
+from dcsim.registry.interfaces import Plugin
 from dcsim.robots.joint_path import JointPath, SingularPath
 from dcsim.scenario.model import Scenario
 

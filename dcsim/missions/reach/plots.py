@@ -14,7 +14,7 @@ base torque and joint torques, and the change of total linear and angular moment
 limits) and the largest joint tracking error.
 
 A dotted vertical line marks the end of the planned path. Drawn with matplotlib's
-non-interactive Agg backend, as :mod:`dcsim.plots` is.
+non-interactive Agg backend, as :mod:`dcsim.report.plots` is.
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
 import numpy as np  # noqa: E402
 
-from dcsim.plots import FrameAxes, plots_folder, save, stacked  # noqa: E402
+from dcsim.report.plots import FrameAxes, plots_folder, save, stacked  # noqa: E402
 from dcsim.scenario.model import Scenario  # noqa: E402
 
 SIGHT_LIMIT_DEG = 60.0

@@ -28,7 +28,6 @@ from typing import Any
 import numpy as np
 
 from dcsim.geometry import rotate
-from dcsim.interfaces import Plugin
 from dcsim.messages import (
     Bounds,
     CostWeights,
@@ -44,6 +43,7 @@ from dcsim.messages import (
 )
 from dcsim.missions.base import Emit, Mission, MissionWorld
 from dcsim.missions.transfer.settings import TransferMissionSection
+from dcsim.registry.interfaces import Plugin
 from dcsim.scenario.model import Scenario
 
 _TRAJECTORY_HEADER = (

@@ -12,9 +12,9 @@ initial attitude), angular rate, delta-v, tracking error and the surface gap to 
 nearest obstacle against time, with the mission's modes shaded behind, each change of
 mode marked and the path planner's answers (a plan, or "no path") along the top.
 
-Axes are named and ticked as :class:`dcsim.plots.FrameAxes` says (radial, along-track
+Axes are named and ticked as :class:`dcsim.report.plots.FrameAxes` says (radial, along-track
 and orbit-normal in the LVLH frame). Drawn with matplotlib's non-interactive Agg
-backend, as :mod:`dcsim.plots` is.
+backend, as :mod:`dcsim.report.plots` is.
 """
 
 from __future__ import annotations
@@ -34,7 +34,8 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
 from dcsim.messages import ObjectKind, Shape, ShapeKind  # noqa: E402
-from dcsim.plots import (  # noqa: E402
+from dcsim.report.outlines import outline, wireframe  # noqa: E402
+from dcsim.report.plots import (  # noqa: E402
     LEGEND_ROW,
     TITLE_ROOM,
     FrameAxes,
@@ -49,7 +50,6 @@ from dcsim.plots import (  # noqa: E402
     thrust_panel,
 )
 from dcsim.scenario.model import Scenario  # noqa: E402
-from dcsim.shape_outlines import outline, wireframe  # noqa: E402
 from dcsim.world.objects import build_objects  # noqa: E402
 
 SCENE_MARGIN = 10.0

@@ -8,7 +8,7 @@ import numpy as np
 from scipy.spatial import ConvexHull
 
 from dcsim.messages import Shape
-from dcsim.shape_outlines import surface_points
+from dcsim.report.outlines import surface_points
 
 
 @dataclass(frozen=True)

@@ -3,7 +3,7 @@
 The page needs no server and no network: plotly.js (from the ``plotly`` Python
 package), the player (``dcsim/templates/viewer/view.js``) and the scene (JSON) are
 written into it. Most of its size is plotly.js (about 4.8 MB); the scene adds a few
-hundred kB for a run of a handful of objects at :data:`~dcsim.viewer.scene.MAX_FRAMES`
+hundred kB for a run of a handful of objects at :data:`~dcsim.report.viewer.scene.MAX_FRAMES`
 frames.
 """
 
@@ -19,8 +19,8 @@ from typing import Any
 import numpy as np
 
 from dcsim import __version__
-from dcsim.viewer.records import ViewError, read_run
-from dcsim.viewer.scene import MAX_FRAMES, build_scene
+from dcsim.report.viewer.records import ViewError, read_run
+from dcsim.report.viewer.scene import MAX_FRAMES, build_scene
 
 PAGE_NAME = "view.html"
 """File name of the page in the run directory."""
@@ -66,7 +66,7 @@ def write_view(run_dir: Path, out: Path | None = None, max_frames: int = MAX_FRA
 
 
 def page_html(scene: dict[str, Any]) -> str:
-    """The page's HTML for ``scene`` (:func:`dcsim.viewer.scene.build_scene`)."""
+    """The page's HTML for ``scene`` (:func:`dcsim.report.viewer.scene.build_scene`)."""
     values = {
         "title": html.escape(scene["title"]),
         "subtitle": html.escape(scene["subtitle"]),

@@ -1,5 +1,5 @@
 """Calling plugins during a run: every exception a plugin raises, and every answer that
-breaks its kind's contract (:mod:`dcsim.plugin_outputs`), becomes a recorded failure
+breaks its kind's contract (:mod:`dcsim.registry.answers`), becomes a recorded failure
 that names the plugin."""
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ import traceback
 from collections.abc import Mapping
 from typing import Any
 
-from dcsim.interfaces import Plugin
-from dcsim.plugin_outputs import ANSWERS, output_problem
+from dcsim.registry.answers import ANSWERS, output_problem
+from dcsim.registry.interfaces import Plugin
 
 
 class PluginFailure(Exception):
@@ -82,7 +82,7 @@ def call_plugin(
     ------
     PluginFailure
         If the plugin raised, or answered with a value its kind may not return
-        (:func:`dcsim.plugin_outputs.output_problem`).
+        (:func:`dcsim.registry.answers.output_problem`).
     """
     plugin = plugins[role]
     try:

@@ -14,7 +14,7 @@ strings, ready for JSON) that the page's script plays without knowing dcsim:
 - ``trails``: paths drawn up to the current frame;
 - ``stages``: lines that change at given times (the debris mission's plans);
 - ``readouts``: the key numbers at every frame, formatted; ``events``: the event log
-  (:mod:`~dcsim.viewer.readouts`);
+  (:mod:`~dcsim.report.viewer.readouts`);
 - ``extent``: boxes the views show; ``playback``: speeds offered;
 - ``axes``: the names of the world frame's x, y and z axes (radial, along-track and
   orbit-normal in LVLH).
@@ -30,13 +30,13 @@ from typing import Any
 import numpy as np
 
 from dcsim.messages import ObjectKind, Shape, ShapeKind
+from dcsim.report.outlines import wireframe
+from dcsim.report.viewer.meshes import Mesh, shape_mesh
+from dcsim.report.viewer.objects import Handling, ObjectTrack, Status, object_tracks
+from dcsim.report.viewer.readouts import event_log, readouts, subtitle, title
+from dcsim.report.viewer.records import RunRecords
+from dcsim.report.viewer.robot import RobotPath, arm_polylines, body_axes
 from dcsim.scenario.model import ManipulatorSection, frame_axes, point_to_cartesian
-from dcsim.shape_outlines import wireframe
-from dcsim.viewer.meshes import Mesh, shape_mesh
-from dcsim.viewer.objects import Handling, ObjectTrack, Status, object_tracks
-from dcsim.viewer.readouts import event_log, readouts, subtitle, title
-from dcsim.viewer.records import RunRecords
-from dcsim.viewer.robot import RobotPath, arm_polylines, body_axes
 
 MAX_FRAMES = 600
 """Frames a page holds at most (telemetry rows evenly spread over the run)."""

@@ -16,8 +16,8 @@ from string import Template
 
 from dcsim import __version__
 from dcsim.errors import DcsimError
-from dcsim.interfaces import PLUGIN_KINDS
-from dcsim.registry import PluginRegistry
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.registry.interfaces import PLUGIN_KINDS
 
 MISSION = "mission"
 """The kind ``dcsim new-plugin`` writes a mission package for."""

@@ -179,7 +179,7 @@ class Recorder:
     Parameters
     ----------
     out_dir : Path or None
-        Run directory, created if missing (:func:`dcsim.rundir.prepare_run_directory`
+        Run directory, created if missing (:func:`dcsim.run.directory.prepare_run_directory`
         checks one before a run); None records in memory only.
     columns : sequence of str
         The telemetry columns (:func:`telemetry_columns`).

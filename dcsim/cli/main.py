@@ -3,7 +3,7 @@
 Every error a user can cause is printed as ``error: <message>`` with exit status 2 and
 no traceback; ``dcsim --debug ...`` shows the traceback instead. Installed plugin
 packages add their own commands (``dcsim bench ant-colony`` is the ``ant-colony``
-plugin's) through the ``dcsim_register_commands`` hook (:mod:`dcsim.cli_plugins`).
+plugin's) through the ``dcsim_register_commands`` hook (:mod:`dcsim.cli.plugin_commands`).
 """
 
 from __future__ import annotations
@@ -21,19 +21,19 @@ import click
 
 from dcsim import __version__
 from dcsim.bench.options import comma_numbers, comma_words
-from dcsim.cli_campaign import campaign_group, cluster_choice, cluster_options
+from dcsim.cli.campaign import campaign_group, cluster_choice, cluster_options
 from dcsim.errors import DcsimError, PluginLoadWarning, PluginNotFoundError, did_you_mean
-from dcsim.interfaces import PLUGIN_KINDS
 from dcsim.params import ParameterInfo, parameter_infos
-from dcsim.registry import PluginRegistry, RegisteredPlugin
-from dcsim.rundir import file_name_part, prepare_run_directory
-from dcsim.runsetup import prepare_run
-from dcsim.scenario import load_scenario
+from dcsim.registry.discovery import PluginRegistry, RegisteredPlugin
+from dcsim.registry.interfaces import PLUGIN_KINDS
+from dcsim.run.directory import file_name_part, prepare_run_directory
+from dcsim.run.setup import setup_run
+from dcsim.scenario import read_scenario
 from dcsim.scenario.model import MAX_SEED
 
 if TYPE_CHECKING:  # the bench modules and the runner are imported by their commands only
     from dcsim.bench.path_planners import PlannerChoice, ProblemResult
-    from dcsim.runner import Runner
+    from dcsim.run.loop import Runner
 
 EXIT_USER_ERROR = 2
 
@@ -41,7 +41,7 @@ EXIT_USER_ERROR = 2
 class _PluginGroup(click.Group):
     """A click group that also holds the commands plugin packages add to it.
 
-    The packages are asked (:mod:`dcsim.cli_plugins`) only when a command is not one of
+    The packages are asked (:mod:`dcsim.cli.plugin_commands`) only when a command is not one of
     dcsim's own, or when the commands are listed, once per command line.
     """
 
@@ -88,7 +88,7 @@ def _plugin_commands(ctx: click.Context) -> dict[str, dict[str, click.Command]]:
     refused ones are printed as warnings on stderr)."""
     meta = ctx.find_root().meta
     if "dcsim.plugin_commands" not in meta:
-        from dcsim.cli_plugins import plugin_commands
+        from dcsim.cli.plugin_commands import plugin_commands
 
         taken = {"cli": cli.commands, "bench": bench_group.commands}
         found = plugin_commands(_registry(), taken)
@@ -220,7 +220,7 @@ def validate_command(files: tuple[Path, ...]) -> None:
     failed = False
     for path in files:
         try:
-            load_scenario(path, registry=registry)
+            read_scenario(path, registry=registry)
         except DcsimError as exc:
             click.echo(f"error: {exc}", err=True)
             failed = True
@@ -279,9 +279,9 @@ def run_command(
     when interrupted with Ctrl-C. With --view the run directory also receives
     view.html, written after the run however it ended.
     """
-    from dcsim.runner import Runner, terminal_progress  # the world engine loads PyBullet
+    from dcsim.run.loop import Runner, terminal_progress  # the world engine loads PyBullet
 
-    setup = prepare_run(scenario, overrides, seed, registry=_registry())
+    setup = setup_run(scenario, overrides, seed, registry=_registry())
     if out is None:
         stamp = f"{datetime.now():%Y%m%d-%H%M%S}"
         out = Path("runs") / f"{file_name_part(setup.scenario.name)}-{stamp}"
@@ -367,7 +367,7 @@ def view_command(run_dir: Path, out: Path | None, max_frames: int) -> None:
     disappear), the plans, beacons, drop point or goal, a time slider with play and
     pause, and the mission's mode and key numbers at the time shown.
     """
-    from dcsim.viewer import write_view
+    from dcsim.report.viewer import write_view
 
     page = write_view(run_dir, out, max_frames)
     click.echo(f"wrote {page} ({_megabytes(page)})")
@@ -376,7 +376,7 @@ def view_command(run_dir: Path, out: Path | None, max_frames: int) -> None:
 def _write_view(run_dir: Path) -> None:
     """Write the run's page after ``dcsim run --view``, saying where; a run that left
     nothing to show (no telemetry row) gets a warning, and keeps its exit status."""
-    from dcsim.viewer import ViewError, write_view
+    from dcsim.report.viewer import ViewError, write_view
 
     try:
         page = write_view(run_dir)
@@ -421,7 +421,7 @@ def new_plugin_command(kind: str, name: str, directory: Path) -> None:
     `pip install -e DIR/dcsim-NAME` and run `pytest` inside it. A NAME an installed
     plugin of KIND (or an installed mission) already has is refused.
     """
-    from dcsim.scaffold import new_plugin
+    from dcsim.registry.scaffold import new_plugin
 
     root = new_plugin(kind, name, directory, _registry())
     click.echo(f"wrote {root}")
@@ -461,7 +461,7 @@ def bench_world_command(objects: str, duration: float) -> None:
     real-time factor: stepping, the per-step force calls and the localiser plugin alone.
     """
     from dcsim.bench.world import bench_world, floor_line, loop_floor, markdown_table
-    from dcsim.runner import Runner
+    from dcsim.run.loop import Runner
 
     words = [word.strip() for word in objects.split(",")]
     if not all(word.isdigit() for word in words):
@@ -472,7 +472,7 @@ def bench_world_command(objects: str, duration: float) -> None:
     rows = bench_world(sizes, duration, progress=lambda line: click.echo(line, err=True))
     click.echo(markdown_table(rows))
     registry = _registry()
-    summary = Runner(prepare_run(registry=registry)).run()
+    summary = Runner(setup_run(registry=registry)).run()
     click.echo(
         f"\ndefault scenario: {summary['status']} ({summary['reason']}), "
         f"{summary['sim_time_s']:.1f} s simulated in {summary['wall_time_s']:.2f} s, "
@@ -748,7 +748,7 @@ def bench_controllers_command(
     registry = PluginRegistry.discover()
     for name in names:  # unknown controllers and bad overrides fail here, before any run
         chosen = [f"controller.plugin={name}", "controller.params={}", *overrides]
-        safety = load_scenario(scenario, chosen, registry).mission.safety_distance
+        safety = read_scenario(scenario, chosen, registry).mission.safety_distance
     runs = bench_controllers(
         scenario,
         names,
@@ -805,7 +805,7 @@ def bench_campaign_command(
 
     if campaign is None:
         campaign = (
-            Path(__file__).resolve().parents[1] / "scenarios/campaigns/default_dispersed.yaml"
+            Path(__file__).resolve().parents[2] / "scenarios/campaigns/default_dispersed.yaml"
         )
         if not campaign.exists():
             raise click.BadParameter("name a campaign file", param_hint="CAMPAIGN")

@@ -17,7 +17,7 @@ of the run directory at the end. A run ends ``completed`` (the mission says so, 
 ``world.duration`` is reached), ``stopped`` (a collision with ``stop.on_collision``,
 ``stop.max_wall_time``, the mission says so, or an interrupt with Ctrl-C) or
 ``failed`` (a plugin or hook raised, or a plugin answered with something its kind may
-not return: :mod:`dcsim.plugin_outputs`). Whatever the ending,
+not return: :mod:`dcsim.registry.answers`). Whatever the ending,
 the telemetry, events and summary recorded so far are written.
 """
 
@@ -32,21 +32,21 @@ from typing import Any
 
 import numpy as np
 
-from dcsim.hookspecs import RunInfo
 from dcsim.messages import Command, Observations, Prior, StateEstimate
 from dcsim.missions import Mission, mission_class
-from dcsim.plugin_calls import PluginFailure, call_plugin
-from dcsim.recording import (
+from dcsim.registry.calls import PluginFailure, call_plugin
+from dcsim.registry.hookspecs import RunInfo
+from dcsim.run.recording import (
     SIGMA_COLUMNS,
     Recorder,
     RecordingError,
     telemetry_columns,
     telemetry_units,
 )
-from dcsim.runsetup import RunSetup
+from dcsim.run.seeding import component_rng
+from dcsim.run.setup import RunSetup
 from dcsim.scenario import dump_scenario
 from dcsim.scenario.model import point_to_cartesian
-from dcsim.seeding import component_rng
 from dcsim.world import World, WorldInputs
 
 PLOT_POINTS = 2000
@@ -123,7 +123,7 @@ class Runner:
         The resolved scenario and its constructed plugins.
     out_dir : Path, optional
         Run directory to stream the records into (created if missing; see
-        :func:`dcsim.rundir.prepare_run_directory` for the checks the CLI makes first);
+        :func:`dcsim.run.directory.prepare_run_directory` for the checks the CLI makes first);
         None records in memory only.
     progress : callable, optional
         ``progress(sim_time, duration, mode, mission_progress)``, called about four
@@ -372,7 +372,7 @@ class Runner:
         """The localiser's estimate now, or the true state when the mission flies without one."""
         world, plugins = self.world, self.plugins
         if "localiser" not in plugins:
-            position, velocity, _, _ = world.collector_state()
+            position, velocity, _, _ = world.base_state()
             return StateEstimate(
                 world.time, position, velocity=velocity, covariance=_NO_SPREAD, converged=True
             )

@@ -16,8 +16,8 @@ from typing import Any
 import numpy as np
 
 from dcsim.motion import MotionSet
+from dcsim.report.viewer.robot import RobotPath
 from dcsim.scenario.model import Scenario
-from dcsim.viewer.robot import RobotPath
 from dcsim.world.objects import SpaceObject, build_objects
 
 

@@ -18,9 +18,9 @@ import numpy as np
 import pandas as pd
 
 from dcsim.errors import DcsimError
-from dcsim.recording import column_name
-from dcsim.runs import read_events, telemetry_frame
-from dcsim.scenario import load_scenario
+from dcsim.run.recording import column_name
+from dcsim.run.scripting import read_events, telemetry_frame
+from dcsim.scenario import read_scenario
 from dcsim.scenario.model import Scenario
 
 _BRACKETED_UNIT = re.compile(r"^(?P<name>.+?)\s*\[[^\]]*\]$")  # ``time [s]``
@@ -63,7 +63,7 @@ class RunRecords:
 
 def plain_name(column: str) -> str:
     """A column name without its unit: ``x_m`` → ``x`` (the suffixes of
-    :data:`dcsim.recording.UNITS`), ``time [s]`` → ``time``."""
+    :data:`dcsim.run.recording.UNITS`), ``time [s]`` → ``time``."""
     column = column.strip()
     match = _BRACKETED_UNIT.match(column)
     return match.group("name") if match else column_name(column)
@@ -137,7 +137,7 @@ def read_run(directory: Path) -> RunRecords:
     if not len(telemetry["time"]):
         raise ViewError(f"{directory / 'telemetry.csv'} has no rows yet: nothing to show")
     try:
-        scenario = load_scenario(directory / "scenario.yaml")
+        scenario = read_scenario(directory / "scenario.yaml")
     except DcsimError as error:
         raise ViewError(f"cannot read the run's scenario: {error}") from None
     return RunRecords(
@@ -151,7 +151,8 @@ def read_run(directory: Path) -> RunRecords:
 
 
 def _events(path: Path) -> list[dict[str, Any]]:
-    """The events of an ``events.jsonl`` (:func:`dcsim.runs.read_events`); none if missing."""
+    """The events of an ``events.jsonl`` (:func:`dcsim.run.scripting.read_events`); none if
+    missing."""
     if not path.is_file():
         return []
     try:

@@ -16,33 +16,22 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-import yaml
-
-from dcsim.errors import Problem, ScenarioError
-from dcsim.recording import column_unit, count_lines, to_json
-from dcsim.registry import PluginRegistry
-from dcsim.rundir import RunDirectoryError, prepare_run_directory
-from dcsim.runsetup import RunSetup, prepare_run
-from dcsim.scenario import Scenario, ScenarioSource
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.run.directory import RunDirectoryError, prepare_run_directory
+from dcsim.run.recording import column_unit, count_lines, to_json
+from dcsim.run.setup import Overrides, ScenarioInput, setup_run
+from dcsim.scenario import Scenario
 
 if TYPE_CHECKING:
     import pandas
 
-    from dcsim.recording import Recorder
-    from dcsim.runner import Runner
-
-Overrides = Sequence[str] | Mapping[str, Any]
-"""``key.path=value`` texts as for ``dcsim run --set``, or a mapping of key paths to values."""
-
-ScenarioInput = ScenarioSource | Scenario
-"""A scenario file's path, its data as a mapping, a loaded :class:`Scenario`, or None
-for the packaged default scenario."""
+    from dcsim.run.loop import Runner
+    from dcsim.run.recording import Recorder
 
 
 @dataclass(frozen=True, eq=False)
@@ -87,66 +76,6 @@ class RunResult:
         import pandas as pd
 
         return pd.DataFrame(self.events)
-
-
-def override_texts(overrides: Overrides) -> list[str]:
-    """Overrides as ``key.path=value`` texts (the form of ``dcsim run --set``).
-
-    Parameters
-    ----------
-    overrides : sequence of str or mapping
-        Texts, kept as they are (one text alone counts as one override), or a mapping
-        of key paths to plain values (``{"world.duration": 30}``; numpy numbers and
-        arrays count as plain), each value written as YAML.
-
-    Raises
-    ------
-    ScenarioError
-        If a mapped value is not plain data (numbers, text, booleans, None, lists,
-        mappings).
-    """
-    if isinstance(overrides, str):
-        return [overrides]
-    if not isinstance(overrides, Mapping):
-        return list(overrides)
-    texts = []
-    for key, value in overrides.items():
-        try:
-            text = yaml.safe_dump(_plain(value), default_flow_style=True, width=1 << 30)
-        except yaml.YAMLError:
-            message = f"{value!r} is not plain data (numbers, text, lists, mappings)"
-            raise ScenarioError("overrides", [Problem(str(key), message)]) from None
-        texts.append(f"{key}={text.strip().removesuffix('...').strip()}")
-    return texts
-
-
-def _plain(value: Any) -> Any:
-    """``value`` with numpy scalars and arrays (a notebook's ``np.linspace`` values)
-    turned into Python numbers and lists, at any depth."""
-    if isinstance(value, np.generic | np.ndarray):
-        return value.tolist()
-    if isinstance(value, Mapping):
-        return {k: _plain(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_plain(v) for v in value]
-    return value
-
-
-def setup_run(
-    scenario: ScenarioInput = None,
-    overrides: Overrides = (),
-    seed: int | None = None,
-    registry: PluginRegistry | None = None,
-) -> RunSetup:
-    """The scenario resolved (overrides and seed applied) and its plugins constructed.
-
-    Raises
-    ------
-    ScenarioError
-        If the scenario, an override or a plugin choice is invalid.
-    """
-    source = scenario.model_dump(mode="json") if isinstance(scenario, Scenario) else scenario
-    return prepare_run(source, override_texts(overrides), seed, registry)
 
 
 def load_scenario(
@@ -253,7 +182,7 @@ def open_run(
 
     Returns
     -------
-    dcsim.runner.Runner
+    dcsim.run.loop.Runner
         The open run: ``advance()`` flies one control period (``world.control_period``
         s, optionally with a disturbance force in N and torque in N·m, world frame)
         and decides the next; ``ended`` says when the mission, ``world.duration`` or a
@@ -280,7 +209,7 @@ def close_run(runner: Runner) -> RunResult:
 
     Parameters
     ----------
-    runner : dcsim.runner.Runner
+    runner : dcsim.run.loop.Runner
         The run, from :func:`open_run`.
 
     Returns
@@ -375,7 +304,7 @@ def _runner(
     registry: PluginRegistry | None,
 ) -> Runner:
     """A runner of the resolved scenario, its run directory checked and made ready."""
-    from dcsim.runner import Runner  # the world engine loads PyBullet
+    from dcsim.run.loop import Runner  # the world engine loads PyBullet
 
     setup = setup_run(scenario, overrides, seed, registry)
     out_dir = None if out is None else prepare_run_directory(Path(out), force)

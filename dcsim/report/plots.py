@@ -33,7 +33,7 @@ from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 from matplotlib.ticker import FuncFormatter  # noqa: E402
 
-from dcsim.recording import SIGMA_COLUMNS  # noqa: E402
+from dcsim.run.recording import SIGMA_COLUMNS  # noqa: E402
 from dcsim.scenario.model import XYZ_AXES, Scenario, frame_axes  # noqa: E402
 
 KM_FROM = 10_000.0
@@ -356,7 +356,7 @@ def estimation_figure(scenario: Scenario, telemetry: Mapping[str, np.ndarray]) -
     """The estimation error per axis with its ±3σ envelope, and its length, over time.
 
     The error is estimated minus true position; σ is the localiser's reported standard
-    deviation (:data:`dcsim.recording.SIGMA_COLUMNS`). Until the localiser converges the
+    deviation (:data:`dcsim.run.recording.SIGMA_COLUMNS`). Until the localiser converges the
     panels are shaded grey, and each panel's scale is set by the converged stretch.
 
     Parameters

@@ -7,7 +7,7 @@ and a controller's ``command()`` a :class:`~dcsim.messages.Command`. Messages ch
 their own shapes when they are built; what is left to check is the type, the numbers
 (every one finite), the things a message cannot know alone (how many joints the robot
 has) and a trajectory's clock. The runner checks every answer this way
-(:func:`dcsim.plugin_calls.call_plugin`), and so does the conformance suite, so a
+(:func:`dcsim.registry.calls.call_plugin`), and so does the conformance suite, so a
 plugin that breaks its contract is named where it happens instead of one tick later in
 another plugin.
 """

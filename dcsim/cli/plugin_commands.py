@@ -1,6 +1,6 @@
 """Commands that plugin packages add to the ``dcsim`` command line.
 
-A package implements :func:`~dcsim.hookspecs.dcsim_register_commands` and adds click
+A package implements :func:`~dcsim.registry.hookspecs.dcsim_register_commands` and adds click
 commands to the groups it is given; dcsim's built-in plugins add their own benches
 (``dcsim bench ant-colony``, ``dcsim bench q-learning``) the same way. Each
 implementation gets groups of its own, so that a name already taken (by dcsim or by a
@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import click
 
-from dcsim.registry import PluginRegistry
+from dcsim.registry.discovery import PluginRegistry
 
 GROUPS = ("cli", "bench")
 """The hook's arguments: the groups a package can add commands to (``dcsim NAME``,

@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 import pluggy
 
-from dcsim.interfaces import Plugin
+from dcsim.registry.interfaces import Plugin
 
 if TYPE_CHECKING:
     import click
@@ -63,9 +63,11 @@ def dcsim_plugin_classes() -> list[type[Plugin]]:
     """Return the plugin classes this package provides.
 
     Each class derives from one of the four plugin kinds
-    (:class:`~dcsim.interfaces.Localiser`, :class:`~dcsim.interfaces.TaskPlanner`,
-    :class:`~dcsim.interfaces.PathPlanner`, :class:`~dcsim.interfaces.Controller`) and
-    declares ``name``, ``summary`` and ``Params``.
+    (:class:`~dcsim.registry.interfaces.Localiser`,
+    :class:`~dcsim.registry.interfaces.TaskPlanner`,
+    :class:`~dcsim.registry.interfaces.PathPlanner`,
+    :class:`~dcsim.registry.interfaces.Controller`) and declares ``name``, ``summary`` and
+    ``Params``.
 
     Returns
     -------

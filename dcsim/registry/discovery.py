@@ -2,7 +2,7 @@
 
 Plugins are found through the ``dcsim`` entry-point group; dcsim's own built-ins use the
 same group. Each entry point names either a module implementing the
-:func:`~dcsim.hookspecs.dcsim_plugin_classes` hook or a plugin class itself.
+:func:`~dcsim.registry.hookspecs.dcsim_plugin_classes` hook or a plugin class itself.
 
 The environment variable ``DCSIM_LOAD_PLUGINS`` (a comma-separated list of distribution
 names) restricts which external packages are loaded; dcsim's built-ins always are.
@@ -24,7 +24,6 @@ from typing import Any
 import numpy as np
 import pluggy
 
-from dcsim import hookspecs
 from dcsim.errors import (
     DuplicatePluginError,
     PluginInterfaceError,
@@ -32,8 +31,9 @@ from dcsim.errors import (
     PluginNotFoundError,
     did_you_mean,
 )
-from dcsim.interfaces import PLUGIN_KINDS, Plugin
 from dcsim.params import PluginParams
+from dcsim.registry import hookspecs
+from dcsim.registry.interfaces import PLUGIN_KINDS, Plugin
 
 LOAD_PLUGINS_ENV = "DCSIM_LOAD_PLUGINS"
 """Environment variable restricting which external plugin distributions load."""

@@ -7,8 +7,8 @@ from typing import Any
 
 import numpy as np
 
+from dcsim.report.viewer.objects import Handling
 from dcsim.scenario.model import ManipulatorSection, Scenario
-from dcsim.viewer.objects import Handling
 
 COLUMN_READOUTS = (
     ("fuel_used", "propellant used", "{:.3f} of {total} kg"),

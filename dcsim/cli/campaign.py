@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 import click
 
-from dcsim.rundir import file_name_part
+from dcsim.run.directory import file_name_part
 
 if TYPE_CHECKING:
     from dcsim.campaign import CampaignRun, ClusterOptions
