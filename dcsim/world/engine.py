@@ -173,9 +173,7 @@ class World:
         self.robot_id = self._robot.body
         self._joint_torques = np.zeros(0)
         self._bodies = ObjectBodies(self._client, self.field)
-        self._payload = Payload(
-            self._client, self.robot_id, robot.radius, self.field, self._bodies
-        )
+        self._payload = Payload(self._client, self.robot_id, robot.radius, self.field, self._bodies)
         self._contacts: set[tuple[int, int]] = set()
         self._candidates = np.zeros(0, dtype=int)
         self._period_mass = self.assembly_mass()
@@ -287,9 +285,7 @@ class World:
         The inertia is the base's own, as PyBullet holds it, about its centre of mass in
         the body frame.
         """
-        return self._robot.spec(
-            self.assembly_mass(), self.base_mass(), self.cargo_protrusion()
-        )
+        return self._robot.spec(self.assembly_mass(), self.base_mass(), self.cargo_protrusion())
 
     def carried_ids(self) -> list[int]:
         """Ids of the targets on board."""
