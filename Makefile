@@ -5,7 +5,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: test test-slow run docs clean
+.PHONY: lint test test-slow run docs clean
 
 $(STAMP): pyproject.toml setup.cfg
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -30,6 +30,12 @@ test-slow: $(STAMP)
 
 run: $(STAMP)
 	$(BIN)/dcsim run
+
+# Types and style of dcsim/ and plugins/ (settings in pyproject.toml); tests/ is linted too.
+lint: $(STAMP)
+	$(BIN)/ruff check dcsim plugins tests
+	$(BIN)/ruff format --check dcsim plugins tests
+	$(BIN)/mypy
 
 # Regenerate the generated parts of docs/ (a test fails while they are stale).
 docs: $(STAMP)
