@@ -4,6 +4,6 @@ One subpackage per kind (``localisers``, ``task_planners``, ``path_planners``,
 ``controllers``). Each plugin module uses dcsim's public API (:mod:`dcsim.api`) only
 and exposes its class through the ``dcsim_plugin_classes`` hook, exactly as a
 third-party package would. A plugin's own bench or environment lives beside it
-(``path_planners/ant_colony_bench.py``, ``q_learning_bench.py``, ``q_learning_gym.py``)
+(``path_planners/ant_colony/bench.py``, ``q_learning/bench.py``, ``q_learning/gym.py``)
 and reaches the command line through the ``dcsim_register_commands`` hook.
 """

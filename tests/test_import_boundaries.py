@@ -59,6 +59,6 @@ def test_the_scan_sees_a_plugin_import(tmp_path):
     framework.write_text(
         "import importlib\n"
         "from dcsim_plugins.path_planners import ant_colony\n"
-        "importlib.import_module('dcsim_plugins.path_planners.q_learning')\n"
+        "importlib.import_module('dcsim_plugins.path_planners.q_learning.planner')\n"
     )
     assert [line for line, _ in imported(framework)] == [1, 2, 3]

@@ -8,8 +8,7 @@ import math
 
 import numpy as np
 import pytest
-from dcsim_plugins.path_planners.ant_colony import AntColonyParams, AntColonyPlanner
-from dcsim_plugins.path_planners.colony import (
+from dcsim_plugins.path_planners.ant_colony.colony import (
     descend,
     lay_pheromone,
     solve_colony,
@@ -18,7 +17,12 @@ from dcsim_plugins.path_planners.colony import (
     visibility,
     walk,
 )
-from dcsim_plugins.path_planners.layered_graph import LayeredGraph, build_graph, segment_gaps
+from dcsim_plugins.path_planners.ant_colony.layered_graph import (
+    LayeredGraph,
+    build_graph,
+    segment_gaps,
+)
+from dcsim_plugins.path_planners.ant_colony.planner import AntColonyParams, AntColonyPlanner
 
 from dcsim.api import (
     GoalRegion,

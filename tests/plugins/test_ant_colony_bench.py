@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from click.testing import CliRunner
-from dcsim_plugins.path_planners import ant_colony_bench as bench
-from dcsim_plugins.path_planners.ant_colony import AntColonyPlanner
+from dcsim_plugins.path_planners.ant_colony import bench
+from dcsim_plugins.path_planners.ant_colony.planner import AntColonyPlanner
 
 from dcsim.api import layered_optimum, load_bench_problem
 from dcsim.cli.main import cli

@@ -6,8 +6,8 @@ import dataclasses
 
 import numpy as np
 import pytest
-from dcsim_plugins.task_planners.ga import GeneticTaskPlanner
-from dcsim_plugins.task_planners.ga_population import (
+from dcsim_plugins.task_planners.ga.planner import GeneticTaskPlanner
+from dcsim_plugins.task_planners.ga.population import (
     Population,
     evaluate,
     greedy_crossover,
@@ -16,7 +16,7 @@ from dcsim_plugins.task_planners.ga_population import (
     repair_runs,
     swap_mutation,
 )
-from dcsim_plugins.task_planners.ga_problem import PlanModel, TaskProblem
+from dcsim_plugins.task_planners.ga.problem import PlanModel, TaskProblem
 
 from dcsim.api import (
     DropPoint,

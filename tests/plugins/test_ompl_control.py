@@ -11,9 +11,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from dcsim_plugins.path_planners.ompl_control import OmplControlParams, OmplControlPlanner
-from dcsim_plugins.path_planners.ompl_support import in_worker, seed_ompl
-from dcsim_plugins.path_planners.rigid_body import Model, discrete_control
+from dcsim_plugins.path_planners.ompl.control import OmplControlParams, OmplControlPlanner
+from dcsim_plugins.path_planners.ompl.rigid_body import Model, discrete_control
+from dcsim_plugins.path_planners.ompl.support import in_worker, seed_ompl
 
 from dcsim.api import (
     Bounds,
@@ -250,7 +250,7 @@ import time
 from ompl import base as ob
 from ompl import util as ou
 
-from dcsim_plugins.path_planners.ompl_support import in_worker, seed_ompl
+from dcsim_plugins.path_planners.ompl.support import in_worker, seed_ompl
 
 
 def draw(seed):

@@ -6,7 +6,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from dcsim_plugins.path_planners.ompl_geometric import MOVING_REFUSAL, OmplGeometricPlanner
+from dcsim_plugins.path_planners.ompl.geometric import MOVING_REFUSAL, OmplGeometricPlanner
 
 from dcsim.api import (
     Bounds,

@@ -7,9 +7,9 @@ import itertools
 
 import numpy as np
 import pytest
-from dcsim_plugins.path_planners.cell_environment import ACTIONS, CellRules, build_environment
-from dcsim_plugins.path_planners.q_learning import QLearningPlanner, simplified
-from dcsim_plugins.path_planners.tabular_q import (
+from dcsim_plugins.path_planners.q_learning.cells import ACTIONS, CellRules, build_environment
+from dcsim_plugins.path_planners.q_learning.planner import QLearningPlanner, simplified
+from dcsim_plugins.path_planners.q_learning.tabular_q import (
     Schedule,
     choose_action,
     greedy_rollout,

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 from click.testing import CliRunner
-from dcsim_plugins.path_planners import q_learning_bench as bench
-from dcsim_plugins.path_planners.q_learning import QLearningPlanner
+from dcsim_plugins.path_planners.q_learning import bench
+from dcsim_plugins.path_planners.q_learning.planner import QLearningPlanner
 
 from dcsim.api import load_reach_problem, optimal_values, packaged_scenario_path
 from dcsim.cli.main import cli

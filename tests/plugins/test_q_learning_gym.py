@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-MODULE = "dcsim_plugins.path_planners.q_learning_gym"
+MODULE = "dcsim_plugins.path_planners.q_learning.gym"
 """The module that registers the environment when imported."""
 ENVIRONMENT_ID = "dcsim/ManipulatorReachCells-v0"
 

@@ -83,7 +83,7 @@ from dcsim.api import (
 )
 
 if TYPE_CHECKING:
-    from dcsim_plugins.path_planners.ant_colony import AntColonyParams
+    from dcsim_plugins.path_planners.ant_colony.planner import AntColonyParams
 
 _DEFAULT_POINTS = {"line": 10, "grid": 4}
 

@@ -44,7 +44,7 @@ from typing import Literal
 
 import numpy as np
 from dcsim_plugins.path_planners.obstacle_field import ObstacleField, goal_or_refusal
-from dcsim_plugins.path_planners.ompl_support import in_worker, seed_ompl
+from dcsim_plugins.path_planners.ompl.support import in_worker, seed_ompl
 from dcsim_plugins.path_planners.polyline_flight import (
     SHORTEST,
     Samples,

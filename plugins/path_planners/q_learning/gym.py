@@ -15,7 +15,7 @@ module itself when the id names it (also in a fresh process or a vector env's wo
     import gymnasium
 
     env = gymnasium.make(
-        "dcsim_plugins.path_planners.q_learning_gym:dcsim/ManipulatorReachCells-v0"
+        "dcsim_plugins.path_planners.q_learning.gym:dcsim/ManipulatorReachCells-v0"
     )
     observation, info = env.reset(seed=1)
     observation, reward, terminated, truncated, info = env.step(4)   # +x
@@ -33,7 +33,7 @@ from typing import Any
 
 import gymnasium
 import numpy as np
-from dcsim_plugins.path_planners.q_learning import QLearningPlanner
+from dcsim_plugins.path_planners.q_learning.planner import QLearningPlanner
 from gymnasium import spaces
 
 from dcsim.api import load_reach_problem, packaged_scenario_path

@@ -52,7 +52,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from dcsim_plugins.task_planners.ga_population import (
+from dcsim_plugins.task_planners.ga.population import (
     Evaluation,
     Population,
     evaluate,
@@ -64,7 +64,7 @@ from dcsim_plugins.task_planners.ga_population import (
     run_mutation,
     swap_mutation,
 )
-from dcsim_plugins.task_planners.ga_problem import PlanModel, TaskProblem
+from dcsim_plugins.task_planners.ga.problem import PlanModel, TaskProblem
 
 from dcsim.api import (
     DropVisit,

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-from dcsim_plugins.path_planners.rigid_body import DV, Model, P, Q, T, V, W
+from dcsim_plugins.path_planners.ompl.rigid_body import DV, Model, P, Q, T, V, W
 
 from dcsim.api import (
     PathProblem,
@@ -20,7 +20,7 @@ from dcsim.api import (
 )
 
 if TYPE_CHECKING:
-    from dcsim_plugins.path_planners.ompl_control import StateCheck
+    from dcsim_plugins.path_planners.ompl.control import StateCheck
 
 _DURATIONS = np.geomspace(1.0, 2000.0, 48)  # durations tried, in steps
 

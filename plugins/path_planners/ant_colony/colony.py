@@ -34,10 +34,10 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-from dcsim_plugins.path_planners.layered_graph import LayeredGraph
+from dcsim_plugins.path_planners.ant_colony.layered_graph import LayeredGraph
 
 if TYPE_CHECKING:
-    from dcsim_plugins.path_planners.ant_colony import AntColonyParams
+    from dcsim_plugins.path_planners.ant_colony.planner import AntColonyParams
 
 _BELOW_ONE = 1.0 - 2.0**-30  # largest roulette draw: p + draw < p + 1 for any node p
 

@@ -32,7 +32,7 @@ from typing import Any
 
 import click
 import numpy as np
-from dcsim_plugins.path_planners.q_learning import QLearningPlanner
+from dcsim_plugins.path_planners.q_learning.planner import QLearningPlanner
 
 from dcsim.api import (
     PathProblem,

@@ -85,13 +85,12 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
-from dcsim_plugins.path_planners.closing_manoeuvre import Closing, ClosingManoeuvre
 from dcsim_plugins.path_planners.obstacle_field import (
     ObstacleField,
     endpoint_refusal,
 )
-from dcsim_plugins.path_planners.ompl_support import in_worker, seed_ompl
-from dcsim_plugins.path_planners.rigid_body import (
+from dcsim_plugins.path_planners.ompl.closing_manoeuvre import Closing, ClosingManoeuvre
+from dcsim_plugins.path_planners.ompl.rigid_body import (
     DIMENSION,
     DV,
     Model,
@@ -102,6 +101,7 @@ from dcsim_plugins.path_planners.rigid_body import (
     W,
     state_vector,
 )
+from dcsim_plugins.path_planners.ompl.support import in_worker, seed_ompl
 from ompl import base as ob
 from ompl import control as oc
 from pydantic import field_validator

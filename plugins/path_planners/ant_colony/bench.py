@@ -47,7 +47,7 @@ from typing import Any
 
 import click
 import numpy as np
-from dcsim_plugins.path_planners.ant_colony import AntColonyPlanner
+from dcsim_plugins.path_planners.ant_colony.planner import AntColonyPlanner
 
 from dcsim.api import (
     BenchProblem,

@@ -21,7 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from dcsim_plugins.task_planners.ga_problem import TaskProblem
+from dcsim_plugins.task_planners.ga.problem import TaskProblem
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,6 @@
 """A task request as arrays, for evaluating whole populations of plans at once.
 
-The ``ga`` planner's model of a plan (see :mod:`dcsim_plugins.task_planners.ga`): the
+The ``ga`` planner's model of a plan (see :mod:`dcsim_plugins.task_planners.ga.planner`): the
 collector flies straight constant-velocity legs between timed nodes — its start, each
 pickup, each drop visit — and burns impulsively at every node to match the node's
 velocity. A leg from ``(p_a, u_a)`` at ``t_a`` to ``(p_b, u_b)`` at ``t_b`` costs

@@ -60,8 +60,8 @@ import time
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
-from dcsim_plugins.path_planners.colony import ColonyResult, solve_colony
-from dcsim_plugins.path_planners.layered_graph import (
+from dcsim_plugins.path_planners.ant_colony.colony import ColonyResult, solve_colony
+from dcsim_plugins.path_planners.ant_colony.layered_graph import (
     GraphUnfinished,
     LayeredGraph,
     build_graph,
@@ -284,6 +284,6 @@ def dcsim_plugin_classes() -> list[type]:
 @hookimpl
 def dcsim_register_commands(bench: click.Group) -> None:
     """Add ``dcsim bench ant-colony``: the colony against its graph's exact optimum."""
-    from dcsim_plugins.path_planners.ant_colony_bench import command
+    from dcsim_plugins.path_planners.ant_colony.bench import command
 
     bench.add_command(command)

@@ -33,16 +33,16 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from dcsim_plugins.path_planners.cell_environment import (
+from dcsim_plugins.path_planners.deadline import OutOfTime
+from dcsim_plugins.path_planners.end_effector_line import unreachable
+from dcsim_plugins.path_planners.minimum_jerk import minimum_jerk_legs
+from dcsim_plugins.path_planners.q_learning.cells import (
     CellEnvironment,
     CellRules,
     TooManyCells,
     build_environment,
 )
-from dcsim_plugins.path_planners.deadline import OutOfTime
-from dcsim_plugins.path_planners.end_effector_line import unreachable
-from dcsim_plugins.path_planners.minimum_jerk import minimum_jerk_legs
-from dcsim_plugins.path_planners.tabular_q import (
+from dcsim_plugins.path_planners.q_learning.tabular_q import (
     Rollout,
     Schedule,
     Training,
@@ -347,6 +347,6 @@ def dcsim_plugin_classes() -> list[type]:
 @hookimpl
 def dcsim_register_commands(bench: click.Group) -> None:
     """Add ``dcsim bench q-learning``: the planner against value iteration on its cells."""
-    from dcsim_plugins.path_planners.q_learning_bench import command
+    from dcsim_plugins.path_planners.q_learning.bench import command
 
     bench.add_command(command)
