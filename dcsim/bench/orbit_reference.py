@@ -255,9 +255,9 @@ class LvlhFrame:
             ``r_c + Cρ`` (m) and ``v_c + C(ρ̇ + ω × ρ)`` (m/s), ECI.
         """
         rotation = self.rotation[..., None, :, :]
-        inertial_rate = rhodot + np.cross(self.rate[..., None, :], rho)
+        relative_velocity = rhodot + np.cross(self.rate[..., None, :], rho)
         position = self.position[..., None, :] + _apply(rotation, rho)
-        return position, self.velocity[..., None, :] + _apply(rotation, inertial_rate)
+        return position, self.velocity[..., None, :] + _apply(rotation, relative_velocity)
 
     def from_inertial(self, position: Array, velocity: Array) -> tuple[Array, Array]:
         """Deputies' relative states from their ECI states, inverse of :meth:`to_inertial`.
@@ -306,7 +306,7 @@ def propagate_inertial(
     position, velocity : ndarray (n, 3)
         ECI positions (m) and velocities (m/s) at t = 0.
     times : ndarray (m,)
-        Non-decreasing output times ≥ 0, s.
+        Non-decreasing output times ≥ 0, the last > 0, s.
     model : {"two-body", "j2"}
         Gravity model, see :func:`gravity`.
     mu, radius, j2 : float
@@ -322,8 +322,10 @@ def propagate_inertial(
         ECI positions (m) and velocities (m/s) at ``times``.
     """
     times = np.asarray(times, float)
-    if times.ndim != 1 or times.size == 0 or times[0] < 0 or np.any(np.diff(times) < 0):
-        raise ValueError("times must be a non-empty, non-decreasing 1-D array of times ≥ 0 s")
+    if times.ndim != 1 or times.size == 0 or times[0] < 0 or times[-1] <= 0:
+        raise ValueError("times must be a 1-D array of times ≥ 0 s ending after 0 s")
+    if np.any(np.diff(times) < 0):
+        raise ValueError("times must be non-decreasing")
     _check_model(model)
     position, velocity = np.asarray(position, float), np.asarray(velocity, float)
     n = position.shape[0]
@@ -397,7 +399,7 @@ def propagate_relative(
         Deputies' relative positions (m) and velocities seen in the rotating frame (m/s)
         at t = 0, LVLH components.
     times : ndarray (m,)
-        Non-decreasing output times ≥ 0, s.
+        Non-decreasing output times ≥ 0, the last > 0, s.
     model : {"two-body", "j2"}
         Gravity model acting on chief and deputies alike.
     mu, radius, j2 : float

@@ -180,7 +180,9 @@ def test_unknown_models_and_bad_times_are_refused():
     with pytest.raises(ValueError, match="unknown orbit model 'j3'; use one of two-body, j2"):
         ref.propagate_inertial(position[None], velocity[None], [0.0, 1.0], "j3")
     with pytest.raises(ValueError, match="non-decreasing"):
-        ref.propagate_inertial(position[None], velocity[None], [1.0, 0.0])
+        ref.propagate_inertial(position[None], velocity[None], [1.0, 0.0, 2.0])
+    with pytest.raises(ValueError, match="ending after 0 s"):
+        ref.propagate_inertial(position[None], velocity[None], [0.0])
 
 
 @needs_brahe
@@ -205,8 +207,8 @@ def test_brahe_ends_one_orbit_where_the_reference_does(model):
     brahe (RKN12(10), tolerance 1e-12) and in the reference (DOP853, rtol 1e-12).
 
     Measured: 1.25e-5 m apart in ECI for both models, which is the reference's own
-    integration error (tightening it to rtol 1e-13 moves its end by 1.1e-5 m), and
-    5e-8 m apart in the deputy's position relative to the chief. Under J2 the chief ends
+    integration error (tightening it to rtol 1e-13 moves its end by 1.1e-5 m), 1.4e-8 m/s
+    in velocity, and 1e-7 m apart in the deputy's position relative to the chief. Under J2 the chief ends
     kilometres from its two-body end, so the J2 agreement is not two-body's."""
     chief = ref.elements_to_state(LEO, BRAHE_CONSTANTS["mu"])
     frame = ref.LvlhFrame.of_chief(*chief, ref.gravity(chief[0], model, **BRAHE_CONSTANTS))
