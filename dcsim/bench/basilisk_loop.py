@@ -278,7 +278,7 @@ def _build(m: _Modules, setup: BasiliskSetup) -> _Loop:
     control = _attitude_loop(m, loop, setup, navigation, vehicle_msg)
     actuator.cmdTorqueInMsg.subscribeTo(control.cmdTorqueOutMsg)
     if setup.position_gains is not None:
-        hold = _position_loop(m, loop, setup, navigation, vehicle_msg)
+        hold = _position_loop(m, loop, setup.position_gains, navigation, vehicle_msg)
         actuator.cmdForceInertialInMsg.subscribeTo(hold.forceOutMsg)
     loop.add("fsw", actuator)
     loop.states = hub.scStateOutMsg.recorder(_nanos(setup.control_period))
@@ -324,14 +324,15 @@ def _attitude_loop(
 
 
 def _position_loop(
-    m: _Modules, loop: _Loop, setup: BasiliskSetup, navigation: Any, vehicle_msg: Any
+    m: _Modules, loop: _Loop, gains: tuple[float, float], navigation: Any, vehicle_msg: Any
 ) -> Any:
-    """hillFrameRelativeControl about a constant chief at the hold point."""
+    """hillFrameRelativeControl about a constant chief at the hold point, with the
+    setup's ``position_gains`` K (1/s²) and P (1/s)."""
     chief = m.messaging.NavTransMsgPayload()
     chief.r_BN_N = list(HOLD_POINT)
     chief.v_BN_N = [0.0, CHIEF_SPEED, 0.0]
     chief_msg = m.messaging.NavTransMsg().write(chief)
-    k, p = setup.position_gains
+    k, p = gains
     hold = m.hillFrameRelativeControl.HillFrameRelativeControl()
     hold.ModelTag = "hillFrameRelativeControl"
     hold.chiefTransInMsg.subscribeTo(chief_msg)

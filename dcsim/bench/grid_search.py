@@ -29,6 +29,7 @@ from dcsim.bench.path_planners import Flight, fly
 from dcsim.bench.path_problems import BenchProblem, load_problem
 from dcsim.messages import CostWeights, NoPath, PathProblem, Trajectory
 from dcsim.registry.discovery import PluginRegistry
+from dcsim.registry.interfaces import PathPlanner
 from dcsim.yardsticks.clearance import path_clearance
 
 FOOT = 0.3048
@@ -132,7 +133,10 @@ def plan_cell(
     params: Mapping[str, Any] | None = None,
 ) -> Cell:
     """Plan one cell in this process and judge the plan with the swept clearance."""
-    plugin = registry.get("path_planner", planner).cls(params, np.random.default_rng(0))
+    planner_class = registry.get("path_planner", planner).cls
+    # the registry files plugins by their class's kind
+    assert issubclass(planner_class, PathPlanner)
+    plugin = planner_class(params, np.random.default_rng(0))
     began = time.perf_counter()
     answer = plugin.plan(problem)
     seconds = time.perf_counter() - began
@@ -274,7 +278,7 @@ def tables(cells: Sequence[Cell]) -> str:
         )
     lines.append("")
     lines.append(f"The paper's three-burn path to the third goal: {PAPER_THREE_BURN} ft/s.")
-    flown = [c for c in cells if c.flight is not None]
+    flown = [(c, c.flight) for c in cells if c.flight is not None]
     if flown:
         lines += [
             "",
@@ -284,11 +288,11 @@ def tables(cells: Sequence[Cell]) -> str:
             "| planned / flown delta-v, ft/s | flown − planned |",
             "|---|---|---|---|---|---|---|",
         ]
-        for c in flown:
-            flown_dv = c.flight.delta_v / FOOT
+        for c, flight in flown:
+            flown_dv = flight.delta_v / FOOT
             lines.append(
                 f"| {c.planner} | {c.goal} | ({c.weights[0]:g}, {c.weights[1]:g}) | "
-                f"{'yes' if c.flight.reached else 'no'} | {c.flight.collisions} | "
+                f"{'yes' if flight.reached else 'no'} | {flight.collisions} | "
                 f"{c.delta_v:.3f} / {flown_dv:.3f} | {100 * (flown_dv / c.delta_v - 1):+.1f} % |"
             )
     return "\n".join(lines)

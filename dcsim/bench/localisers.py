@@ -25,6 +25,7 @@ import numpy as np
 from dcsim.bench.figures import pyplot, save
 from dcsim.messages import BeaconRange, MotionInput, Prior
 from dcsim.registry.discovery import PluginRegistry
+from dcsim.registry.interfaces import Localiser
 
 BEACONS = np.array(
     [
@@ -120,6 +121,7 @@ def fly(
 ) -> None:
     """Run one localiser through one run, recording errors, convergence and latency."""
     localiser = registry.create("localiser", name, params, np.random.default_rng(seed))
+    assert isinstance(localiser, Localiser)  # the registry files plugins by their class's kind
     localiser.reset(run.prior, 0.0)
     errors, converged_at = [], np.inf
     for k, (motion, ranges) in enumerate(zip(run.motions, run.ranges, strict=True)):

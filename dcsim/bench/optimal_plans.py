@@ -164,7 +164,7 @@ def _held_karp(cost: np.ndarray, n: int, capacity: int) -> tuple[list[int], list
         order.append(int(j))
         drops.append(after_drop)
         pj, pload, through = parent[mask, j, load]
-        mask &= ~(1 << j)
+        mask &= ~(1 << int(j))
         j, load, after_drop = pj, pload, bool(through)
     return order[::-1], drops[::-1]
 
@@ -199,8 +199,9 @@ def optimal_grid_plan(
     t0 = request.time
     grid = t0 + time_step * np.arange(1, int(horizon / time_step) + 1)
     states = [track.predict(grid) for track in request.targets]
+    drop_p, drop_v = request.drop_point.state_at(grid)
     states.append(
-        tuple(np.broadcast_to(a, grid.shape + (3,)) for a in request.drop_point.state_at(grid))
+        (np.broadcast_to(drop_p, grid.shape + (3,)), np.broadcast_to(drop_v, grid.shape + (3,)))
     )
     position = np.stack([p for p, _ in states])  # (n + 1, G, 3)
     velocity = np.stack([v for _, v in states])
@@ -274,7 +275,7 @@ def _grid_dp(legs: np.ndarray, first: np.ndarray, n: int, capacity: int):
                     _relax(value, parent, nxt, m, load + 1, src, direct[:, :, m, :], load, None)
                 _relax(value, parent, nxt, m, 1, src, via[:, :, m, :], load, via_k[:, :, m, :])
     final_cost = value[full] + np.min(legs[:n, :, drop, :], axis=-1)[:, None, :]
-    j, load, k = np.unravel_index(np.argmin(final_cost), final_cost.shape)
+    j, load, k = map(int, np.unravel_index(np.argmin(final_cost), final_cost.shape))
     if not np.isfinite(final_cost[j, load, k]):
         raise ValueError("no feasible plan on the grid visits every target")
     last_drop = int(np.argmin(legs[j, k, drop, :]))
@@ -286,7 +287,7 @@ def _grid_dp(legs: np.ndarray, first: np.ndarray, n: int, capacity: int):
         drops.append(pending_drop >= 0)
         drop_k.append(int(pending_drop))
         pj, pload, pk, dk = parent[mask, j, load, k]
-        mask &= ~(1 << j)
+        mask &= ~(1 << int(j))
         j, load, k, pending_drop = pj, pload, pk, dk
     return order[::-1], drops[::-1], pick_k[::-1], drop_k[::-1]
 

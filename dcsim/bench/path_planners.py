@@ -47,6 +47,7 @@ from dcsim.bench.path_problems import BenchProblem
 from dcsim.errors import DcsimError
 from dcsim.messages import NoPath, PathProblem, Trajectory
 from dcsim.registry.discovery import PluginRegistry, RegisteredPlugin
+from dcsim.registry.interfaces import Plugin
 from dcsim.run.loop import Runner
 from dcsim.run.seeding import component_rng
 from dcsim.run.setup import RunSetup
@@ -80,7 +81,7 @@ class PlannerChoice:
     params: Mapping[str, Any] = field(default_factory=dict)
 
     @property
-    def cls(self) -> type:
+    def cls(self) -> type[Plugin]:
         """The plugin class."""
         return self.entry.cls
 

@@ -103,9 +103,9 @@ class BulletModel:
 
     def jacobian(self, q: Array) -> Array:
         """The end effector's ``[v; ω]`` Jacobian in dcsim's frame and order (6, 6 + n)."""
-        linear, angular = self.calls(q, np.zeros(6 + self.n_joints))["jacobian"]()
+        linear, angular = np.asarray(self.calls(q, np.zeros(6 + self.n_joints))["jacobian"]())
         rotation = rotation_matrix(q[3:7])
-        theirs = np.vstack([rotation @ np.array(linear), rotation @ np.array(angular)])
+        theirs = np.vstack([rotation @ linear, rotation @ angular])
         return theirs @ bullet_velocity_map(q)
 
     def calls(self, q: Array, qd: Array) -> Calls:
@@ -180,11 +180,12 @@ class PinocchioModel:
         is its acceleration ``[−ω × v, 0, 0]`` (local), so ``C q̇`` is the inverse
         dynamics (RNEA) there.
         """
-        return pinocchio_velocity_map(q).T @ self.calls(q, qd)["bias"]()
+        return pinocchio_velocity_map(q).T @ np.asarray(self.calls(q, qd)["bias"]())
 
     def jacobian(self, q: Array) -> Array:
         """The end effector's ``[v; ω]`` Jacobian in dcsim's frame and order (6, 6 + n)."""
-        return self.calls(q, np.zeros(self.model.nv))["jacobian"]() @ pinocchio_velocity_map(q)
+        theirs = np.asarray(self.calls(q, np.zeros(self.model.nv))["jacobian"]())
+        return theirs @ pinocchio_velocity_map(q)
 
     def end_effector_pose(self, q: Array) -> tuple[Array, Array]:
         """The end effector's position (3,), m, and attitude (3, 3), world frame."""

@@ -25,6 +25,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
@@ -43,6 +44,7 @@ from dcsim.api import (
 from dcsim.bench.figures import pyplot, save
 from dcsim.bench.optimal_plans import LegRules, optimal_grid_plan, optimal_static_plan
 from dcsim.registry.discovery import PluginRegistry
+from dcsim.registry.interfaces import TaskPlanner
 
 AREA = 50.0
 """Half-width of the cube the targets start in, m."""
@@ -53,6 +55,26 @@ TARGET_SPEED_SIGMA = 0.02
 CAPACITY = 3
 MAX_SPEED = 0.5
 MAX_ACCELERATION = 0.02
+
+
+class _SearchCount(Protocol):
+    """The part of the ga planner's ``statistics`` the strategy bench reads."""
+
+    @property
+    def iterations(self) -> int:
+        """Generations run by the last plan."""
+        ...
+
+
+@runtime_checkable
+class _SearchingPlanner(Protocol):
+    """A task planner that reports its last search in ``statistics`` (the ga planner)."""
+
+    @property
+    def statistics(self) -> _SearchCount:
+        """How the last plan's search went."""
+        ...
+
 
 PLAN_MODEL = LegRules(time_weight=0.005, min_time_step=1.0, speed_fraction=0.8, max_leg_time=600.0)
 """The plan model the optimum is exact for, and the planners are configured with."""
@@ -90,7 +112,7 @@ def random_request(
         )
     return TaskRequest(
         time=0.0,
-        robot=StateEstimate(time=0.0, position=[0.0, 0.0, 0.0], converged=True),
+        robot=StateEstimate(time=0.0, position=np.zeros(3), converged=True),
         targets=tuple(tracks),
         drop_point=DropPoint(StaticMotion(rng.uniform(-DROP_AREA, DROP_AREA, 3)), tolerance=1.0),
         capacity=CAPACITY,
@@ -100,9 +122,12 @@ def random_request(
     )
 
 
-def _plan(registry: PluginRegistry, name: str, params: dict, seed: int, request: TaskRequest):
+def _plan(
+    registry: PluginRegistry, name: str, params: dict, seed: int, request: TaskRequest
+) -> tuple[Plan, float, TaskPlanner]:
     """Plan with a fresh planner; return the plan, the wall time and the planner."""
     planner = registry.create("task_planner", name, params, np.random.default_rng(seed))
+    assert isinstance(planner, TaskPlanner)  # the registry files plugins by their class's kind
     start = time.perf_counter()
     plan = planner.plan(request)
     return plan, time.perf_counter() - start, planner
@@ -146,6 +171,7 @@ def compare_strategies(
             result = StrategyResult(label, n)
             for seed, request in enumerate(requests):
                 plan, seconds, planner = _plan(registry, "ga", params, seed, request)
+                assert isinstance(planner, _SearchingPlanner)  # ga reports its search
                 result.costs.append(plan.cost)  # ga's cost is plan_cost with its time weight
                 result.iterations.append(planner.statistics.iterations)
                 result.seconds.append(seconds)
@@ -260,7 +286,7 @@ def optimality_gaps(
     cases = [(False, n, instances) for n in static_sizes] + [
         (True, n, moving_instances) for n in moving_sizes
     ]
-    results = []
+    results: list[GapResult] = []
     for moving, n, count in cases:
         rows = {label: GapResult(label, moving, n) for label, _, _ in planners}
         for seed in range(count):

@@ -228,6 +228,7 @@ def loop_floor(
         forced = _best(lambda: _step_with_forces(world, steps), repeats)
         ranges = world.beacon_ranges()
         localiser = setup.plugins["localiser"]
+        assert isinstance(localiser, Localiser)  # the run set it up for the localiser role
         position = world.base_state()[0]
         _localise(localiser, ranges, position, 1, world.control_period)  # imports on first use
         timed = _best(

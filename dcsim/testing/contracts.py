@@ -15,7 +15,7 @@ import inspect
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, NoReturn
+from typing import Any, NoReturn, TypeVar
 
 import numpy as np
 
@@ -39,6 +39,8 @@ LOCALISER_ERROR_BOUND = 1.0
 
 TIME_SLACK = 0.2
 """Wall time (s) allowed beyond a time budget (and 20 % of it) for returning."""
+
+P = TypeVar("P", bound=Plugin)
 
 
 class ContractViolation(AssertionError):
@@ -133,9 +135,15 @@ def _label(plugin_class: type) -> str:
     return f"{kind} plugin '{getattr(plugin_class, 'name', plugin_class.__name__)}'"
 
 
-def make(plugin_class: type[Plugin], params: Any = None, seed: int = SEED) -> Plugin:
+def make(plugin_class: type[P], params: Any = None, seed: int = SEED) -> P:
     """A plugin instance with ``params`` (defaults if None) and a generator seeded with ``seed``."""
     return plugin_class(params, np.random.default_rng(seed))
+
+
+def not_derived(plugin_class: type[Plugin], base: type) -> NoReturn:
+    """Fail a check that drives a plugin through the interface of ``base``, its kind's
+    class, which ``plugin_class`` does not derive from."""
+    fail(f"{_label(plugin_class)} does not derive from {base.__name__}")
 
 
 def fail(message: str) -> NoReturn:
@@ -430,10 +438,13 @@ def check_outputs(plugin_class: type[Plugin]) -> None:
     "truth: it works from its inputs alone",
 )
 def check_public_api(plugin_class: type[Plugin]) -> None:
-    try:
-        source = inspect.getsource(inspect.getmodule(plugin_class))
-    except (OSError, TypeError):
+    module = inspect.getmodule(plugin_class)
+    if module is None:
         return  # classes defined interactively have no source to read
+    try:
+        source = inspect.getsource(module)
+    except (OSError, TypeError):
+        return  # nor do those of built-in or compiled modules
     for node in ast.walk(ast.parse(source)):
         names = []
         if isinstance(node, ast.Import):

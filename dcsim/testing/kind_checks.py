@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Callable
+from functools import partial
 
 import numpy as np
 
@@ -23,7 +24,7 @@ from dcsim.messages import (
     Surroundings,
     Trajectory,
 )
-from dcsim.registry.interfaces import Plugin
+from dcsim.registry.interfaces import Controller, PathPlanner, Plugin, TaskPlanner
 from dcsim.testing import problems
 from dcsim.testing.contracts import (
     LOCALISER_ERROR_BOUND,
@@ -32,6 +33,7 @@ from dcsim.testing.contracts import (
     contract,
     fail,
     make,
+    not_derived,
     problem_robot,
     run_plugin,
     standard_inputs,
@@ -179,12 +181,6 @@ def check_completeness(plugin_class: type[Plugin]) -> None:
         fail(f"targets {sorted(missing)} were left out of the plan")
 
 
-_BUDGET_PROBLEMS: dict[str, Callable[[float], object]] = {
-    "task_planner": lambda budget: problems.task_request(targets=15, time_budget=budget),
-    "path_planner": problems.enclosed_goal_problem,
-}
-
-
 @contract(
     "honours_time_budget",
     "a request for 15 targets (task planners), or a path problem whose goal is walled in by "
@@ -194,19 +190,27 @@ _BUDGET_PROBLEMS: dict[str, Callable[[float], object]] = {
     kinds=("task_planner", "path_planner"),
 )
 def check_budget(plugin_class: type[Plugin]) -> None:
-    if plugin_class.kind == "path_planner" and problem_robot(plugin_class) == "manipulator":
-        request = problems.reach_problem(0.3)
+    budget = 0.3
+    plan: Callable[[], object]
+    if plugin_class.kind == "task_planner":
+        request = problems.task_request(targets=15, time_budget=budget)
+        if not issubclass(plugin_class, TaskPlanner):
+            not_derived(plugin_class, TaskPlanner)
+        plan = partial(make(plugin_class).plan, request)
     else:
-        request = _BUDGET_PROBLEMS[plugin_class.kind](0.3)
-        if plugin_class.kind == "path_planner":
-            request = problems.posed(plugin_class, request)
-    plugin = make(plugin_class)
+        if problem_robot(plugin_class) == "manipulator":
+            problem = problems.reach_problem(budget)
+        else:
+            problem = problems.posed(plugin_class, problems.enclosed_goal_problem(budget))
+        if not issubclass(plugin_class, PathPlanner):
+            not_derived(plugin_class, PathPlanner)
+        plan = partial(make(plugin_class).plan, problem)
     start = time.perf_counter()
-    answer = plugin.plan(request)
+    answer = plan()
     elapsed = time.perf_counter() - start
-    if elapsed > 1.2 * request.time_budget + TIME_SLACK:
-        fail(f"took {elapsed:.3f} s with a budget of {request.time_budget} s")
-    checked_answer(plugin_class.kind, answer, f"a problem with a {request.time_budget:g} s budget")
+    if elapsed > 1.2 * budget + TIME_SLACK:
+        fail(f"took {elapsed:.3f} s with a budget of {budget} s")
+    checked_answer(plugin_class.kind, answer, f"a problem with a {budget:g} s budget")
 
 
 DEADLINE_AWAY = 0.3
@@ -229,6 +233,8 @@ def check_deadline(plugin_class: type[Plugin]) -> None:
         problem = problems.reach_problem(LONG_BUDGET)
     else:
         problem = problems.posed(plugin_class, problems.enclosed_goal_problem(LONG_BUDGET))
+    if not issubclass(plugin_class, PathPlanner):
+        not_derived(plugin_class, PathPlanner)
     plugin = make(plugin_class)
     deadline = time.monotonic() + DEADLINE_AWAY
     answer = plugin.plan(dataclasses.replace(problem, deadline=deadline))
@@ -325,6 +331,7 @@ def check_endpoints(plugin_class: type[Plugin]) -> None:
 def check_bounds(plugin_class: type[Plugin]) -> None:
     trajectory, problem = _standard_path(plugin_class)
     times, positions, _ = _fine_samples(trajectory, problem)
+    assert problem.bounds is not None  # the standard path problem is posed in a box
     outside = ~problem.bounds.contains(positions)
     if outside.any():
         i = int(np.flatnonzero(outside)[0])
@@ -508,6 +515,7 @@ def check_reach_endpoints(plugin_class: type[Plugin]) -> None:
     trajectory, problem = _reach_path(plugin_class)
     start = problem.start
     q = start.configuration
+    assert problem.model is not None  # the reach problem carries the manipulator's model
     end_effector = problem.model.forward_kinematics(q).end_effector
     _check_start(trajectory, dataclasses.replace(start, position=end_effector), "the reach problem")
     final = trajectory.end_state()
@@ -596,23 +604,23 @@ def check_rest(plugin_class: type[Plugin]) -> None:
         joints = problems.MANIPULATOR_JOINTS
         estimate = StateEstimate(
             time=0.0,
-            position=[3.0, -4.0, 5.0],
-            attitude=[0.0, 0.6, 0.0, 0.8],
+            position=np.array([3.0, -4.0, 5.0]),
+            attitude=np.array([0.0, 0.6, 0.0, 0.8]),
             joint_positions=joints,
             joint_velocities=np.zeros_like(joints),
             converged=True,
         )
         reference = Reference(
             time=0.0,
-            position=[3.0, -4.0, 5.0],
-            attitude=[0.0, 0.6, 0.0, 0.8],
+            position=np.array([3.0, -4.0, 5.0]),
+            attitude=np.array([0.0, 0.6, 0.0, 0.8]),
             joint_positions=joints,
         )
         what = "a manipulator at rest on its reference"
     else:
         robot = problems.ROBOT
-        estimate = StateEstimate(time=0.0, position=[3.0, -4.0, 5.0], converged=True)
-        reference = Reference(time=0.0, position=[3.0, -4.0, 5.0])
+        estimate = StateEstimate(time=0.0, position=np.array([3.0, -4.0, 5.0]), converged=True)
+        reference = Reference(time=0.0, position=np.array([3.0, -4.0, 5.0]))
         what = "a collector at rest on its reference"
     inputs = [robot, [(0.0, estimate, reference, Surroundings())]]
     command = run_plugin(plugin_class, inputs, what)[0]
@@ -633,10 +641,12 @@ def check_rest(plugin_class: type[Plugin]) -> None:
 )
 def check_double_integrator(plugin_class: type[Plugin]) -> None:
     robot, dt = problems.ROBOT, 0.1
+    if not issubclass(plugin_class, Controller):
+        not_derived(plugin_class, Controller)
     plugin = make(plugin_class)
     plugin.reset(robot)
     position, velocity = np.array([10.0, -5.0, 3.0]), np.zeros(3)
-    reference = Reference(time=0.0, position=[0.0, 0.0, 0.0])
+    reference = Reference(time=0.0, position=np.zeros(3))
     for k in range(10_000):
         estimate = StateEstimate(time=k * dt, position=position, velocity=velocity, converged=True)
         command = checked_answer(
@@ -666,11 +676,16 @@ CONVERGENCE_TIME = 15.0
 )
 def check_manipulator_convergence(plugin_class: type[Plugin]) -> None:
     robot = problems.manipulator_robot()
+    if not issubclass(plugin_class, Controller):
+        not_derived(plugin_class, Controller)
     plugin = make(plugin_class)
     plugin.reset(robot)
     joints = problems.MANIPULATOR_JOINTS
     reference = Reference(
-        time=0.0, position=[0.0, 0.0, 0.0], attitude=[0.0, 0.0, 0.0, 1.0], joint_positions=joints
+        time=0.0,
+        position=np.zeros(3),
+        attitude=np.array([0.0, 0.0, 0.0, 1.0]),
+        joint_positions=joints,
     )
     offset = np.array([0.05, -0.05, 0.05, -0.05, 0.05, -0.05])
     tilt = quaternion_from_rotation_vector([0.03, 0.0, 0.0])

@@ -86,7 +86,8 @@ def mission_check(name: str, contract: str) -> Callable:
 def _selectable(mission: type[Mission]) -> None:
     """Make ``mission`` the scenario's ``mission.type`` in this process, as installing
     its distribution would (a class not yet installed, under test)."""
-    if mission_types().get(getattr(mission, "type", None)) is not mission:
+    name = getattr(mission, "type", None)  # a class under test may lack it
+    if name is None or mission_types().get(name) is not mission:
         try:
             register_mission(mission)
         except (ValueError, AttributeError) as error:

@@ -117,7 +117,7 @@ def beacon_problem(
     prior = Prior(
         position=position + [30.0, -20.0, 20.0],
         position_sigma=50.0,
-        velocity=[0, 0, 0],
+        velocity=np.zeros(3),
         velocity_sigma=0.5,
     )
     out = []
@@ -182,7 +182,7 @@ def task_request(targets: int = 6, time_budget: float = 1.0, capacity: int = 2) 
     )
     return TaskRequest(
         time=100.0,
-        robot=StateEstimate(time=100.0, position=[0.0, 0.0, 0.0], converged=True),
+        robot=StateEstimate(time=100.0, position=np.zeros(3), converged=True),
         targets=tracks,
         drop_point=DropPoint(StaticMotion((-5.0, 0.0, 0.0)), tolerance=1.5),
         capacity=capacity,
@@ -213,10 +213,12 @@ def path_problem(time_budget: float = 1.0) -> PathProblem:
     Three spheres (two of them moving), a turned box and a turned cylinder; a safety
     margin of :data:`SAFETY_MARGIN`.
     """
-    box = Shape(ShapeKind.BOX, half_extents=(1.5, 1.0, 2.0), orientation=_turn((0, 0, 1), 30))
+    box = Shape(
+        ShapeKind.BOX, half_extents=np.array([1.5, 1.0, 2.0]), orientation=_turn((0, 0, 1), 30)
+    )
     cylinder = Shape(ShapeKind.CYLINDER, radius=1.0, height=3.0, orientation=_turn((1, 0, 0), 60))
     return PathProblem(
-        start=RobotState(time=0.0, position=[0.0, 0.0, 0.0]),
+        start=RobotState(time=0.0, position=np.zeros(3)),
         goal=GoalRegion(position=GOAL, tolerance=1.0),
         obstacles=(
             obstacle_track(1, (20.0, 12.0, 0.0), radius=2.0),
@@ -229,7 +231,7 @@ def path_problem(time_budget: float = 1.0) -> PathProblem:
         max_speed=ROBOT.max_speed,
         max_acceleration=0.025,
         max_delta_v=5.0,
-        bounds=Bounds(lower=[-10.0, -30.0, -30.0], upper=[60.0, 30.0, 30.0]),
+        bounds=Bounds(lower=np.array([-10.0, -30.0, -30.0]), upper=np.array([60.0, 30.0, 30.0])),
         time_budget=time_budget,
         safety_margin=SAFETY_MARGIN,
     )
@@ -243,7 +245,7 @@ def margin_problem(time_budget: float = 1.0) -> PathProblem:
     side = ROBOT.radius + 2.0 + DIRECT_GAP
     return dataclasses.replace(
         path_problem(time_budget),
-        goal=GoalRegion(position=(40.0, 0.0, 0.0), tolerance=1.0),
+        goal=GoalRegion(position=np.array([40.0, 0.0, 0.0]), tolerance=1.0),
         obstacles=(obstacle_track(1, (20.0, side, 0.0), radius=2.0),),
         safety_margin=WIDE_MARGIN,
     )
@@ -308,7 +310,7 @@ def enclosed_goal_problem(time_budget: float = 1.0, shell: int = 60) -> PathProb
 def outside_bounds_problem(time_budget: float = 1.0) -> PathProblem:
     """The standard path problem with the goal beyond its bounds."""
     problem = path_problem(time_budget)
-    goal = dataclasses.replace(problem.goal, position=[80.0, 5.0, 0.0])
+    goal = dataclasses.replace(problem.goal, position=np.array([80.0, 5.0, 0.0]))
     return dataclasses.replace(problem, goal=goal)
 
 
@@ -323,7 +325,7 @@ def held_still(problem: PathProblem) -> PathProblem:
                 track,
                 time=t,
                 position=position,
-                velocity=(0.0, 0.0, 0.0),
+                velocity=np.zeros(3),
                 motion=StaticMotion(position),
             )
         )

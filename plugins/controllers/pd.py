@@ -114,12 +114,14 @@ class PDController(Controller):
         force = clip_norm(self.robot.mass * acceleration, self.robot.max_force)
         if reference.attitude is None:
             return Command(force=force)
-        return Command(force=force, torque=self._torque(estimate, reference))
+        return Command(force=force, torque=self._torque(estimate, reference, reference.attitude))
 
-    def _torque(self, estimate: StateEstimate, reference: Reference) -> np.ndarray:
-        """The attitude loop's torque, world frame, N·m."""
+    def _torque(
+        self, estimate: StateEstimate, reference: Reference, attitude: np.ndarray
+    ) -> np.ndarray:
+        """The attitude loop's torque towards ``attitude`` (the reference's), world frame, N·m."""
         error = rotation_vector(
-            quaternion_multiply(reference.attitude, quaternion_conjugate(estimate.attitude))
+            quaternion_multiply(attitude, quaternion_conjugate(estimate.attitude))
         )
         limit = min(self.robot.max_angular_rate, reference.max_angular_rate)
         rate = clip_norm(

@@ -53,6 +53,7 @@ class EndEffectorLinePlanner(PathPlanner):
         refusal = unreachable(problem)
         if refusal is not None:
             return refusal
+        assert problem.model is not None  # unreachable() refuses a problem without one
         origin = problem.model.forward_kinematics(problem.start.configuration).end_effector
         target = problem.goal.position
         length = float(np.linalg.norm(target - origin))

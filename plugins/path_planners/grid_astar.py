@@ -267,7 +267,7 @@ def neighbour_moves(
     span = np.arange(-max(reach, 1), max(reach, 1) + 1)
     cube = np.array(np.meshgrid(span, span, span, indexing="ij")).reshape(3, -1).T
     lengths = np.linalg.norm(cube, axis=1)
-    moves = set()
+    moves: set[tuple[tuple[int, ...], int]] = set()
     for steps in range(1, max_leg_steps + 1):
         if steps * t > longest_duration:
             break
@@ -419,7 +419,7 @@ class GridSearch:
             margins = np.maximum(margins, 0.5 * self.params.check_spacing) + self.corner_cut
         inside = np.ones(len(durations), dtype=bool)
         if self.problem.bounds is not None:
-            inside = self.problem.bounds.contains(points).all(axis=1)
+            inside = np.all(self.problem.bounds.contains(points), axis=1)
         return inside & self.obstacles.clear_arcs(points, start_time + elapsed, margins, which)
 
     def _resting_clear(self, cell: tuple[int, int, int], position: np.ndarray) -> np.ndarray:
@@ -530,9 +530,9 @@ class GridSearch:
         arrivals = moves.arrivals(position, departures[rows], rows)
         fresh = []
         for row, cost, arrival in zip(rows, costs, arrivals, strict=True):
-            cell = tuple(int(c) for c in np.add(state.cell, moves.offsets[row]))
+            x, y, z = (int(c) for c in np.add(state.cell, moves.offsets[row]))
             child = SearchState(
-                cell, state.step + int(moves.steps[row]), int(row), arrival, float(cost), index
+                (x, y, z), state.step + int(moves.steps[row]), int(row), arrival, float(cost), index
             )
             key = self._key(child)
             if cost < self.best.get(key, math.inf):

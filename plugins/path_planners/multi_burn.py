@@ -231,6 +231,19 @@ class Assessment:
     violation: np.ndarray
     depth: np.ndarray | None = None
 
+    @property
+    def swept_depth(self) -> np.ndarray:
+        """``depth`` of an assessment made with ``sweep`` (C, k), m.
+
+        Raises
+        ------
+        ValueError
+            If the plans were not swept.
+        """
+        if self.depth is None:
+            raise ValueError("the plans were not swept: assess them with sweep=True")
+        return self.depth
+
 
 @dataclass(frozen=True)
 class Candidate:
@@ -442,7 +455,7 @@ class BurnSearch:
             durations,
             float(found.cost[0]),
             float(found.violation[0]),
-            found.depth[0],
+            found.swept_depth[0],
             step,
         )
         self._keep(candidate)
@@ -517,7 +530,7 @@ class BurnSearch:
             legs = np.flatnonzero(seed.depth > 0)
             if not len(legs):
                 legs = np.arange(len(seed.durations))
-            for leg in legs:
+            for leg in map(int, legs):
                 a, b = seed.positions[leg], seed.positions[leg + 1]
                 grow = max(0.5 * float(np.linalg.norm(b - a)), 2.0 * self.reach)
                 low, high = np.minimum(a, b) - grow, np.maximum(a, b) + grow
@@ -525,7 +538,7 @@ class BurnSearch:
                     low, high = np.maximum(low, bounds.lower), np.minimum(high, bounds.upper)
                 axes = [np.linspace(lo, hi, points) for lo, hi in zip(low, high, strict=True)]
                 grid = np.array(np.meshgrid(*axes, indexing="ij")).reshape(3, -1).T
-                spacing = float(np.mean((high - low) / (points - 1)))
+                grid_spacing = float(np.mean((high - low) / (points - 1)))
                 first = np.linalg.norm(grid - a, axis=1)
                 second = np.linalg.norm(b - grid, axis=1)
                 keep = (first > 1e-9) & (second > 1e-9)
@@ -555,7 +568,7 @@ class BurnSearch:
                     ],
                     axis=1,
                 )
-                parts.append((positions, durations, new, np.full(count, spacing)))
+                parts.append((positions, durations, new, np.full(count, grid_spacing)))
         positions, durations, new, spacing = (np.concatenate(p) for p in zip(*parts, strict=True))
         if self.total is not None:
             durations = durations * (self.total / durations.sum(axis=1, keepdims=True))
@@ -586,7 +599,7 @@ class BurnSearch:
             swept = self.assess(positions[rows], durations[rows], sweep=True)
             self.statistics.plans_tried += len(rows)
             for row, depth, violation, cost in zip(
-                rows, swept.depth, swept.violation, swept.cost, strict=True
+                rows, swept.swept_depth, swept.violation, swept.cost, strict=True
             ):
                 depths[int(row)] = depth
                 if violation == 0 and not np.any(depth > 0):
@@ -641,7 +654,11 @@ class BurnSearch:
             positions, durations = unpack(x)
             found = self.assess(positions[None], durations[None], sweep=True, slack=slack)
             self.statistics.plans_tried += 1
-            cost, violation, depth = float(found.cost[0]), float(found.violation[0]), found.depth[0]
+            cost, violation, depth = (
+                float(found.cost[0]),
+                float(found.violation[0]),
+                found.swept_depth[0],
+            )
             exact = np.maximum(depth - slack, 0.0)
             if violation == 0 and not np.any(exact > 0) and (best is None or cost < best.cost):
                 best = Candidate(positions, durations, cost, 0.0, exact, candidate.step)

@@ -118,12 +118,12 @@ class ObstacleField:
         reach = self.reach + margins
         gaps = np.linalg.norm(centres - points[:, None], axis=2) - self.bounding
         near = gaps < reach[:, None]
-        for i in np.flatnonzero(near.any(axis=0)):
-            if self.round[i]:
+        for j in np.flatnonzero(near.any(axis=0)):
+            if self.round[j]:
                 return False
-            rows = near[:, i]
-            body = (points[rows] - centres[rows, i]) @ self.to_body[i].T
-            exact = body_surface_distance(self.tracks[i].shape, body)
+            rows = near[:, j]
+            body = (points[rows] - centres[rows, j]) @ self.to_body[j].T
+            exact = body_surface_distance(self.tracks[j].shape, body)
             if np.any(exact < reach[rows]):
                 return False
         return True
@@ -236,7 +236,8 @@ class ObstacleField:
         """Id of an obstacle the robot sphere at ``point`` (m) at ``t`` (s) overlaps."""
         if not self.count:
             return None
-        hit = self._first_hit(*map(float, point), t, self.reach)
+        x, y, z = map(float, point)
+        hit = self._first_hit(x, y, z, t, self.reach)
         return None if hit is None else self.tracks[hit].id
 
 

@@ -16,8 +16,14 @@ from dcsim_plugins.localisers.trilateration import TrilaterationLocaliser
 from dcsim_plugins.path_planners.straight_line import StraightLinePlanner
 from dcsim_plugins.task_planners.nearest import NearestTaskPlanner
 
-from dcsim.api import Command, GoalRegion, NoPath, PluginRegistry, ShapeKind
-from dcsim.testing import CheckResult, ControllerContract, check_plugin, checks_for
+from dcsim.api import Command, GoalRegion, NoPath, Plugin, PluginRegistry, ShapeKind
+from dcsim.testing import (
+    CheckResult,
+    ContractViolation,
+    ControllerContract,
+    check_plugin,
+    checks_for,
+)
 from tests.testing.peeking_plugin import PeekingController
 
 # `fmu` needs an FMU to exist at all; tests/fmu/test_fmu_controller.py runs these checks
@@ -341,6 +347,20 @@ def test_a_class_that_is_no_plugin_fails_only_the_metadata_check():
     (result,) = check_plugin(int)
     assert result.check == "declares_metadata" and not result.passed
     assert "is not a plugin class" in result.message
+
+
+class ControllerByNameOnly(Plugin):
+    """Says it is a controller, but derives from no kind's class."""
+
+    kind = "controller"
+    name = "by-name-only"
+    summary = "A controller by its kind attribute alone."
+
+
+def test_a_check_run_alone_names_a_class_not_derived_from_its_kind():
+    (check,) = [c for c in checks_for("controller") if c.name == "stabilises_a_double_integrator"]
+    with pytest.raises(ContractViolation, match="does not derive from Controller"):
+        check.run(ControllerByNameOnly)
 
 
 class TestSubclassingTheContractRunsEveryCheck(ControllerContract):

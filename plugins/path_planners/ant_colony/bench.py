@@ -42,6 +42,7 @@ import re
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -285,20 +286,20 @@ def run_setting(
     """
     params = setting.params(extra)
     problem = bench.problem if budget is None else replace(bench.problem, time_budget=budget)
-    base = {"problem": bench.name, "setting": setting, "seed": seed}
+    start = partial(Run, bench.name, setting, seed)
     planner = AntColonyPlanner(params, np.random.default_rng(seed))
     began = time.perf_counter()
     try:
         graph = planner.candidate_graph(problem)
     except ValueError as exc:
-        return Run(**base, status="no graph", reason=str(exc))
+        return start(status="no graph", reason=str(exc))
     graph_seconds = time.perf_counter() - began
     began = time.perf_counter()
     optimum = layered_optimum(graph.lengths, graph.node_cost)
     dp_seconds = time.perf_counter() - began
-    timing = {"graph_seconds": graph_seconds, "dp_seconds": dp_seconds}
+    timed = partial(start, graph_seconds=graph_seconds, dp_seconds=dp_seconds)
     if not graph.has_path:
-        return Run(**base, status="no path", reason="every path is blocked", **timing)
+        return timed(status="no path", reason="every path is blocked")
     try:
         began = time.perf_counter()
         colony = planner.colony(graph)
@@ -308,12 +309,11 @@ def run_setting(
         answer = whole.plan(problem)
         plan_seconds = time.perf_counter() - began
     except Exception as exc:  # noqa: BLE001  (a planner fault is reported, not fatal)
-        return Run(**base, status="error", reason=f"{type(exc).__name__}: {exc}", **timing)
+        return timed(status="error", reason=f"{type(exc).__name__}: {exc}")
     history = np.asarray(colony.history, dtype=float)
     found = np.flatnonzero(history <= colony.cost)
     statistics = answer.statistics if isinstance(answer, Trajectory) else {}
-    return Run(
-        **base,
+    return timed(
         status="scored",
         optimum=optimum.cost,
         cost=float(colony.cost),
@@ -334,7 +334,6 @@ def run_setting(
         positions=graph.positions(np.asarray(colony.path)),
         optimum_positions=graph.positions(optimum.path),
         trajectory=answer if isinstance(answer, Trajectory) else None,
-        **timing,
     )
 
 
@@ -602,6 +601,7 @@ def paths_figure(runs: Sequence[Run], bench: BenchProblem, path: Path) -> None:
     run, the paper's literal colony (dashed).
     """
     plt = pyplot()
+    from matplotlib.artist import Artist
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
@@ -625,7 +625,9 @@ def paths_figure(runs: Sequence[Run], bench: BenchProblem, path: Path) -> None:
 
     def lines(run: Run) -> list[tuple[np.ndarray, dict[str, Any]]]:
         colour = _delta_colour(deltas, run.setting.delta)
-        drawn = []
+        # Only scored runs are drawn, and a scored run has both paths' points.
+        assert run.positions is not None and run.optimum_positions is not None
+        drawn: list[tuple[np.ndarray, dict[str, Any]]] = []
         if run.setting.variant == "defaults":
             if run.trajectory is not None:
                 drawn.append((run.trajectory.positions, {"color": colour, "lw": 2.4, "alpha": 0.8}))
@@ -675,7 +677,7 @@ def paths_figure(runs: Sequence[Run], bench: BenchProblem, path: Path) -> None:
             aspect="equal",
         )
         axis.grid(alpha=0.3)
-    handles = []
+    handles: list[Artist] = []
     for delta in deltas:
         colour = _delta_colour(deltas, delta)
         mine = [r for r in shown if r.setting.delta == delta]
@@ -717,9 +719,10 @@ def paths_figure(runs: Sequence[Run], bench: BenchProblem, path: Path) -> None:
         Patch(facecolor=_OBSTACLE, alpha=0.3, edgecolor=_OBSTACLE, label="obstacle"),
     ]
     figure.legend(handles=handles, loc="lower center", ncol=2, fontsize=9)
+    first = shown[0].positions if shown else None
     figure.suptitle(
         f"{bench.name}: ant colony paths for δ = {', '.join(f'{d:g}' for d in deltas)} m² "
-        f"({cross} cross-section, m = {len(shown[0].positions) - 1 if shown else '?'}; "
+        f"({cross} cross-section, m = {len(first) - 1 if first is not None else '?'}; "
         "the paper's Fig. 2)"
     )
     figure.tight_layout(rect=(0.0, 0.1, 1.0, 0.97), h_pad=3.0)
@@ -877,8 +880,9 @@ def distribution_plot(runs: Sequence[Run], path: Path) -> None:
 
 def _span(specs: Sequence[str]) -> str:
     """``static-spheres:0..99`` for consecutive seeds of one family, else the specs."""
-    match = [re.fullmatch(r"([a-z-]+):(\d+)", spec) for spec in specs]
-    if all(match) and len({m[1] for m in match}) == 1:
+    found = [re.fullmatch(r"([a-z-]+):(\d+)", spec) for spec in specs]
+    match = [m for m in found if m is not None]
+    if len(match) == len(specs) and len({m[1] for m in match}) == 1:
         seeds = [int(m[2]) for m in match]
         if seeds == list(range(seeds[0], seeds[0] + len(seeds))) and len(seeds) > 1:
             return f"{match[0][1]}:{seeds[0]}..{seeds[-1]}"

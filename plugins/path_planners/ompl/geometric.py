@@ -254,14 +254,18 @@ class OmplGeometricPlanner(PathPlanner):
         found = in_worker(solve, args, deadline)
         if found is None or found.points is None:
             return NoPath(f"no path within the {problem.time_budget:g} s budget")
-        return self._timed(problem, stopping, found)
+        return self._timed(problem, stopping, found.points, found.statistics)
 
     def _timed(
-        self, problem: PathProblem, stopping: Samples, found: Waypoints
+        self,
+        problem: PathProblem,
+        stopping: Samples,
+        points: np.ndarray,
+        statistics: dict[str, float],
     ) -> Trajectory | NoPath:
-        """The waypoints flown rest to rest after braking, waiting for the goal's time."""
+        """The waypoints ``points`` (k, 3) m flown rest to rest after braking, waiting for
+        the goal's time; ``statistics`` are the worker's figures."""
         pieces = [stopping] if len(stopping[0]) > 1 else []
-        points = found.points
         speed = self.params.speed_fraction * problem.max_speed
         pieces += [
             rest_to_rest_segment(a, b, speed, problem.max_acceleration)
@@ -289,7 +293,7 @@ class OmplGeometricPlanner(PathPlanner):
             times = np.append(times, times[-1] + 1e-3)
             positions = np.vstack([positions, positions[-1]])
             velocities = np.vstack([velocities, velocities[-1]])
-        return trajectory_of(problem, (times, positions, velocities), found.statistics)
+        return trajectory_of(problem, (times, positions, velocities), statistics)
 
 
 @hookimpl

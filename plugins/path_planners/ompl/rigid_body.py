@@ -10,6 +10,7 @@ vectors this short.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -80,7 +81,7 @@ class Model:
         a, tau = self.acceleration, self.torque
         return [-a, -a, -a, -tau, -tau, -tau], [a, a, a, tau, tau, tau]
 
-    def wrench(self, u: tuple[float, ...], q: tuple[float, ...]) -> tuple[float, ...]:
+    def wrench(self, u: tuple[float, ...], q: Sequence[float]) -> tuple[float, ...]:
         """Thrust acceleration (m/s², world) and torque (N·m, world) of control ``u`` at
         attitude ``q``, as ``(ax, ay, az, τx, τy, τz)``."""
         if self.discrete:

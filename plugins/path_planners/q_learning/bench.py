@@ -39,7 +39,6 @@ from dcsim.api import (
     Trajectory,
     comma_numbers,
     load_reach_problem,
-    load_scenario,
     optimal_values,
     pyplot,
     reachable_cells,
@@ -407,11 +406,6 @@ def run_applications(scenario: str | Path, seed: int = 0) -> list[Application]:
     ]
 
 
-def target_of(scenario: str | Path) -> np.ndarray:
-    """The scenario's target, m."""
-    return np.asarray(load_scenario(scenario).mission.target, dtype=float)
-
-
 # --------------------------------------------------------------------- command
 @click.command("q-learning", short_help="The q-learning planner against value iteration.")
 @click.option(
@@ -477,7 +471,7 @@ def command(
         figures_dir.mkdir(parents=True, exist_ok=True)
         plot_curves(reward_curves(problem, size_episodes), figures_dir / "q_learning_rewards.png")
         plot_sizes(sizes, figures_dir / "q_learning_sizes.png")
-        target = target_of(scenario)
+        target = problem.goal.position  # the reach mission's goal is about its target
         for case, name in zip(cases, ("start_a", "start_b"), strict=True):
             plot_application(case, target, figures_dir / f"q_learning_{name}.png")
         click.echo(f"\nfigures in {figures_dir}")

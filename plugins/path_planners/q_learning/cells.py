@@ -155,18 +155,23 @@ def build_environment(
 
     Raises
     ------
+    ValueError
+        If the problem carries no robot model (it is not a manipulator's).
     OutOfTime
         If the deadline passes first.
     TooManyCells
         If the grid would have more than ``rules.max_cells`` cells.
     """
     model, start = problem.model, problem.start
+    if model is None:
+        raise ValueError("a cell environment is a manipulator's: the problem carries no model")
     q0 = start.configuration
     first = model.forward_kinematics(q0).end_effector
     target_offset = np.rint((problem.goal.position - first) / rules.cell_size).astype(int)
     lower = np.minimum(0, target_offset) - rules.margin
     upper = np.maximum(0, target_offset) + rules.margin
-    shape = tuple(int(v) for v in upper - lower + 1)
+    nx, ny, nz = (int(v) for v in upper - lower + 1)
+    shape = (nx, ny, nz)
     if np.prod(shape, dtype=float) > rules.max_cells:
         raise TooManyCells(
             f"the grid would have {' × '.join(map(str, shape))} cells, more than max_cells = "

@@ -207,7 +207,8 @@ def min_distance_times(
         active = start <= k
         arrival = _retimed(problem, p, v, t, sub.order[:, k], sub.gaps[:, k], active)
         sub.gaps[:, k] = arrival - t
-        p, v, t = (*problem.state(sub.order[:, k], arrival), arrival)
+        p, v = problem.state(sub.order[:, k], arrival)
+        t = arrival
         going = sub.drops[:, k]
         at_drop = _retimed(problem, p, v, t, drop_obj, sub.drop_gaps[:, k], active & going)
         sub.drop_gaps[:, k] = np.where(going, at_drop - t, sub.drop_gaps[:, k])

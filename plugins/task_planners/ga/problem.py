@@ -214,5 +214,6 @@ class TaskProblem:
             t_from[:, None] + candidates,
         )
         feasible = np.where(tried.violation > 0, np.inf, tried.cost)
-        score = np.where(np.isfinite(feasible).any(axis=1)[:, None], feasible, tried.penalised())
+        any_feasible = np.any(np.isfinite(feasible), axis=1)
+        score = np.where(any_feasible[:, None], feasible, tried.penalised())
         return t_from + candidates[rows, np.argmin(score, axis=1)]
