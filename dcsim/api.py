@@ -30,7 +30,8 @@ Messages
     Sensing: :class:`ObjectTrack`, :class:`ObjectKind`, :class:`Shape`, :class:`ShapeKind`,
     :class:`BeaconRange`, :class:`Observations`, :class:`Surroundings`.
     Path planning: :class:`PathProblem`, :class:`GoalRegion`, :class:`FrameDynamics`,
-    :class:`FrameKind`, :class:`Bounds`, :class:`CostWeights`, :class:`Trajectory`,
+    :class:`FrameKind`, :class:`ChiefOrbit`, :class:`OrbitModel`, :class:`Bounds`,
+    :class:`CostWeights`, :class:`Trajectory`,
     :class:`NoPath`.
     Task planning (debris): :class:`TaskRequest`, :class:`PlanTask`, :class:`DropVisit`,
     :class:`Plan`, :class:`DropPoint`.
@@ -96,6 +97,7 @@ from dcsim.bench.options import comma_numbers, comma_words, plugin_spec
 from dcsim.errors import (
     DcsimError,
     DuplicatePluginError,
+    PlannerModelWarning,
     PlanOutlastsRunWarning,
     PluginError,
     PluginInterfaceError,
@@ -126,6 +128,7 @@ from dcsim.geometry import (
 from dcsim.messages import (
     BeaconRange,
     Bounds,
+    ChiefOrbit,
     Command,
     CostWeights,
     DropPoint,
@@ -139,6 +142,7 @@ from dcsim.messages import (
     ObjectKind,
     ObjectTrack,
     Observations,
+    OrbitModel,
     PathProblem,
     Plan,
     PlanTask,
@@ -283,6 +287,7 @@ __all__ = [
     "FmuError",
     "FmuInstance",
     "ForwardKinematics",
+    "ChiefOrbit",
     "FrameDynamics",
     "FrameKind",
     "GoalRegion",
@@ -307,6 +312,7 @@ __all__ = [
     "MotionInput",
     "MotionModel",
     "NoPath",
+    "OrbitModel",
     "ObjectKind",
     "ObjectTrack",
     "Observations",
@@ -321,6 +327,7 @@ __all__ = [
     "PlanTask",
     "Plugin",
     "PLUGIN_KINDS",
+    "PlannerModelWarning",
     "PlanOutlastsRunWarning",
     "PluginError",
     "RobotTypeError",

@@ -148,6 +148,11 @@ class PluginLoadWarning(UserWarning):
     """A plugin package could not be loaded; every other plugin still is."""
 
 
+class PlannerModelWarning(UserWarning):
+    """A planner plans with other orbital dynamics than the world moves bodies by (its
+    ``orbit_models`` do not include ``world.orbit.model``)."""
+
+
 class PlanOutlastsRunWarning(UserWarning):
     """A plan made during a run ends after ``world.duration``: the run will stop before
     the plan is flown to its end."""

@@ -10,11 +10,13 @@ command and limits), :mod:`~dcsim.messages.sensing` (objects, ranges, observatio
 from dcsim.messages.base import Message, array_field, message
 from dcsim.messages.planning import (
     Bounds,
+    ChiefOrbit,
     CostWeights,
     FrameDynamics,
     FrameKind,
     GoalRegion,
     NoPath,
+    OrbitModel,
     PathProblem,
     Trajectory,
 )
@@ -45,12 +47,14 @@ __all__ = [
     "CostWeights",
     "DropPoint",
     "DropVisit",
+    "ChiefOrbit",
     "FrameDynamics",
     "FrameKind",
     "GoalRegion",
     "Message",
     "MotionInput",
     "NoPath",
+    "OrbitModel",
     "ObjectKind",
     "ObjectTrack",
     "Observations",

@@ -128,9 +128,57 @@ class FrameKind(enum.StrEnum):
     CLOHESSY_WILTSHIRE = "clohessy-wiltshire"
 
 
+class OrbitModel(enum.StrEnum):
+    """How bodies move relative to the chief of an LVLH frame."""
+
+    CLOHESSY_WILTSHIRE = "cw"
+    TWO_BODY = "two-body"
+    J2 = "j2"
+
+
+@message
+class ChiefOrbit(Message):
+    """The chief's orbit of an LVLH world, for planners that model it exactly.
+
+    Attributes
+    ----------
+    model : OrbitModel
+        The world's relative dynamics.
+    semi_major_axis : float
+        m.
+    eccentricity : float
+        In [0, 1).
+    inclination, raan, argument_of_perigee, true_anomaly : float
+        The chief's elements at t = 0, rad.
+    mu : float
+        Gravitational parameter, m³/s².
+    j2 : float
+        Second zonal harmonic (felt under ``OrbitModel.J2`` only).
+    earth_radius : float
+        J2's reference radius, m.
+    """
+
+    model: OrbitModel
+    semi_major_axis: float
+    eccentricity: float = 0.0
+    inclination: float = 0.0
+    raan: float = 0.0
+    argument_of_perigee: float = 0.0
+    true_anomaly: float = 0.0
+    mu: float = 3.986004418e14
+    j2: float = 0.0
+    earth_radius: float = 6_378_137.0
+
+
 @message
 class FrameDynamics(Message):
-    """The frame's free motion: force-free, or Clohessy–Wiltshire about a circular orbit.
+    """The frame's free motion: force-free, or relative motion in an orbit's LVLH frame.
+
+    In an LVLH world the frame's dynamics are always given as Clohessy–Wiltshire with
+    the orbit's mean motion (every planner that models orbital motion knows them);
+    ``orbit`` says when the world moves bodies by an exact model instead, so that a
+    planner that knows it can use it and one that does not plans with the
+    linearisation (and says so: :attr:`~dcsim.api.PathPlanner.orbit_models`).
 
     Attributes
     ----------
@@ -139,10 +187,21 @@ class FrameDynamics(Message):
         radial, y along-track, z orbit normal).
     mean_motion : float
         Mean motion of the reference orbit, rad/s (Clohessy–Wiltshire only).
+    orbit : ChiefOrbit or None
+        The chief's orbit when the world's model is ``two-body`` or ``j2``; None under
+        Clohessy–Wiltshire and in an inertial frame.
     """
 
     kind: FrameKind = FrameKind.INERTIAL
     mean_motion: float = 0.0
+    orbit: ChiefOrbit | None = None
+
+    @property
+    def model(self) -> OrbitModel | None:
+        """The world's relative dynamics in an LVLH frame; None in an inertial one."""
+        if self.kind is FrameKind.INERTIAL:
+            return None
+        return OrbitModel.CLOHESSY_WILTSHIRE if self.orbit is None else self.orbit.model
 
 
 @message

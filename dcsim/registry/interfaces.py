@@ -115,9 +115,19 @@ class Localiser(Plugin):
 
 
 class TaskPlanner(Plugin):
-    """Orders pickups of moving targets, with drop-point visits when full."""
+    """Orders pickups of moving targets, with drop-point visits when full.
+
+    Attributes
+    ----------
+    orbit_models : tuple of str
+        The orbit models (``world.orbit.model``: ``cw``, ``two-body``, ``j2``) the planner
+        plans with exactly; ``("cw",)`` by default. In a world whose model is not among
+        them the planner plans with the Clohessy–Wiltshire linearisation, and the run
+        records a ``planner_model_differs`` event saying so.
+    """
 
     kind = "task_planner"
+    orbit_models: ClassVar[tuple[str, ...]] = ("cw",)
 
     @abstractmethod
     def plan(self, request: TaskRequest) -> Plan:
@@ -161,11 +171,17 @@ class PathPlanner(Plugin):
         that declares False answers every problem with a moving obstacle with a
         :class:`NoPath` saying so; the conformance suite then poses its path checks with
         the obstacles held where they are at the start, and checks that refusal.
+    orbit_models : tuple of str
+        The orbit models (``world.orbit.model``: ``cw``, ``two-body``, ``j2``) the planner
+        plans with exactly; ``("cw",)`` by default. In a world whose model is not among
+        them the planner plans with the Clohessy–Wiltshire linearisation the problem's
+        frame gives, and the run records a ``planner_model_differs`` event saying so.
     """
 
     kind = "path_planner"
     Params: ClassVar[type[PluginParams]] = PathPlannerParams
     handles_moving_obstacles: ClassVar[bool] = True
+    orbit_models: ClassVar[tuple[str, ...]] = ("cw",)
 
     @abstractmethod
     def plan(self, problem: PathProblem) -> Trajectory | NoPath:

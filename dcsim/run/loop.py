@@ -26,12 +26,14 @@ from __future__ import annotations
 import dataclasses
 import sys
 import time as wallclock
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from dcsim.errors import PlannerModelWarning
 from dcsim.messages import Command, Observations, Prior, StateEstimate
 from dcsim.missions import Mission, mission_class
 from dcsim.registry.calls import PluginFailure, call_plugin
@@ -330,6 +332,7 @@ class Runner:
         self.mission = self.mission_class(self.scenario, world, self.plugins, self._event)
         self.recorder.start(dump_scenario(self.scenario), self._summary_head("running", ""))
         self._hook("dcsim_run_start", run=self.info)
+        self._note_planner_models()
         # every tick's hook is called only when a plugin implements it
         self._step_observed = bool(self.setup.registry.hook.dcsim_run_step.get_hookimpls())
         if "localiser" in self.plugins:
@@ -338,6 +341,32 @@ class Runner:
         self._robot_changes = world.robot_changes
         self.laps.start()
         self._decide()
+
+    def _note_planner_models(self) -> None:
+        """Record which planners plan with another orbit model than the world's."""
+        world_model = self.scenario.frame_dynamics.model
+        if world_model is None:
+            return
+        for role in ("task_planner", "path_planner"):
+            plugin = self.plugins.get(role)
+            models = getattr(plugin, "orbit_models", None)
+            if plugin is None or models is None or world_model in models:
+                continue
+            name = self.setup.sources[role].name
+            self._event(
+                "planner_model_differs",
+                role=role,
+                plugin=name,
+                world_model=str(world_model),
+                planner_models=list(models),
+            )
+            warnings.warn(
+                f"{role.replace('_', ' ')} {name!r} models {', '.join(models) or 'no'} orbital "
+                f"dynamics, not the world's {world_model}: its plans are flown in a world it "
+                "does not model (world.orbit.model)",
+                PlannerModelWarning,
+                stacklevel=2,
+            )
 
     def _decide(self) -> None:
         """Sense, localise, run the mission and the controller at the current time."""

@@ -35,6 +35,7 @@ from dcsim.scenario.model import (
     MAX_PHYSICS_STEPS,
     MAX_STEPS_PER_CONTROL_PERIOD,
     MEAN_MOTION_RANGE,
+    OrbitSpec,
     Scenario,
     scenario_model,
 )
@@ -337,9 +338,22 @@ def _duration_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
 
 
 def _orbit_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
+    """The chief's orbit: one size, a mean motion in range, a perigee above the surface,
+    a circular orbit for ``cw``, an orbit model only in the LVLH frame."""
     if get("world", "frame") != "lvlh":
-        return []
-    radius, mu = get("world", "orbit", "radius"), get("world", "orbit", "mu")
+        if get("world", "orbit", "model") == "cw":
+            return []
+        return [(("world", "orbit", "model"), "an orbit model needs world.frame: lvlh")]
+    sizes = (get("world", "orbit", "radius"), get("world", "orbit", "altitude"))
+    if None not in sizes:
+        message = "give radius or altitude, not both"
+        return [(("world", "orbit", "altitude"), message)]
+    orbit = OrbitSpec(**{key: get("world", "orbit", key) for key in OrbitSpec.model_fields})
+    return [*_mean_motion_rule(orbit), *_perigee_rule(orbit), *_circular_cw_rule(orbit)]
+
+
+def _mean_motion_rule(orbit: OrbitSpec) -> list[tuple[KeyPath, str]]:
+    radius, mu = orbit.semi_major_axis, orbit.mu
     with np.errstate(all="ignore"):  # as mean_motion() computes it, overflow giving inf or 0
         rate = float(np.sqrt(np.float64(mu) / np.float64(radius) ** 3))
     low, high = MEAN_MOTION_RANGE
@@ -350,6 +364,31 @@ def _orbit_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
         f"change them so that it is between {low:g} and {high:g} rad/s"
     )
     return [(("world", "orbit"), message)]
+
+
+def _perigee_rule(orbit: OrbitSpec) -> list[tuple[KeyPath, str]]:
+    perigee = orbit.semi_major_axis * (1.0 - orbit.eccentricity)
+    if perigee > orbit.earth_radius:
+        return []
+    message = (
+        f"the perigee ({perigee:,.0f} m from the centre) is not above earth_radius "
+        f"({orbit.earth_radius:,.0f} m); raise the orbit or lower its eccentricity"
+    )
+    if orbit.eccentricity > 0:
+        key = "eccentricity"
+    else:
+        key = "altitude" if orbit.altitude is not None else "radius"
+    return [(("world", "orbit", key), message)]
+
+
+def _circular_cw_rule(orbit: OrbitSpec) -> list[tuple[KeyPath, str]]:
+    if orbit.model != "cw" or orbit.eccentricity == 0.0:
+        return []
+    message = (
+        "Clohessy-Wiltshire relative motion needs a circular orbit; set "
+        "world.orbit.model to two-body or j2 for an eccentric one"
+    )
+    return [(("world", "orbit", "eccentricity"), message)]
 
 
 def _propellant_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:

@@ -27,7 +27,7 @@ from pydantic import (
 )
 
 from dcsim.geometry import Vector, spherical_to_cartesian
-from dcsim.messages.planning import FrameDynamics, FrameKind
+from dcsim.messages.planning import ChiefOrbit, FrameDynamics, FrameKind, OrbitModel
 from dcsim.messages.sensing import Shape, ShapeKind
 from dcsim.motion import (
     STANDARD_GRAVITATIONAL_PARAMETER_EARTH,
@@ -160,11 +160,60 @@ MotionSpec = Annotated[
 """A motion, chosen by its ``type`` key: static, cartesian, spherical or cw."""
 
 
-class OrbitSpec(Section):
-    """The circular reference orbit of the LVLH frame."""
+EARTH_RADIUS = 6_378_137.0
+"""Earth's equatorial radius (WGS 84), m."""
 
-    radius: float = quantity(
-        6_778_137.0, unit="m", gt=0, description="Orbit radius (Earth radius + altitude)."
+EARTH_J2 = 1.08262668e-3
+"""Earth's second zonal harmonic J2 (dimensionless)."""
+
+DEFAULT_ORBIT_RADIUS = 6_778_137.0
+"""The default orbit's radius: 400 km above :data:`EARTH_RADIUS`, m."""
+
+OrbitModelName = Literal["cw", "two-body", "j2"]
+"""How bodies move relative to the chief: linearised (Clohessy–Wiltshire), exact
+two-body, or exact two-body with Earth's J2."""
+
+
+class OrbitSpec(Section):
+    """The chief's orbit, whose LVLH frame is the world frame, and the relative dynamics.
+
+    The frame is the chief's local-vertical local-horizontal frame at every instant: x
+    along the chief's position, z along its orbital angular momentum, y = z × x (along
+    track for a circular orbit). Under ``cw`` the orbit is circular and the relative
+    motion linearised; under ``two-body`` and ``j2`` every body moves under the exact
+    relative dynamics (J2 perturbs the chief too).
+    """
+
+    model: OrbitModelName = Field(
+        "cw",
+        description="Relative dynamics: `cw` (Clohessy–Wiltshire, circular orbit only), "
+        "`two-body` (exact Keplerian) or `j2` (exact, with Earth's J2 on every body).",
+    )
+    radius: float | None = quantity(
+        None,
+        unit="m",
+        gt=0,
+        description="Semi-major axis (a circular orbit's radius); "
+        f"{DEFAULT_ORBIT_RADIUS:,.0f} m (400 km up) when neither it nor altitude is given.",
+    )
+    altitude: float | None = quantity(
+        None,
+        unit="m",
+        gt=0,
+        description="Altitude of a circular orbit above earth_radius, instead of radius.",
+    )
+    eccentricity: float = quantity(
+        0.0, ge=0, lt=1, description="Eccentricity (0 for `cw`, which is circular)."
+    )
+    inclination: float = quantity(51.6, unit="deg", ge=0, le=180, description="Inclination.")
+    raan: float = quantity(
+        0.0, unit="deg", ge=0, lt=360, description="Right ascension of the ascending node."
+    )
+    argument_of_perigee: float = quantity(
+        0.0, unit="deg", ge=0, lt=360, description="Argument of perigee."
+    )
+    true_anomaly: float = quantity(
+        0.0, unit="deg", ge=0, lt=360, description="The chief's true anomaly at t = 0."
     )
     mu: float = quantity(
         STANDARD_GRAVITATIONAL_PARAMETER_EARTH,
@@ -172,11 +221,29 @@ class OrbitSpec(Section):
         gt=0,
         description="Gravitational parameter of the central body.",
     )
+    j2: float = quantity(
+        EARTH_J2, ge=0, description="Second zonal harmonic of the central body (model `j2`)."
+    )
+    earth_radius: float = quantity(
+        EARTH_RADIUS,
+        unit="m",
+        gt=0,
+        description="Equatorial radius of the central body (J2's reference radius).",
+    )
+
+    @property
+    def semi_major_axis(self) -> float:
+        """The orbit's semi-major axis, m (from ``radius``, ``altitude`` or the default)."""
+        if self.radius is not None:
+            return self.radius
+        if self.altitude is not None:
+            return self.earth_radius + self.altitude
+        return DEFAULT_ORBIT_RADIUS
 
     @property
     def mean_motion(self) -> float:
         """Mean motion of the orbit, rad/s."""
-        return mean_motion(self.radius, self.mu)
+        return mean_motion(self.semi_major_axis, self.mu)
 
 
 class WorldSpec(Section):
@@ -679,9 +746,29 @@ class Scenario(Section):
     @property
     def frame_dynamics(self) -> FrameDynamics:
         """The free dynamics of the world's frame, as path planners are told them."""
-        if self.world.frame == "lvlh":
+        if self.world.frame != "lvlh":
+            return FrameDynamics(FrameKind.INERTIAL)
+        orbit = self.world.orbit
+        if orbit.model == "cw":
             return FrameDynamics(FrameKind.CLOHESSY_WILTSHIRE, self.mean_motion)
-        return FrameDynamics(FrameKind.INERTIAL)
+        chief = ChiefOrbit(
+            OrbitModel(orbit.model),
+            orbit.semi_major_axis,
+            orbit.eccentricity,
+            *(
+                math.radians(angle)
+                for angle in (
+                    orbit.inclination,
+                    orbit.raan,
+                    orbit.argument_of_perigee,
+                    orbit.true_anomaly,
+                )
+            ),
+            orbit.mu,
+            orbit.j2,
+            orbit.earth_radius,
+        )
+        return FrameDynamics(FrameKind.CLOHESSY_WILTSHIRE, self.mean_motion, chief)
 
 
 @functools.cache

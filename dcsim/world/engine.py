@@ -54,6 +54,8 @@ from dcsim.world.environment import (
 from dcsim.world.free_flyer import FreeFlyerBody
 from dcsim.world.manipulator import ManipulatorBody
 from dcsim.world.objects import ObjectField, ObjectStatus, build_objects
+from dcsim.world.orbit.chief import relative_dynamics
+from dcsim.world.orbit.forces import ExactOrbitalForces
 from dcsim.world.payload import Payload
 from dcsim.world.pybullet_client import connect_direct, pb
 from dcsim.world.robot_body import RobotBody
@@ -160,8 +162,10 @@ class World:
         )
         self.collisions: list[CollisionEvent] = []
         self.inputs = WorldInputs()
-        self._mean_motion = scenario.mean_motion if scenario.world.frame == "lvlh" else None
-        self.field = ObjectField(build_objects(scenario))
+        orbit, lvlh = scenario.world.orbit, scenario.world.frame == "lvlh"
+        self._mean_motion = scenario.mean_motion if lvlh and orbit.model == "cw" else None
+        dynamics = relative_dynamics(orbit) if lvlh and orbit.model != "cw" else None
+        self.field = ObjectField(build_objects(scenario, dynamics))
         self._sensors = Sensors(scenario.beacons, robot.sensor_range, self.field, rng)
         self._client = connect_direct()
         # A world dropped without close() (an FMU reset does that) still disconnects.
@@ -178,6 +182,10 @@ class World:
         self._candidates = np.zeros(0, dtype=int)
         self._period_mass = self.assembly_mass()
         self._body_mass = robot.mass
+        self._exact_forces: ExactOrbitalForces | None = None
+        if dynamics is not None:
+            self._exact_forces = ExactOrbitalForces(self._client, dynamics, self.control_period)
+            self._exact_forces.stagger_velocity(self.robot_id, self.physics_step)
 
     # ------------------------------------------------------------------ state
     @property
@@ -381,7 +389,9 @@ class World:
             "robot.sensor_range": r.sensor_range,
             "robot.grab_distance": r.grab_distance,
             "robot.capacity": float(r.capacity),
-            "mean_motion": self._mean_motion or 0.0,
+            "mean_motion": self.scenario.mean_motion
+            if self.scenario.world.frame == "lvlh"
+            else 0.0,
         }
 
     def outputs(self) -> dict[str, object]:
@@ -420,6 +430,8 @@ class World:
         torque = clip_norm(self.inputs.torque, self.robot.max_torque)
         self._period_mass = self.assembly_mass()
         self._joint_torques = self._robot.clip_joint_torques(self.inputs.joint_torques)
+        if self._exact_forces is not None:
+            self._linearise_orbital_forces()
         self._update_broad_phase(force)
         disturbance = tuple(float(f) for f in self.inputs.disturbance_force)
         total_torque = tuple(
@@ -430,6 +442,16 @@ class World:
         self._set_body_mass(self.base_mass())
         self.collisions += started
         return started
+
+    def _linearise_orbital_forces(self) -> None:
+        """Expand the exact orbital acceleration of every body of the robot (base, cargo,
+        arm links) about its state at the coming period's start."""
+        assert self._exact_forces is not None
+        position, velocity, _, _ = self.base_state()
+        held = self._payload.held.items()
+        parts = [(c, -1, self.field.objects[i].mass) for i, (c, _) in held]
+        parts += [(self.robot_id, link, mass) for link, mass in self._robot.links]
+        self._exact_forces.begin_period(self.time, self.robot_id, (position, velocity), parts)
 
     def _set_body_mass(self, mass: float) -> None:
         """Give the robot's base ``mass``, kg (the orbital force on it uses it)."""
@@ -450,11 +472,12 @@ class World:
         apply_force, step = pb.applyExternalForce, pb.stepSimulation
         cargo = [(c, self.field.objects[i].mass) for i, (c, _) in self._payload.held.items()]
         robot, links = self._robot, self._robot.links
+        exact, dt = self._exact_forces, self.physics_step
         apply_torque = torque != (0.0, 0.0, 0.0)
         check_contacts = len(self._candidates) > 0
         dx, dy, dz = disturbance
         started: list[CollisionEvent] = []
-        for tx, ty, tz in thrusts:
+        for k, (tx, ty, tz) in enumerate(thrusts):
             position = get_pose(body, client)[0]
             fx, fy, fz = tx + dx, ty + dy, tz + dz
             if n is not None:
@@ -464,6 +487,11 @@ class World:
                     apply_cw_force(client, carried, carried_mass, n)
                 for link, link_mass in links:
                     apply_cw_force_on_link(client, body, link, link_mass, n)
+            elif exact is not None:
+                velocity = get_velocity(body, client)[0]
+                ax, ay, az = exact.base_acceleration(k * dt, body, position, velocity)
+                fx, fy, fz = fx + mass * ax, fy + mass * ay, fz + mass * az
+                exact.apply_to_parts(k * dt)
             robot.apply_joint_torques(self._joint_torques)
             apply_force(body, -1, (fx, fy, fz), position, pb.WORLD_FRAME, client)
             if apply_torque:
@@ -488,6 +516,8 @@ class World:
         accel = push / self._period_mass
         if self._mean_motion is not None:
             accel += 2 * length(cw_acceleration(self._mean_motion, position, velocity))
+        elif self._exact_forces is not None:
+            accel += 2 * length(np.array(self._exact_forces.base.base))
         sweep = length(velocity) * period + accel * period**2
         now = self.field.free_states(self.time)[0][free]
         later = self.field.free_states((self._steps + self.steps_per_control) * self.physics_step)[

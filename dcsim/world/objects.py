@@ -11,6 +11,9 @@ import numpy as np
 from dcsim.messages import ObjectKind, Shape, ShapeKind
 from dcsim.motion import MotionModel, MotionSet
 from dcsim.scenario.model import Scenario
+from dcsim.world.orbit.chief import orbit_period, relative_dynamics
+from dcsim.world.orbit.objects import ObjectOrbits, PropagatedMotion
+from dcsim.world.orbit.relative import RelativeDynamics
 
 
 class ObjectStatus(enum.IntEnum):
@@ -56,18 +59,44 @@ class SpaceObject:
 _FREE = int(ObjectStatus.FREE)
 
 
-def build_objects(scenario: Scenario) -> list[SpaceObject]:
+def build_objects(
+    scenario: Scenario, dynamics: RelativeDynamics | None = None
+) -> list[SpaceObject]:
     """The mission's targets and the scenario's obstacles as world objects (targets
-    first)."""
+    first).
+
+    In a ``two-body`` or ``j2`` world each motion spec gives only the object's state at
+    t = 0; the objects then move under the world's orbit model (``dynamics``, built from
+    the scenario's orbit if not given).
+    """
     n = scenario.mean_motion
-    return [
-        SpaceObject(spec.id, kind, spec.build_shape(), spec.mass, spec.motion.build(n))
+    specs = [
+        (kind, spec)
         for kind, specs in (
             (ObjectKind.TARGET, scenario.mission.target_specs()),
             (ObjectKind.OBSTACLE, scenario.obstacles),
         )
         for spec in specs
     ]
+    motions = [spec.motion.build(n) for _, spec in specs]
+    orbit = scenario.world.orbit
+    if scenario.world.frame == "lvlh" and orbit.model != "cw" and motions:
+        motions = _propagated(motions, dynamics or relative_dynamics(orbit), orbit_period(orbit))
+    return [
+        SpaceObject(spec.id, kind, spec.build_shape(), spec.mass, motion)
+        for (kind, spec), motion in zip(specs, motions, strict=True)
+    ]
+
+
+def _propagated(
+    motions: list[MotionModel], dynamics: RelativeDynamics, period: float
+) -> list[MotionModel]:
+    """Motions under the world's orbit model from the given motions' states at t = 0."""
+    start = [m.state_at(0.0) for m in motions]
+    orbits = ObjectOrbits(
+        dynamics, np.array([p for p, _ in start]), np.array([v for _, v in start]), period
+    )
+    return [PropagatedMotion(orbits, i) for i in range(len(motions))]
 
 
 class ObjectField:

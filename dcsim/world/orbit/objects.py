@@ -1,0 +1,109 @@
+"""Free objects moving under the world's orbit model, as motion models.
+
+Under ``two-body`` and ``j2`` an object's motion spec gives only its state at t = 0;
+from there it moves under the world's gravity. :class:`ObjectOrbits` maps every
+object's initial LVLH state to the inertial frame, propagates them together
+(:class:`~dcsim.world.orbit.propagation.NumericalOrbits`) and maps them back into the
+chief's LVLH frame at any time; :class:`PropagatedMotion` is one object's motion model
+over it, usable wherever a motion model is (tracks, planners' predictions, plots).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from dcsim.geometry import Vector
+from dcsim.motion import MotionModel
+from dcsim.world.orbit.frame import lvlh_axes, lvlh_rate, to_relative
+from dcsim.world.orbit.gravity import Gravity
+from dcsim.world.orbit.propagation import InertialMotion, NumericalOrbits
+from dcsim.world.orbit.relative import RelativeDynamics
+
+
+class ObjectOrbits:
+    """Objects propagated in the inertial frame, seen in the chief's LVLH frame.
+
+    Parameters
+    ----------
+    dynamics : RelativeDynamics
+        The chief and the gravity field.
+    positions, velocities : ndarray (N, 3)
+        The objects' LVLH states at t = 0, m and m/s.
+    period : float
+        The chief's orbital period, s (the propagation's span).
+    """
+
+    def __init__(
+        self, dynamics: RelativeDynamics, positions: Vector, velocities: Vector, period: float
+    ) -> None:
+        self._chief: InertialMotion = dynamics.chief
+        self._gravity: Gravity = dynamics.gravity
+        start = dynamics.frame(0.0)
+        inertial = start.to_inertial(np.asarray(positions, float), np.asarray(velocities, float))
+        self._orbits = NumericalOrbits(*inertial, self._gravity, period)
+        self._last: tuple[float, tuple[Vector, Vector]] | None = None
+
+    def relative_states(self, t: ArrayLike) -> tuple[Vector, Vector]:
+        """Every object's LVLH position and velocity at time(s) ``t`` (s), shape
+        ``t.shape + (N, 3)``, m and m/s."""
+        times = np.asarray(t, dtype=float)
+        if times.ndim == 0 and self._last is not None and self._last[0] == float(times):
+            return self._last[1]
+        flat = times.reshape(-1)
+        chief_position, chief_velocity = (a[:, 0] for a in self._chief.states(flat))
+        axes = lvlh_axes(chief_position, chief_velocity)
+        rate = lvlh_rate(chief_position, chief_velocity, self._gravity(chief_position))
+        positions, velocities = self._orbits.states(flat)
+        rho, rho_dot = to_relative(
+            chief_position, chief_velocity, axes, rate, positions, velocities
+        )
+        shape = (*times.shape, rho.shape[1], 3)
+        result = (rho.reshape(shape), rho_dot.reshape(shape))
+        if times.ndim == 0:
+            self._last = (float(times), result)
+        return result
+
+
+class PropagatedMotion(MotionModel):
+    """One object's motion under the world's orbit model.
+
+    Parameters
+    ----------
+    orbits : ObjectOrbits
+        The propagation it is part of.
+    index : int
+        The object's index in it.
+    """
+
+    def __init__(self, orbits: ObjectOrbits, index: int) -> None:
+        self.orbits = orbits
+        self.index = index
+
+    def state_at(self, t: ArrayLike) -> tuple[Vector, Vector]:
+        """LVLH position and velocity at time(s) ``t`` (s), shape ``t.shape + (3,)``."""
+        positions, velocities = self.orbits.relative_states(t)
+        return positions[..., self.index, :], velocities[..., self.index, :]
+
+    @classmethod
+    def stack(cls, models: Sequence[MotionModel]) -> Any:
+        """The propagations and each model's index in its own."""
+        return [(m.orbits, m.index) for m in models if isinstance(m, PropagatedMotion)]
+
+    @classmethod
+    def stacked_state(cls, stacked: Any, t: float) -> tuple[Vector, Vector]:
+        """States (N, 3) at ``t`` (s) of models gathered by :meth:`stack`, one
+        propagation evaluated once."""
+        groups: dict[int, tuple[ObjectOrbits, list[int], list[int]]] = {}
+        for row, (orbits, index) in enumerate(stacked):
+            groups.setdefault(id(orbits), (orbits, [], []))
+            groups[id(orbits)][1].append(row)
+            groups[id(orbits)][2].append(index)
+        positions, velocities = np.zeros((len(stacked), 3)), np.zeros((len(stacked), 3))
+        for orbits, rows, indices in groups.values():
+            p, v = orbits.relative_states(t)
+            positions[rows], velocities[rows] = p[indices], v[indices]
+        return positions, velocities
