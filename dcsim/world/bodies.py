@@ -18,7 +18,7 @@ import numpy as np
 
 from dcsim.messages import Shape, ShapeKind
 from dcsim.world.objects import ObjectField
-from dcsim.world.pybullet_client import pb
+from dcsim.world.pybullet_client import MAX_SPEED, pb
 
 
 def create_body(client: int, shape: Shape, mass: float, position: np.ndarray, maximal: bool) -> int:
@@ -56,7 +56,14 @@ def create_body(client: int, shape: Shape, mass: float, position: np.ndarray, ma
         # default); without it their closest points are exact (to ~1e-7 m on curved faces).
         pb.changeDynamics(body, -1, collisionMargin=0.0, physicsClientId=client)
     if mass > 0:
-        pb.changeDynamics(body, -1, linearDamping=0, angularDamping=0, physicsClientId=client)
+        pb.changeDynamics(
+            body,
+            -1,
+            linearDamping=0,
+            angularDamping=0,
+            maxJointVelocity=MAX_SPEED,
+            physicsClientId=client,
+        )
     return body
 
 

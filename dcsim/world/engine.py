@@ -184,7 +184,9 @@ class World:
         self._body_mass = robot.mass
         self._exact_forces: ExactOrbitalForces | None = None
         if dynamics is not None:
-            self._exact_forces = ExactOrbitalForces(self._client, dynamics, self.control_period)
+            self._exact_forces = ExactOrbitalForces(
+                self._client, dynamics, self.physics_step, self.steps_per_control
+            )
             self._exact_forces.stagger_velocity(self.robot_id, self.physics_step)
 
     # ------------------------------------------------------------------ state

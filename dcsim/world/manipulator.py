@@ -18,7 +18,7 @@ import numpy as np
 from dcsim.messages import RobotSpec
 from dcsim.robots.manipulator import ManipulatorModel
 from dcsim.scenario.model import ManipulatorSection, point_to_cartesian
-from dcsim.world.pybullet_client import load_urdf, pb
+from dcsim.world.pybullet_client import MAX_SPEED, load_urdf, pb
 from dcsim.world.robot_body import base_spec_fields
 
 
@@ -64,7 +64,12 @@ class ManipulatorBody:
         self.position_limits = np.array([link.joint_limits for link in self.robot.links])
         for link in (-1, *range(count)):
             pb.changeDynamics(
-                self.body, link, linearDamping=0, angularDamping=0, physicsClientId=client
+                self.body,
+                link,
+                linearDamping=0,
+                angularDamping=0,
+                maxJointVelocity=MAX_SPEED,
+                physicsClientId=client,
             )
             pb.setCollisionFilterGroupMask(self.body, link, 0, 0, physicsClientId=client)
         pb.setJointMotorControlArray(

@@ -81,7 +81,10 @@ def build_objects(
     motions = [spec.motion.build(n) for _, spec in specs]
     orbit = scenario.world.orbit
     if scenario.world.frame == "lvlh" and orbit.model != "cw" and motions:
-        motions = _propagated(motions, dynamics or relative_dynamics(orbit), orbit_period(orbit))
+        world = scenario.world
+        clock = (world.physics_step, round(world.control_period / world.physics_step))
+        dynamics = dynamics or relative_dynamics(orbit)
+        motions = _propagated(motions, dynamics, orbit_period(orbit), clock)
     return [
         SpaceObject(spec.id, kind, spec.build_shape(), spec.mass, motion)
         for (kind, spec), motion in zip(specs, motions, strict=True)
@@ -89,12 +92,20 @@ def build_objects(
 
 
 def _propagated(
-    motions: list[MotionModel], dynamics: RelativeDynamics, period: float
+    motions: list[MotionModel],
+    dynamics: RelativeDynamics,
+    period: float,
+    clock: tuple[float, int],
 ) -> list[MotionModel]:
-    """Motions under the world's orbit model from the given motions' states at t = 0."""
+    """Motions under the world's orbit model from the given motions' states at t = 0
+    (``clock``: the world's physics step, s, and steps per control period)."""
     start = [m.state_at(0.0) for m in motions]
     orbits = ObjectOrbits(
-        dynamics, np.array([p for p, _ in start]), np.array([v for _, v in start]), period
+        dynamics,
+        np.array([p for p, _ in start]),
+        np.array([v for _, v in start]),
+        period,
+        clock,
     )
     return [PropagatedMotion(orbits, i) for i in range(len(motions))]
 

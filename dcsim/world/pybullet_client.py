@@ -53,3 +53,9 @@ def load_urdf(client: int, text: str) -> int:
             flags=pb.URDF_USE_INERTIA_FROM_FILE,
             physicsClientId=client,
         )
+
+
+MAX_SPEED = 1e5
+"""Speed above which PyBullet would clamp a multibody's velocities, m/s (or rad/s for a
+joint). PyBullet's default, 100, is below relative speeds that a drift of tens of
+kilometres reaches in a two-body world; bodies of dcsim's worlds are set to this."""

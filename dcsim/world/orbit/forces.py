@@ -19,6 +19,9 @@ from dcsim.world.pybullet_client import pb
 
 Force = tuple[float, float, float]
 
+FRAME_BLOCK = 128
+"""Control periods whose frames are computed together."""
+
 
 class ExactOrbitalForces:
     """Orbital forces on the robot's bodies, one linearisation per control period.
@@ -29,27 +32,40 @@ class ExactOrbitalForces:
         PyBullet client id.
     dynamics : RelativeDynamics
         The chief's frame and the relative acceleration.
-    control_period : float
+    physics_step : float
         s.
+    steps_per_control : int
+        Physics steps in a control period.
     """
 
-    def __init__(self, client: int, dynamics: RelativeDynamics, control_period: float) -> None:
+    def __init__(
+        self,
+        client: int,
+        dynamics: RelativeDynamics,
+        physics_step: float,
+        steps_per_control: int,
+    ) -> None:
         self._client = client
         self.dynamics = dynamics
-        self._period = control_period
-        self._frames: dict[float, LvlhFrame] = {}
+        self._step = physics_step
+        self._steps_per_control = steps_per_control
+        self._period = steps_per_control * physics_step
+        self._frames: dict[int, LvlhFrame] = {}
         self._base: AffineAcceleration | None = None
         self._parts: list[tuple[int, int, float, AffineAcceleration]] = []
         self._previous: dict[tuple[int, int], tuple[float, ...]] = {}
 
-    def _frame(self, t: float) -> LvlhFrame:
-        """The frame at ``t`` (s); the latest two are kept (a period's end is the next
-        one's start)."""
-        frame = self._frames.get(t)
+    def _frame(self, period: int) -> LvlhFrame:
+        """The frame at the start of control period ``period``; frames are computed
+        :data:`FRAME_BLOCK` periods at a time, at the world's own clock
+        (``steps × physics_step``)."""
+        frame = self._frames.get(period)
         if frame is None:
-            if len(self._frames) >= 2:
-                self._frames.pop(min(self._frames))
-            frame = self._frames[t] = self.dynamics.frame(t)
+            indices = range(period, period + FRAME_BLOCK)
+            steps = np.array(indices) * self._steps_per_control
+            frames = self.dynamics.frames(steps * self._step)
+            self._frames = dict(zip(indices, frames, strict=True))
+            frame = self._frames[period]
         return frame
 
     def stagger_velocity(self, body: int, physics_step: float) -> None:
@@ -63,7 +79,7 @@ class ExactOrbitalForces:
         accurate.
         """
         position, velocity = self._state(body, -1)
-        frame = self._frame(0.0)
+        frame = self._frame(0)
         acceleration = self.dynamics.acceleration(
             frame, np.array([position]), np.array([velocity])
         )[0]
@@ -95,8 +111,9 @@ class ExactOrbitalForces:
         states = [base_state, *(self._state(b, link) for b, link, _ in parts)]
         rho = np.array([p for p, _ in states], dtype=float)
         rho_dot = np.array([v for _, v in states], dtype=float)
+        period = round(t / self._period)
         fields = self.dynamics.linearised(
-            self._frame(t), self._frame(t + self._period), self._period, rho, rho_dot
+            self._frame(period), self._frame(period + 1), self._period, rho, rho_dot
         )
         self._base = fields[0]
         self._parts = [(b, link, m, f) for (b, link, m), f in zip(parts, fields[1:], strict=True)]

@@ -8,6 +8,7 @@ at ``(r, v)``: x̂ = r/|r|, ẑ = h/|h| with h = r × v, ŷ = ẑ × x̂. The fr
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -91,8 +92,30 @@ class LvlhFrame:
     def to_inertial(self, rho: Vector, rho_dot: Vector) -> tuple[Vector, Vector]:
         """Inertial states (…, 3) of points at LVLH relative states ``(ρ, ρ̇)`` (…, 3)."""
         position = self.position + rho @ self.axes.T
-        velocity = self.velocity + (rho_dot + np.cross(self.rate, rho)) @ self.axes.T
+        velocity = self.velocity + (rho_dot + cross(self.rate, rho)) @ self.axes.T
         return position, velocity
+
+    @functools.cached_property
+    def frame_terms(self) -> tuple[Vector, Vector]:
+        """The rotating frame's accelerations as matrices (3, 3): the relative
+        acceleration's part ``−ω̇ × ρ − ω × (ω × ρ)`` is ``ρ @ A_ρ.T`` and its part
+        ``−2 ω × ρ̇`` is ``ρ̇ @ A_v.T``; returns ``(A_ρ, A_v)``."""
+        w, w_dot = skew(self.rate), skew(self.rate_change)
+        return -w_dot - w @ w, -2.0 * w
+
+
+def skew(vector: Vector) -> Vector:
+    """The matrix (3, 3) ``[v×]`` with ``[v×] u = v × u``."""
+    x, y, z = vector
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+
+
+def cross(a: Vector, b: Vector) -> Vector:
+    """``a × b`` over the last axis (…, 3), broadcast; faster than :func:`numpy.cross`
+    on small arrays."""
+    ax, ay, az = a[..., 0], a[..., 1], a[..., 2]
+    bx, by, bz = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack((ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx), axis=-1)
 
 
 def to_relative(
@@ -123,22 +146,22 @@ def to_relative(
     """
     rho = np.einsum("kni,kij->knj", position - chief_position[:, None], axes)
     seen = np.einsum("kni,kij->knj", velocity - chief_velocity[:, None], axes)
-    return rho, seen - np.cross(rate[:, None], rho)
+    return rho, seen - cross(rate[:, None], rho)
 
 
 def lvlh_axes(position: Vector, velocity: Vector) -> Vector:
     """LVLH unit vectors as columns (…, 3, 3) of chiefs at inertial ``(r, v)`` (…, 3)."""
     x = position / np.linalg.norm(position, axis=-1, keepdims=True)
-    h = np.cross(position, velocity)
+    h = cross(position, velocity)
     z = h / np.linalg.norm(h, axis=-1, keepdims=True)
-    return np.stack((x, np.cross(z, x), z), axis=-1)
+    return np.stack((x, cross(z, x), z), axis=-1)
 
 
 def lvlh_rate(position: Vector, velocity: Vector, acceleration: Vector) -> Vector:
     """The LVLH frame's angular velocity ω (…, 3) (LVLH components, rad/s) of chiefs at
     inertial ``(r, v)`` with acceleration ``a`` (m/s²), each (…, 3)."""
     r = np.linalg.norm(position, axis=-1)
-    h_vector = np.cross(position, velocity)
+    h_vector = cross(position, velocity)
     h = np.linalg.norm(h_vector, axis=-1)
     normal_acceleration = np.einsum("...i,...i->...", acceleration, h_vector) / h
     return np.stack((r * normal_acceleration / h, np.zeros_like(r), h / r**2), axis=-1)

@@ -23,6 +23,9 @@ from dcsim.world.orbit.gravity import Gravity
 from dcsim.world.orbit.propagation import InertialMotion, NumericalOrbits
 from dcsim.world.orbit.relative import RelativeDynamics
 
+TICK_BLOCK = 64
+"""Control periods whose object states are computed together."""
+
 
 class ObjectOrbits:
     """Objects propagated in the inertial frame, seen in the chief's LVLH frame.
@@ -35,24 +38,60 @@ class ObjectOrbits:
         The objects' LVLH states at t = 0, m and m/s.
     period : float
         The chief's orbital period, s (the propagation's span).
+    clock : (float, int), optional
+        The world's physics step (s) and steps per control period: the times the
+        world asks for most, computed ahead in blocks.
     """
 
     def __init__(
-        self, dynamics: RelativeDynamics, positions: Vector, velocities: Vector, period: float
+        self,
+        dynamics: RelativeDynamics,
+        positions: Vector,
+        velocities: Vector,
+        period: float,
+        clock: tuple[float, int] | None = None,
     ) -> None:
         self._chief: InertialMotion = dynamics.chief
         self._gravity: Gravity = dynamics.gravity
         start = dynamics.frame(0.0)
         inertial = start.to_inertial(np.asarray(positions, float), np.asarray(velocities, float))
         self._orbits = NumericalOrbits(*inertial, self._gravity, period)
-        self._last: tuple[float, tuple[Vector, Vector]] | None = None
+        self._clock = clock
+        self._ticks: dict[float, tuple[Vector, Vector]] = {}
 
     def relative_states(self, t: ArrayLike) -> tuple[Vector, Vector]:
         """Every object's LVLH position and velocity at time(s) ``t`` (s), shape
-        ``t.shape + (N, 3)``, m and m/s."""
+        ``t.shape + (N, 3)``, m and m/s.
+
+        With a clock, a scalar time on it (a whole number of control periods) is
+        answered from states computed :data:`TICK_BLOCK` control periods at a time.
+        """
         times = np.asarray(t, dtype=float)
-        if times.ndim == 0 and self._last is not None and self._last[0] == float(times):
-            return self._last[1]
+        if times.ndim == 0 and self._clock is not None:
+            found = self._ticks.get(float(times))
+            if found is None and self._on_clock(float(times)):
+                found = self._fill_ticks(float(times))
+            if found is not None:
+                return found
+        return self._compute(times)
+
+    def _on_clock(self, t: float) -> bool:
+        """Whether ``t`` (s) is a control period's start on the world's clock."""
+        assert self._clock is not None
+        step, per_period = self._clock
+        steps = round(t / step)
+        return steps % per_period == 0 and steps * step == t
+
+    def _fill_ticks(self, t: float) -> tuple[Vector, Vector]:
+        """States at ``t`` and the next :data:`TICK_BLOCK` − 1 control periods' starts."""
+        assert self._clock is not None
+        step, per_period = self._clock
+        steps = (round(t / step) + np.arange(TICK_BLOCK) * per_period) * step
+        positions, velocities = self._compute(steps)
+        self._ticks = {float(time): (positions[k], velocities[k]) for k, time in enumerate(steps)}
+        return self._ticks[t]
+
+    def _compute(self, times: np.ndarray) -> tuple[Vector, Vector]:
         flat = times.reshape(-1)
         chief_position, chief_velocity = (a[:, 0] for a in self._chief.states(flat))
         axes = lvlh_axes(chief_position, chief_velocity)
@@ -62,10 +101,7 @@ class ObjectOrbits:
             chief_position, chief_velocity, axes, rate, positions, velocities
         )
         shape = (*times.shape, rho.shape[1], 3)
-        result = (rho.reshape(shape), rho_dot.reshape(shape))
-        if times.ndim == 0:
-            self._last = (float(times), result)
-        return result
+        return rho.reshape(shape), rho_dot.reshape(shape)
 
 
 class PropagatedMotion(MotionModel):

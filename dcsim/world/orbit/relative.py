@@ -46,33 +46,40 @@ class RelativeDynamics:
         self.gravity = gravity
 
     def frame(self, t: float) -> LvlhFrame:
-        """The LVLH frame at time ``t`` (s), its rate change differenced over ±0.5 s."""
+        """The LVLH frame at time ``t`` (s)."""
+        return self.frames(np.array([t]))[0]
+
+    def frames(self, times: Vector) -> list[LvlhFrame]:
+        """The LVLH frames at ``times`` (K,), s, computed together; each frame's rate
+        change is differenced over ±0.5 s (forward from a time under 0.5 s)."""
         step = RATE_CHANGE_STEP
-        times = np.array([t, t - step, t + step]) if t >= step else np.array([t, t, t + step])
-        positions, velocities = self.chief.states(times)
-        positions, velocities = positions[:, 0], velocities[:, 0]
+        before = np.where(times >= step, times - step, times)
+        after = times + step
+        samples = np.concatenate((times, before, after))
+        positions, velocities = (a[:, 0] for a in self.chief.states(samples))
         accelerations = self.gravity(positions)
         rates = lvlh_rate(positions, velocities, accelerations)
-        rate_change = (rates[2] - rates[1]) / (times[2] - times[1])
-        return LvlhFrame(
-            positions[0],
-            velocities[0],
-            accelerations[0],
-            lvlh_axes(positions[0], velocities[0]),
-            rates[0],
-            rate_change,
-        )
+        count = len(times)
+        rate_change = (rates[2 * count :] - rates[count : 2 * count]) / (after - before)[:, None]
+        axes = lvlh_axes(positions[:count], velocities[:count])
+        return [
+            LvlhFrame(
+                positions[k],
+                velocities[k],
+                accelerations[k],
+                axes[k],
+                rates[k],
+                rate_change[k],
+            )
+            for k in range(count)
+        ]
 
     def acceleration(self, frame: LvlhFrame, rho: Vector, rho_dot: Vector) -> Vector:
         """Relative accelerations (…, 3), m/s², LVLH, of points at ``(ρ, ρ̇)`` (…, 3)."""
-        axes, w, w_dot = frame.axes, frame.rate, frame.rate_change
+        axes = frame.axes
         differential = (self.gravity(frame.position + rho @ axes.T) - frame.acceleration) @ axes
-        return (
-            differential
-            - 2.0 * np.cross(w, rho_dot)
-            - np.cross(w_dot, rho)
-            - np.cross(w, np.cross(w, rho))
-        )
+        position_terms, velocity_terms = frame.frame_terms
+        return differential + rho @ position_terms.T + rho_dot @ velocity_terms.T
 
     def linearised(
         self, start: LvlhFrame, end: LvlhFrame, period: float, rho: Vector, rho_dot: Vector
@@ -88,18 +95,15 @@ class RelativeDynamics:
         rho, rho_dot : ndarray (N, 3)
             The bodies' LVLH states at the period's start, m and m/s.
         """
-        at_start = self.acceleration(start, rho, rho_dot)
-        at_end = self.acceleration(end, rho, rho_dot)
         h = JACOBIAN_STEP
-        offsets = np.concatenate((np.eye(3) * h, -np.eye(3) * h))  # (6, 3)
-        shifted = self.acceleration(
-            start, rho[:, None, :] + offsets, np.repeat(rho_dot[:, None, :], 6, axis=1)
-        )  # (N, 6, 3)
-        jacobians = np.swapaxes((shifted[:, :3] - shifted[:, 3:]) / (2.0 * h), 1, 2)
-        w = start.rate
-        velocity_jacobian = -2.0 * np.array(
-            [[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]]
-        )
+        offsets = np.concatenate((np.zeros((1, 3)), np.eye(3) * h, -np.eye(3) * h))  # (7, 3)
+        around = self.acceleration(
+            start, rho[:, None, :] + offsets, np.repeat(rho_dot[:, None, :], 7, axis=1)
+        )  # (N, 7, 3): at the state, then shifted by +h and -h along each axis
+        at_start = around[:, 0]
+        at_end = self.acceleration(end, rho, rho_dot)
+        jacobians = np.swapaxes((around[:, 1:4] - around[:, 4:7]) / (2.0 * h), 1, 2)
+        velocity_jacobian = start.frame_terms[1]
         drift = (at_end - at_start) / period
         return [
             AffineAcceleration.of(a, d, j, velocity_jacobian, p, v)
@@ -146,19 +150,35 @@ class AffineAcceleration:
         self, tau: float, position: tuple[float, ...], velocity: tuple[float, ...]
     ) -> tuple[float, float, float]:
         """The acceleration (m/s², LVLH) at ``τ`` (s) of a body at ``(ρ, ρ̇)``."""
-        dx, dy, dz = (position[i] - self.position[i] for i in range(3))
-        du, dv, dw = (velocity[i] - self.velocity[i] for i in range(3))
-        out = []
-        for i in range(3):
-            p, v = self.position_jacobian[i], self.velocity_jacobian[i]
-            out.append(
-                self.base[i]
-                + self.drift[i] * tau
-                + p[0] * dx
-                + p[1] * dy
-                + p[2] * dz
-                + v[0] * du
-                + v[1] * dv
-                + v[2] * dw
-            )
-        return out[0], out[1], out[2]
+        p0, v0 = self.position, self.velocity
+        dx, dy, dz = position[0] - p0[0], position[1] - p0[1], position[2] - p0[2]
+        du, dv, dw = velocity[0] - v0[0], velocity[1] - v0[1], velocity[2] - v0[2]
+        (p11, p12, p13), (p21, p22, p23), (p31, p32, p33) = self.position_jacobian
+        (v11, v12, v13), (v21, v22, v23), (v31, v32, v33) = self.velocity_jacobian
+        base, drift = self.base, self.drift
+        return (
+            base[0]
+            + drift[0] * tau
+            + p11 * dx
+            + p12 * dy
+            + p13 * dz
+            + v11 * du
+            + v12 * dv
+            + v13 * dw,
+            base[1]
+            + drift[1] * tau
+            + p21 * dx
+            + p22 * dy
+            + p23 * dz
+            + v21 * du
+            + v22 * dv
+            + v23 * dw,
+            base[2]
+            + drift[2] * tau
+            + p31 * dx
+            + p32 * dy
+            + p33 * dz
+            + v31 * du
+            + v32 * dv
+            + v33 * dw,
+        )
