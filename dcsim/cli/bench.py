@@ -254,7 +254,7 @@ def bench_controllers_command(
     registry = PluginRegistry.discover()
     for name in names:  # unknown controllers and bad overrides fail here, before any run
         chosen = [f"controller.plugin={name}", "controller.params={}", *overrides]
-        safety = read_scenario(scenario, chosen, registry).mission.safety_distance
+        safety = _safety_distance(scenario, chosen, registry)
     runs = bench_controllers(
         scenario,
         names,
@@ -267,6 +267,25 @@ def bench_controllers_command(
     if plot_path is not None:
         plot(runs, safety, plot_path)
         click.echo(f"plot: {plot_path}")
+
+
+def _safety_distance(scenario: Path, overrides: list[str], registry: PluginRegistry) -> float:
+    """The debris mission's safety distance of ``scenario`` with ``overrides``, m.
+
+    Raises
+    ------
+    click.BadParameter
+        When the overrides chose another mission type.
+    """
+    from dcsim.missions.debris.settings import DebrisMissionSection
+
+    mission = read_scenario(scenario, overrides, registry).mission
+    if not isinstance(mission, DebrisMissionSection):
+        raise click.BadParameter(
+            f"the controller bench flies the debris mission, not mission.type {mission.type!r}",
+            param_hint="--set",
+        )
+    return mission.safety_distance
 
 
 @bench_group.command(
