@@ -26,19 +26,40 @@ class Decorator(Protocol):
 
 
 def scenario_argument(required: bool = True) -> Decorator:
-    """``SCENARIO``: a scenario file (when not ``required``, the packaged one is the default)."""
+    """``SCENARIO``: a scenario file, as ``scenario``.
+
+    Parameters
+    ----------
+    required : bool
+        Whether the command needs one; when not, the command flies the packaged
+        scenario without it.
+    """
     return click.argument(
         "scenario", required=required, type=click.Path(dir_okay=False, path_type=Path)
     )
 
 
 def overrides_option(help: str) -> Decorator:
-    """``--set KEY.PATH=VALUE`` (repeatable): scenario values to override, as ``overrides``."""
+    """``--set KEY.PATH=VALUE`` (repeatable): scenario values to override, as ``overrides``.
+
+    Parameters
+    ----------
+    help : str
+        The option's help: what the overrides apply to.
+    """
     return click.option("--set", "overrides", multiple=True, metavar="KEY.PATH=VALUE", help=help)
 
 
 def out_dir_option(help: str, default: Path | None = None) -> Decorator:
-    """``--out``: the directory a command writes (its default shown when there is one)."""
+    """``--out``: the directory a command writes, as ``out``.
+
+    Parameters
+    ----------
+    help : str
+        The option's help: what goes into the directory, and where without the option.
+    default : Path or None
+        The directory without the option (shown in the help), or None.
+    """
     return click.option(
         "--out",
         type=click.Path(file_okay=False, path_type=Path),
@@ -49,7 +70,13 @@ def out_dir_option(help: str, default: Path | None = None) -> Decorator:
 
 
 def out_file_option(help: str) -> Decorator:
-    """``-o``/``--out``: the file a command writes, required."""
+    """``-o``/``--out``: the file a command writes, required, as ``out``.
+
+    Parameters
+    ----------
+    help : str
+        The option's help: which file.
+    """
     return click.option(
         "-o",
         "--out",
@@ -60,19 +87,37 @@ def out_file_option(help: str) -> Decorator:
 
 
 def plot_option(help: str) -> Decorator:
-    """``--plot FILE``: where to save a bench's plot, as ``plot_path`` (none when not given)."""
+    """``--plot FILE``: where to save a bench's plot, as ``plot_path`` (None: no plot).
+
+    Parameters
+    ----------
+    help : str
+        The option's help: what the plot shows.
+    """
     return click.option(
         "--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help=help
     )
 
 
 def fly_option(help: str) -> Decorator:
-    """``--fly``: also fly a planner bench's plans through the transfer mission."""
+    """``--fly``: also fly a planner bench's plans through the transfer mission, as ``fly``.
+
+    Parameters
+    ----------
+    help : str
+        The option's help: which plans are flown.
+    """
     return click.option("--fly", is_flag=True, help=help)
 
 
 def duration_option(default: float) -> Decorator:
-    """``--duration``: simulated seconds per measurement of a bench, >= 1 s."""
+    """``--duration``: simulated seconds per measurement of a bench, at least 1 s.
+
+    Parameters
+    ----------
+    default : float
+        The duration without the option, s (shown in the help).
+    """
     return click.option(
         "--duration",
         type=click.FloatRange(min=1.0),
@@ -83,14 +128,36 @@ def duration_option(default: float) -> Decorator:
 
 
 def count_option(name: str, default: int, help: str, minimum: int = 1) -> Decorator:
-    """An integer option of at least ``minimum`` (runs, seeds, instances ...), default shown."""
+    """An integer option (runs, seeds, instances, repeats ...) with its default shown.
+
+    Parameters
+    ----------
+    name : str
+        The option, e.g. ``--runs``.
+    default : int
+        Its value without the option.
+    help : str
+        The option's help.
+    minimum : int
+        The least value accepted.
+    """
     return click.option(
         name, type=click.IntRange(min=minimum), default=default, show_default=True, help=help
     )
 
 
 def positive_option(name: str, default: float, help: str) -> Decorator:
-    """A number option above zero (a noise, a time, a step ...), default shown."""
+    """A number option above zero (a noise, a time, a step ...) with its default shown.
+
+    Parameters
+    ----------
+    name : str
+        The option, e.g. ``--sigma``.
+    default : float
+        Its value without the option, in the unit its help names.
+    help : str
+        The option's help, naming the unit.
+    """
     return click.option(
         name,
         type=click.FloatRange(min=0, min_open=True),
