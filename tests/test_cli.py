@@ -312,3 +312,10 @@ def test_bench_localisers_prints_the_bound_and_every_localiser(dcsim_cli, tmp_pa
     for name in ("PCRB", "trilateration", "ekf", "ukf", "sspf 1k", "sspf 10k", "sspf 100k"):
         assert name in labels
     assert plot.stat().st_size > 10_000
+
+
+def test_bench_controllers_refuses_another_mission_type_before_any_run(dcsim_cli):
+    result = dcsim_cli("bench", "controllers", "--seeds", "1", "--set", "mission={type: hold}")
+    assert result.returncode == 2
+    assert "flies the debris mission, not mission.type 'hold'" in result.stderr
+    assert "Traceback" not in result.stderr

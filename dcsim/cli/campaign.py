@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 import click
 
+from dcsim.cli.options import cluster_choice, cluster_options, out_dir_option
 from dcsim.run.directory import file_name_part
 
 if TYPE_CHECKING:
@@ -22,50 +23,9 @@ def campaign_group() -> None:
     """Many cases of one scenario on Dask: Monte Carlo draws and sweeps (docs/campaigns.md)."""
 
 
-def cluster_options(command: click.Command) -> click.Command:
-    """Add the options that choose where cases run (``--scheduler``, ``--connect-timeout``,
-    ``--workers``, ``--worker-deaths``) to a command."""
-    options = [
-        click.option(
-            "--scheduler",
-            metavar="tcp://HOST:PORT",
-            help="Run on this existing Dask scheduler (its workers need dcsim and the "
-            "campaign's plugins installed, and the campaign directory at the same path). "
-            "Default: a local cluster.",
-        ),
-        click.option(
-            "--connect-timeout",
-            type=click.FloatRange(min=0.1, max=3600.0),
-            metavar="SECONDS",
-            help="Seconds to wait for the --scheduler before giving up. Default: 10 "
-            "(dcsim.campaign.engine.CONNECT_TIMEOUT).",
-        ),
-        click.option(
-            "--workers",
-            type=click.IntRange(min=1, max=1024),
-            help="Worker processes of the local cluster. Default: one per core.",
-        ),
-        click.option(
-            "--worker-deaths",
-            type=click.IntRange(min=1, max=100),
-            default=3,
-            show_default=True,
-            help="Workers that may die running one case (killed, out of memory) before "
-            "it is a failed case. Local cluster only.",
-        ),
-    ]
-    for option in reversed(options):
-        command = option(command)
-    return command
-
-
 @campaign_group.command("run", short_help="Run a campaign file's cases and collect them.")
 @click.argument("campaign", type=click.Path(dir_okay=False, path_type=Path))
-@click.option(
-    "--out",
-    type=click.Path(file_okay=False, path_type=Path),
-    help="Campaign directory to write. Default: runs/campaigns/NAME-YYYYmmdd-HHMMSS.",
-)
+@out_dir_option("Campaign directory to write. Default: runs/campaigns/NAME-YYYYmmdd-HHMMSS.")
 @click.option("--force", is_flag=True, help="Replace the campaign directory if it holds anything.")
 @click.option(
     "--cases",
@@ -125,11 +85,7 @@ def resume_command(
 @campaign_group.command("rerun", short_help="Run one case again and compare it byte for byte.")
 @click.argument("directory", type=click.Path(file_okay=False, exists=True, path_type=Path))
 @click.option("--case", "index", type=click.IntRange(min=0), required=True, help="Case index.")
-@click.option(
-    "--out",
-    type=click.Path(file_okay=False, path_type=Path),
-    help="Run directory of the replay. Default: DIRECTORY/reruns/case-NNNNNN.",
-)
+@out_dir_option("Run directory of the replay. Default: DIRECTORY/reruns/case-NNNNNN.")
 def rerun_command(directory: Path, index: int, out: Path | None) -> None:
     """Run one case of campaign DIRECTORY again here and compare it with its recorded run.
 
@@ -145,30 +101,6 @@ def rerun_command(directory: Path, index: int, out: Path | None) -> None:
     click.echo(f"  replay in {replay.out}")
     if not all(replay.identical.values()):
         sys.exit(1)
-
-
-def cluster_choice(
-    scheduler: str | None,
-    workers: int | None,
-    worker_deaths: int,
-    connect_timeout: float | None,
-) -> ClusterOptions:
-    """The cluster the options chose; ``--workers`` with ``--scheduler``, or
-    ``--connect-timeout`` without it, is an error."""
-    from dcsim.campaign import ClusterOptions
-
-    if scheduler is not None and workers is not None:
-        raise click.BadParameter(
-            "--workers sizes the local cluster; an existing scheduler has its own workers",
-            param_hint="--workers",
-        )
-    if scheduler is None and connect_timeout is not None:
-        raise click.BadParameter(
-            "--connect-timeout is for a cluster given by --scheduler; the local cluster "
-            "is started here",
-            param_hint="--connect-timeout",
-        )
-    return ClusterOptions(scheduler, workers, worker_deaths, connect_timeout)
 
 
 def _where(options: ClusterOptions) -> str:

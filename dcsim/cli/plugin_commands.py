@@ -6,6 +6,7 @@ commands to the groups it is given; dcsim's built-in plugins add their own bench
 implementation gets groups of its own, so that a name already taken (by dcsim or by a
 package met earlier, in the order of the entry points' names) or an implementation
 that raises is reported and skipped instead of silently replacing a command.
+:class:`PluginGroup` is the click group that serves them beside dcsim's own.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from dataclasses import dataclass, field
 
 import click
 
+from dcsim.cli.common import plugin_registry
 from dcsim.registry.discovery import PluginRegistry
 
 GROUPS = ("cli", "bench")
@@ -83,3 +85,42 @@ def plugin_commands(
                 else:
                     found.commands[group][name] = command
     return found
+
+
+class PluginGroup(click.Group):
+    """A click group that also holds the commands plugin packages add to it.
+
+    The packages are asked only when a command is not one of dcsim's own, or when the
+    commands are listed, once per command line.
+    """
+
+    hook_argument = "bench"
+    """The argument of ``dcsim_register_commands`` that stands for this group."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        """dcsim's own commands and the plugin packages', sorted."""
+        return sorted({*self.commands, *_added_commands(ctx)[self.hook_argument]})
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        """dcsim's own command of that name, else a plugin package's."""
+        own = self.commands.get(cmd_name)
+        return own if own is not None else _added_commands(ctx)[self.hook_argument].get(cmd_name)
+
+
+def _added_commands(ctx: click.Context) -> dict[str, dict[str, click.Command]]:
+    """The commands plugin packages add, by hook argument (asked once per command line;
+    refused ones are printed as warnings on stderr).
+
+    The names taken are those of dcsim's own commands in the plugin groups of the command
+    line: its root group and the groups directly under it.
+    """
+    root = ctx.find_root()
+    if "dcsim.plugin_commands" not in root.meta:
+        groups = [root.command, *getattr(root.command, "commands", {}).values()]
+        taken = {g.hook_argument: g.commands for g in groups if isinstance(g, PluginGroup)}
+        found = plugin_commands(plugin_registry(), taken)
+        for message in found.warnings:
+            click.echo(f"warning: {message}", err=True)
+        root.meta["dcsim.plugin_commands"] = found.commands
+    commands: dict[str, dict[str, click.Command]] = root.meta["dcsim.plugin_commands"]
+    return commands

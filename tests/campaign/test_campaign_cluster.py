@@ -346,7 +346,7 @@ def test_the_python_api_passes_the_connect_timeout_on(tmp_path):
 
 
 def test_the_command_line_s_connect_timeout_reaches_the_cluster_options():
-    from dcsim.cli.campaign import cluster_choice
+    from dcsim.cli.options import cluster_choice
 
     chosen = cluster_choice("tcp://127.0.0.1:8786", None, 3, 2.5)
     assert chosen.scheduler_wait == 2.5

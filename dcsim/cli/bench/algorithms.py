@@ -1,0 +1,179 @@
+"""Benches of the built-in localisers (``localisers``), task planners
+(``task-planners``) and controllers (``controllers``) against their references."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from dcsim.bench.options import comma_words
+from dcsim.cli.common import progress
+from dcsim.cli.options import (
+    cluster_choice,
+    cluster_options,
+    count_option,
+    overrides_option,
+    plot_option,
+    positive_option,
+)
+from dcsim.registry.discovery import PluginRegistry
+from dcsim.scenario import read_scenario
+
+
+@click.command("localisers", short_help="Localisers' RMSE against the Cramér–Rao bound; latency.")
+@count_option("--runs", 10, "Monte Carlo runs.")
+@count_option("--steps", 400, "Updates per run (0.5 s each).", minimum=10)
+@positive_option("--sigma", 1.0, "Range noise, m.")
+@positive_option(
+    "--acceleration-sigma",
+    0.005,
+    "Thrust noise of the manoeuvring collector, m/s^2 (the filters are told).",
+)
+@plot_option("Save the RMSE-over-time plot here.")
+def bench_localisers_command(
+    runs: int, steps: int, sigma: float, acceleration_sigma: float, plot_path: Path | None
+) -> None:
+    """Localisers' RMSE against the posterior Cramér–Rao bound, and their update latency.
+
+    Every localiser (trilateration, ekf, ukf, sspf with 1k, 10k and 100k particles; the
+    last on two runs only) flies the same runs of a manoeuvring collector ranging to the
+    three nearest of eight beacons. Prints a Markdown table for docs/benchmarks.md.
+    """
+    from dcsim.bench.localisers import bench_localisers, markdown_table, plot
+
+    bound, results = bench_localisers(runs, steps, sigma, acceleration_sigma, progress=progress)
+    click.echo(markdown_table(bound, results))
+    if plot_path is not None:
+        plot(bound, results, plot_path)
+        click.echo(f"plot: {plot_path}")
+
+
+@click.command(
+    "task-planners", short_help="ga's time strategies; task planners' gaps to the optimum."
+)
+@count_option("--instances", 100, "Random instances per problem size (both studies).")
+@count_option(
+    "--moving-instances",
+    50,
+    "Instances per size for the gap to the grid optimum with moving targets.",
+    minimum=0,
+)
+@count_option(
+    "--repeats", 10, "Runs with different seeds per instance for the dispersion.", minimum=2
+)
+@count_option("--dispersion-instances", 5, "Instances whose dispersion is measured.")
+@positive_option("--grid-step", 10.0, "Time grid of the moving-target optimum, s.")
+@click.option(
+    "--plots",
+    "plot_dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Save task_planner_strategies.png and task_planner_gaps.png here.",
+)
+def bench_task_planners_command(
+    instances: int,
+    moving_instances: int,
+    repeats: int,
+    dispersion_instances: int,
+    grid_step: float,
+    plot_dir: Path | None,
+) -> None:
+    """The ga planner's time strategies (thesis ch. 3) and task planners' gaps to the optimum.
+
+    Time strategies: 5, 10 and 15 moving targets. Gaps: stationary targets with 5, 7, 9
+    and 11 (exact Held-Karp optimum), moving targets with 5 and 7 (optimum over a time
+    grid of 2500 s). Prints Markdown tables for docs/benchmarks.md.
+    """
+    from dcsim.bench.task_planners import (
+        compare_strategies,
+        gap_table,
+        optimality_gaps,
+        plot_gaps,
+        plot_strategies,
+        strategy_table,
+    )
+
+    gaps = optimality_gaps(
+        (5, 7, 9, 11), (5, 7), instances, moving_instances, grid_step, 2500.0, progress
+    )
+    click.echo(gap_table(gaps) + "\n")
+    strategies = compare_strategies((5, 10, 15), instances, repeats, dispersion_instances, progress)
+    click.echo(strategy_table(strategies, repeats))
+    if plot_dir is not None:
+        plot_dir.mkdir(parents=True, exist_ok=True)
+        plot_gaps(gaps, plot_dir / "task_planner_gaps.png")
+        plot_strategies(strategies, plot_dir / "task_planner_strategies.png")
+        click.echo(f"plots: {plot_dir}")
+
+
+@click.command("controllers", short_help="Controllers across crowded fields of drifting obstacles.")
+@count_option("--seeds", 50, "Fields (and world seeds) flown by every controller.")
+@count_option(
+    "--first-seed", 0, "Seed of the first field (seeds FIRST to FIRST + N - 1).", minimum=0
+)
+@click.option(
+    "--controllers",
+    default="elastic,pd",
+    show_default=True,
+    help="Comma-separated controller plugins (default parameters).",
+)
+@cluster_options
+@overrides_option("Override a value of the crowded-field scenario, as for dcsim run. Repeatable.")
+@plot_option("Save the distribution of the closest approach here.")
+def bench_controllers_command(
+    seeds: int,
+    first_seed: int,
+    controllers: str,
+    scheduler: str | None,
+    connect_timeout: float | None,
+    workers: int | None,
+    worker_deaths: int,
+    overrides: tuple[str, ...],
+    plot_path: Path | None,
+) -> None:
+    """Controllers crossing scenarios/crowded_field.yaml, a fresh field of 60 obstacles per seed.
+
+    Reports per controller the runs with a collision, the closest approach to any
+    obstacle, delta-v and mission time as a Markdown table for docs/benchmarks.md.
+    The runs are campaign cases on Dask (a local cluster unless --scheduler).
+    """
+    from dcsim.bench.controllers import bench_controllers, markdown_table, plot
+    from dcsim.scenario import packaged_scenario_path
+
+    scenario = packaged_scenario_path("crowded_field.yaml")
+    names = comma_words(controllers, "--controllers")
+    registry = PluginRegistry.discover()
+    for name in names:  # unknown controllers and bad overrides fail here, before any run
+        chosen = [f"controller.plugin={name}", "controller.params={}", *overrides]
+        safety = _safety_distance(scenario, chosen, registry)
+    runs = bench_controllers(
+        scenario,
+        names,
+        range(first_seed, first_seed + seeds),
+        overrides,
+        cluster_choice(scheduler, workers, worker_deaths, connect_timeout),
+        progress=progress,
+    )
+    click.echo(markdown_table(runs))
+    if plot_path is not None:
+        plot(runs, safety, plot_path)
+        click.echo(f"plot: {plot_path}")
+
+
+def _safety_distance(scenario: Path, overrides: list[str], registry: PluginRegistry) -> float:
+    """The debris mission's safety distance of ``scenario`` with ``overrides``, m.
+
+    Raises
+    ------
+    click.BadParameter
+        When the overrides chose another mission type.
+    """
+    from dcsim.missions.debris.settings import DebrisMissionSection
+
+    mission = read_scenario(scenario, overrides, registry).mission
+    if not isinstance(mission, DebrisMissionSection):
+        raise click.BadParameter(
+            f"the controller bench flies the debris mission, not mission.type {mission.type!r}",
+            param_hint="--set",
+        )
+    return mission.safety_distance

@@ -1,0 +1,240 @@
+"""Benches of dcsim's engine: the closed loop against PyBullet (``world``), a long run
+(``soak``), the FMU (``fmu``), the campaign engine (``campaign``), the attitude loop
+beside Basilisk's (``peers``) and the manipulator model against Pinocchio's
+(``manipulator``)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from dcsim.bench.options import comma_numbers
+from dcsim.cli.common import plugin_registry, progress
+from dcsim.cli.options import (
+    count_option,
+    duration_option,
+    out_dir_option,
+    plot_option,
+    positive_option,
+    scenario_argument,
+)
+from dcsim.run.directory import prepare_run_directory
+from dcsim.run.setup import setup_run
+
+
+@click.command("world", short_help="Closed-loop wall time per simulated second against PyBullet.")
+@click.option(
+    "--objects",
+    default="10,100,1000",
+    show_default=True,
+    help="Comma-separated field sizes (targets and obstacles in all), each >= 0.",
+)
+@duration_option(60.0)
+def bench_world_command(objects: str, duration: float) -> None:
+    """Closed-loop wall time per simulated second against PyBullet stepping alone.
+
+    For each field size, one synthetic LVLH scenario is stepped bare (stepSimulation
+    only) and flown by the full runner; the closed loop is split by phase of the run
+    loop. Then the default scenario is flown once for its real-time factor. Prints a
+    Markdown table for docs/benchmarks.md, and the floor under the default scenario's
+    real-time factor: stepping, the per-step force calls and the localiser plugin alone.
+    """
+    from dcsim.bench.world import bench_world, floor_line, loop_floor, markdown_table
+    from dcsim.run.loop import Runner
+
+    words = [word.strip() for word in objects.split(",")]
+    if not all(word.isdigit() for word in words):
+        raise click.BadParameter(
+            f"expected integers >= 0 like 10,100,1000, got {objects!r}", param_hint="--objects"
+        )
+    sizes = [int(word) for word in words]
+    rows = bench_world(sizes, duration, progress=progress)
+    click.echo(markdown_table(rows))
+    registry = plugin_registry()
+    summary = Runner(setup_run(registry=registry)).run()
+    click.echo(
+        f"\ndefault scenario: {summary['status']} ({summary['reason']}), "
+        f"{summary['sim_time_s']:.1f} s simulated in {summary['wall_time_s']:.2f} s, "
+        f"real-time factor {summary['real_time_factor']:.0f}"
+    )
+    click.echo(floor_line(loop_floor(summary["sim_time_s"], summary["wall_time_s"], registry)))
+
+
+@click.command("soak", short_help="A long run's memory and time per tick; FMU lifetimes.")
+@count_option("--ticks", 1_000_000, "Control ticks to fly.", minimum=100)
+@count_option("--samples", 100, "Memory and speed samples, evenly spaced.", minimum=10)
+@count_option(
+    "--fmu-cycles",
+    200,
+    "FMU instantiate/step/terminate/free cycles after the run (0: none).",
+    minimum=0,
+)
+@out_dir_option("Run directory for the soak run's records (default: a temporary one).")
+@plot_option("Write memory and time per tick against ticks as a PNG.")
+def bench_soak_command(
+    ticks: int, samples: int, fmu_cycles: int, out: Path | None, plot_path: Path | None
+) -> None:
+    """A long run's resident memory and time per tick, and repeated FMU lifetimes.
+
+    Flies the default scenario for TICKS control ticks with its records streamed to
+    disk, sampling resident memory and wall time per tick; then runs FMU-CYCLES
+    lifetimes of the closed-loop FMU in the same process. Prints Markdown for
+    docs/benchmarks.md.
+    """
+    import tempfile
+
+    from dcsim.bench import soak
+
+    with tempfile.TemporaryDirectory(prefix="dcsim-soak-run-") as tmp:
+        run_dir = prepare_run_directory(out or Path(tmp) / "run", force=False)
+        result = soak.soak(ticks, samples, run_dir, progress)
+    click.echo(soak.markdown_table(result))
+    if plot_path is not None:
+        soak.plot(result, plot_path)
+        click.echo(f"\nplot: {plot_path}")
+    if fmu_cycles:
+        memory = soak.fmu_cycles(fmu_cycles, progress)
+        early = memory[min(len(memory), 20) - 1]
+        click.echo(
+            f"\nFMU: {fmu_cycles} cycles, resident memory {early / 2**20:.1f} MB after cycle "
+            f"{min(len(memory), 20)}, {memory[-1] / 2**20:.1f} MB after the last "
+            f"({100 * (memory[-1] - early) / early:+.1f} %)"
+        )
+
+
+@click.command("fmu", short_help="The closed-loop FMU in fmpy against dcsim run, per tick.")
+@scenario_argument(required=False)
+@duration_option(300.0)
+@count_option("--repeats", 3, "Measurements.")
+def bench_fmu_command(scenario: Path | None, duration: float, repeats: int) -> None:
+    """Closed-loop FMU in fmpy against dcsim run: wall time per control tick.
+
+    SCENARIO (default: the packaged one) is exported as a closed-loop FMU and flown
+    natively and through the FMU, alternately, REPEATS times each. Prints a Markdown
+    table for docs/benchmarks.md.
+    """
+    from dcsim.bench.fmu import bench_fmu, markdown_table
+
+    result = bench_fmu(scenario, duration, repeats, progress=progress)
+    click.echo(markdown_table(result))
+
+
+@click.command("campaign", short_help="The campaign engine's overhead and speed-up per worker.")
+@click.argument(
+    "campaign",
+    required=False,
+    type=click.Path(dir_okay=False, exists=True, path_type=Path),
+)
+@count_option("--cases", 40, "Cases run.")
+@click.option(
+    "--workers",
+    default="1,2",
+    show_default=True,
+    help="Comma-separated local cluster sizes (1 is always run: the reference).",
+)
+@positive_option("--duration", 300.0, "world.duration of every case, s.")
+@out_dir_option("Folder for the run directories. Default: a temporary folder, removed after.")
+def bench_campaign_command(
+    campaign: Path | None, cases: int, workers: str, duration: float, out: Path | None
+) -> None:
+    """The campaign engine against direct runs: overhead per case and speed-up per worker.
+
+    CAMPAIGN defaults to scenarios/campaigns/default_dispersed.yaml of this checkout.
+    """
+    import tempfile
+
+    from dcsim.bench.campaign import bench_campaign, markdown_table
+
+    if campaign is None:
+        campaign = (
+            Path(__file__).resolve().parents[3] / "scenarios/campaigns/default_dispersed.yaml"
+        )
+        if not campaign.exists():
+            raise click.BadParameter("name a campaign file", param_hint="CAMPAIGN")
+    counts = [int(n) for n in comma_numbers(workers, "--workers") if n >= 1]
+    with tempfile.TemporaryDirectory() as scratch:
+        folder = out if out is not None else Path(scratch)
+        bench = bench_campaign(campaign, folder, cases, counts, duration, progress)
+    click.echo(markdown_table(bench))
+
+
+@click.command("peers", short_help="dcsim's attitude loop beside Basilisk's.")
+@click.option(
+    "--duration",
+    type=click.FloatRange(min=1.0, max=86_400.0),
+    default=600.0,
+    show_default=True,
+    help="Simulated seconds per run (whole control periods of 0.1 s).",
+)
+@count_option("--repeats", 3, "Timed runs per side.")
+@click.option(
+    "--basilisk-step",
+    type=click.FloatRange(min=1e-4, max=0.1),
+    default=None,
+    help="Basilisk's dynamics step, s; it must divide the 0.1 s control period "
+    "(default: dcsim's physics step, 0.01 s).",
+)
+@plot_option("Write the pointing error (and the position hold) against time as a PNG.")
+def bench_peers_command(
+    duration: float, repeats: int, basilisk_step: float | None, plot_path: Path | None
+) -> None:
+    """dcsim's attitude loop beside Basilisk's: the same slew, gains and rates.
+
+    A rigid free flyer slews 90° to a fixed inertial attitude under a PD law at 10 Hz,
+    truth-fed, once with translation free and once holding its position; dcsim (the
+    hold mission, pd, PyBullet) and Basilisk (spacecraft hub, extForceTorque, simpleNav,
+    inertial3D, attTrackingError, mrpFeedback, hillFrameRelativeControl) fly it
+    alternately, REPEATS times each. Prints a Markdown table for docs/benchmarks.md.
+    Basilisk is optional (pip install 'dcsim[peers]'); without it the dcsim side runs
+    alone.
+    """
+    from dcsim.bench import peers
+
+    if basilisk_step is not None:
+        periods = peers.SlewCase().control_period / basilisk_step
+        if abs(periods - round(periods)) > 1e-9:
+            raise click.BadParameter(
+                f"{basilisk_step:g} s does not divide the 0.1 s control period",
+                param_hint="'--basilisk-step'",
+            )
+    result = peers.bench_peers(duration, repeats, basilisk_step, progress=progress)
+    click.echo(peers.markdown_table(result))
+    click.echo()
+    click.echo(peers.notes(result))
+    click.echo()
+    click.echo(peers.verdict(result))
+    if plot_path is not None:
+        peers.plot(result, plot_path)
+        click.echo(f"\nplot: {plot_path}")
+
+
+@click.command("manipulator", short_help="The manipulator model's time per call against Pinocchio.")
+@count_option("--states", 64, "Random states (fixed seed) each call is timed at.")
+@count_option(
+    "--repeats", 30, "Timing rounds over every call in turn; each call's best round counts."
+)
+@count_option("--number", 10, "Passes over the states per call and round.")
+@click.option(
+    "--scenario",
+    type=click.Path(exists=True, dir_okay=False, path_type=Path),
+    help="Also run this scenario once and report its real-time factor.",
+)
+def bench_manipulator_command(
+    states: int, repeats: int, number: int, scenario: Path | None
+) -> None:
+    """The manipulator model's time per call against PyBullet's and Pinocchio's.
+
+    Forward kinematics, the end effector's Jacobian, M, C and C q̇ of the thesis's robot,
+    timed with timeit (best of REPEATS rounds) at STATES random states, for dcsim, PyBullet and
+    Pinocchio (if installed), with dcsim's ratio to Pinocchio and whether M + C is
+    within 10× of Pinocchio's. Prints a Markdown table for docs/benchmarks.md.
+    """
+    from dcsim.bench import manipulator as bench
+
+    result = bench.bench_manipulator(states, repeats, number, progress=progress)
+    click.echo(bench.markdown_table(result))
+    click.echo(f"\n{bench.agreement_line(result)}")
+    if scenario is not None:
+        speed = bench.scenario_speed(scenario, registry=plugin_registry())
+        click.echo(f"\n{bench.scenario_line(speed)}")

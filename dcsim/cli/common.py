@@ -1,0 +1,29 @@
+"""What the ``dcsim`` command groups share: the exit status of a user's error, the
+plugin registry with its loading problems printed, and progress lines on stderr."""
+
+from __future__ import annotations
+
+import warnings
+
+import click
+
+from dcsim.errors import PluginLoadWarning
+from dcsim.registry.discovery import PluginRegistry
+
+EXIT_USER_ERROR = 2
+"""Exit status of a command line that a user's error (a dcsim error) ended."""
+
+
+def plugin_registry() -> PluginRegistry:
+    """Discover plugins, printing loading problems as warnings on stderr."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PluginLoadWarning)
+        registry = PluginRegistry.discover()
+    for message in registry.warnings:
+        click.echo(f"warning: {message}", err=True)
+    return registry
+
+
+def progress(line: str) -> None:
+    """Print a command's progress line on stderr (stdout keeps its results)."""
+    click.echo(line, err=True)
