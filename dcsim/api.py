@@ -95,6 +95,7 @@ from dcsim.bench.figures import save as save_figure
 from dcsim.bench.layered_optimum import LayeredOptimum, layered_optimum, optimality_gap
 from dcsim.bench.options import comma_numbers, comma_words, plugin_spec
 from dcsim.errors import (
+    CwValidityWarning,
     DcsimError,
     DuplicatePluginError,
     PlannerModelWarning,
@@ -327,6 +328,7 @@ __all__ = [
     "PlanTask",
     "Plugin",
     "PLUGIN_KINDS",
+    "CwValidityWarning",
     "PlannerModelWarning",
     "PlanOutlastsRunWarning",
     "PluginError",

@@ -148,6 +148,11 @@ class PluginLoadWarning(UserWarning):
     """A plugin package could not be loaded; every other plugin still is."""
 
 
+class CwValidityWarning(UserWarning):
+    """A ``cw`` run flew far enough from the chief, for long enough, that the
+    Clohessy–Wiltshire linearisation may be off by more than ``world.orbit.cw_tolerance``."""
+
+
 class PlannerModelWarning(UserWarning):
     """A planner plans with other orbital dynamics than the world moves bodies by (its
     ``orbit_models`` do not include ``world.orbit.model``)."""

@@ -24,6 +24,7 @@ the telemetry, events and summary recorded so far are written.
 from __future__ import annotations
 
 import dataclasses
+import math
 import sys
 import time as wallclock
 import warnings
@@ -33,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from dcsim.errors import PlannerModelWarning
+from dcsim.errors import CwValidityWarning, PlannerModelWarning
 from dcsim.messages import Command, Observations, Prior, StateEstimate
 from dcsim.missions import Mission, mission_class
 from dcsim.registry.calls import PluginFailure, call_plugin
@@ -50,6 +51,7 @@ from dcsim.run.setup import RunSetup
 from dcsim.scenario import dump_scenario
 from dcsim.scenario.model import point_to_cartesian
 from dcsim.world import World, WorldInputs
+from dcsim.world.orbit.validity import cw_error_estimate
 
 PLOT_POINTS = 2000
 """Telemetry rows the end-of-run plots draw at most (evenly spaced)."""
@@ -192,6 +194,7 @@ class Runner:
         self._squared_error_sum = 0.0
         self._converged_rows = 0
         self._min_gap = float("inf")
+        self._max_separation = 0.0
         self._step_observed = True
 
     @property
@@ -273,7 +276,10 @@ class Runner:
         """End the run, close the world, write the records; return the summary."""
         if not self.ended:
             self._end("stopped", "closed before the end")
+        linearisation = self._cw_error()
         self.summary = self._summary(wallclock.perf_counter() - self._started)
+        if linearisation is not None:
+            self.summary["cw_error_estimate_m"] = linearisation
         self.world.close()
         try:
             for name, text in self.mission.records().items():
@@ -286,6 +292,36 @@ class Runner:
                 self.summary.update(status=self.status, reason=self.reason)
         self._hook("dcsim_run_end", run=self.info, summary=self.summary)
         return self.summary
+
+    def _cw_error(self) -> float | None:
+        """The estimated Clohessy–Wiltshire linearisation error of a ``cw`` run (m), said
+        in an event and a warning when above ``world.orbit.cw_tolerance``; None for
+        other worlds."""
+        world_spec = self.scenario.world
+        orbit = world_spec.orbit
+        if world_spec.frame != "lvlh" or orbit.model != "cw":
+            return None
+        objects = [self.world.field.free_states(t)[0] for t in (0.0, self.world.time)]
+        separation = max(
+            self._max_separation,
+            *(float(np.max(np.linalg.norm(p, axis=1), initial=0.0)) for p in objects),
+        )
+        error = cw_error_estimate(
+            separation, self.world.time, orbit.semi_major_axis, orbit.mean_motion
+        )
+        if error > orbit.cw_tolerance:
+            self._event(
+                "cw_linearisation", error=error, tolerance=orbit.cw_tolerance, separation=separation
+            )
+            warnings.warn(
+                f"Clohessy-Wiltshire may be off by up to {error:.3g} m here ({separation:.0f} m "
+                f"from the chief for {self.world.time:.0f} s), more than world.orbit.cw_tolerance "
+                f"({orbit.cw_tolerance:g} m); set world.orbit.model to two-body or j2 for the "
+                "exact relative motion",
+                CwValidityWarning,
+                stacklevel=2,
+            )
+        return error
 
     def _plot(self) -> None:
         """Draw the run's pictures from its telemetry file."""
@@ -518,6 +554,7 @@ class Runner:
             self._squared_error_sum += float(error @ error)
             self._converged_rows += 1
         self._min_gap = min(self._min_gap, float(outputs["nearest_obstacle_distance"]))
+        self._max_separation = max(self._max_separation, math.hypot(*outputs["position"]))
 
     def _summary_head(self, status: str, reason: str) -> dict[str, Any]:
         """The fields that say what ran and how it ended (or that it is running)."""

@@ -147,10 +147,20 @@ class CWMotionSpec(Section):
         unit="m", description="LVLH position at t = 0 (x radial, y along-track)."
     )
     velocity: Vec3 = quantity((0.0, 0.0, 0.0), unit="m/s", description="LVLH velocity at t = 0.")
+    bounded: bool = Field(
+        False,
+        description="Replace the along-track velocity by the drift-free one for the world's "
+        "orbit and model (−2 n x under `cw`; the chief's energy under `two-body` and `j2`).",
+    )
 
     def build(self, mean_motion: float) -> MotionModel:
-        """The motion model this spec describes."""
-        return ClohessyWiltshireMotion(self.position, self.velocity, mean_motion)
+        """The motion model this spec describes (under ``cw``; a ``two-body`` or ``j2``
+        world takes only its state at t = 0 and makes a bounded start drift-free in its
+        own dynamics)."""
+        velocity = self.velocity
+        if self.bounded:
+            velocity = (velocity[0], -2.0 * mean_motion * self.position[0], velocity[2])
+        return ClohessyWiltshireMotion(self.position, velocity, mean_motion)
 
 
 MotionSpec = Annotated[
@@ -229,6 +239,14 @@ class OrbitSpec(Section):
         unit="m",
         gt=0,
         description="Equatorial radius of the central body (J2's reference radius).",
+    )
+    cw_tolerance: float = quantity(
+        0.1,
+        unit="m",
+        gt=0,
+        description="Under `cw`: the linearisation error (estimated as 3 ρ² n t / a from "
+        "the largest separation ρ and the time t flown) above which the run says that "
+        "CW no longer holds.",
     )
 
     @property

@@ -5,13 +5,15 @@ from __future__ import annotations
 import enum
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from dcsim.messages import ObjectKind, Shape, ShapeKind
 from dcsim.motion import MotionModel, MotionSet
 from dcsim.scenario.model import Scenario
-from dcsim.world.orbit.chief import orbit_period, relative_dynamics
+from dcsim.world.orbit.bounded import energy_matched_velocity
+from dcsim.world.orbit.chief import orbit_period, orbit_potential, relative_dynamics
 from dcsim.world.orbit.objects import ObjectOrbits, PropagatedMotion
 from dcsim.world.orbit.relative import RelativeDynamics
 
@@ -84,30 +86,40 @@ def build_objects(
         world = scenario.world
         clock = (world.physics_step, round(world.control_period / world.physics_step))
         dynamics = dynamics or relative_dynamics(orbit)
-        motions = _propagated(motions, dynamics, orbit_period(orbit), clock)
+        starts = [m.state_at(0.0) for m in motions]
+        potential = orbit_potential(orbit)
+        starts = [
+            (p, energy_matched_velocity(dynamics, potential, p, v) if _bounded(spec) else v)
+            for (p, v), (_, spec) in zip(starts, specs, strict=True)
+        ]
+        motions = _propagated(starts, dynamics, orbit_period(orbit), clock)
     return [
         SpaceObject(spec.id, kind, spec.build_shape(), spec.mass, motion)
         for (kind, spec), motion in zip(specs, motions, strict=True)
     ]
 
 
+def _bounded(spec: Any) -> bool:
+    """Whether an object's motion spec asks for a drift-free start."""
+    return bool(getattr(spec.motion, "bounded", False))
+
+
 def _propagated(
-    motions: list[MotionModel],
+    starts: list[tuple[np.ndarray, np.ndarray]],
     dynamics: RelativeDynamics,
     period: float,
     clock: tuple[float, int],
 ) -> list[MotionModel]:
-    """Motions under the world's orbit model from the given motions' states at t = 0
+    """Motions under the world's orbit model from the objects' LVLH states at t = 0
     (``clock``: the world's physics step, s, and steps per control period)."""
-    start = [m.state_at(0.0) for m in motions]
     orbits = ObjectOrbits(
         dynamics,
-        np.array([p for p, _ in start]),
-        np.array([v for _, v in start]),
+        np.array([p for p, _ in starts]),
+        np.array([v for _, v in starts]),
         period,
         clock,
     )
-    return [PropagatedMotion(orbits, i) for i in range(len(motions))]
+    return [PropagatedMotion(orbits, i) for i in range(len(starts))]
 
 
 class ObjectField:

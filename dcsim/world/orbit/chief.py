@@ -6,7 +6,13 @@ import math
 
 from dcsim.scenario.model import OrbitSpec
 from dcsim.world.orbit.frame import elements_to_state
-from dcsim.world.orbit.gravity import point_mass, with_j2
+from dcsim.world.orbit.gravity import (
+    Potential,
+    j2_potential,
+    point_mass,
+    point_mass_potential,
+    with_j2,
+)
 from dcsim.world.orbit.propagation import KeplerOrbit, NumericalOrbits
 from dcsim.world.orbit.relative import RelativeDynamics
 
@@ -44,3 +50,10 @@ def relative_dynamics(orbit: OrbitSpec) -> RelativeDynamics:
     gravity = with_j2(orbit.mu, orbit.j2, orbit.earth_radius)
     chief = NumericalOrbits(position[None], velocity[None], gravity, orbit_period(orbit))
     return RelativeDynamics(chief, gravity)
+
+
+def orbit_potential(orbit: OrbitSpec) -> Potential:
+    """The potential of a ``two-body`` or ``j2`` orbit's gravity field."""
+    if orbit.model == "j2":
+        return j2_potential(orbit.mu, orbit.j2, orbit.earth_radius)
+    return point_mass_potential(orbit.mu)

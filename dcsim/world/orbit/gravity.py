@@ -54,3 +54,27 @@ def with_j2(mu: float, j2: float, body_radius: float) -> Gravity:
         return central(position) + scale * zonal
 
     return gravity
+
+
+Potential = Callable[[Vector], Vector]
+"""A potential: inertial positions (…, 3), m → potential energy per mass (…), m²/s²."""
+
+
+def point_mass_potential(mu: float) -> Potential:
+    """``U = −μ / |r|`` (μ in m³/s²)."""
+
+    def potential(position: Vector) -> Vector:
+        return -mu / np.linalg.norm(position, axis=-1)
+
+    return potential
+
+
+def j2_potential(mu: float, j2: float, body_radius: float) -> Potential:
+    """``U = −μ/r + μ J2 R² (3 z²/r² − 1) / (2 r³)``: the potential of :func:`with_j2`."""
+
+    def potential(position: Vector) -> Vector:
+        r = np.linalg.norm(position, axis=-1)
+        z2 = position[..., 2] ** 2 / r**2
+        return -mu / r + mu * j2 * body_radius**2 * (3.0 * z2 - 1.0) / (2.0 * r**3)
+
+    return potential
