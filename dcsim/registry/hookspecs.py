@@ -85,7 +85,10 @@ def dcsim_register_commands(cli: click.Group, bench: click.Group) -> None:
 
     Called once when a ``dcsim`` command line needs a command it does not hold itself
     (``dcsim --help``, ``dcsim bench NAME``). Add click commands or groups to either
-    group; the implementation may take only the arguments it uses::
+    group; the implementation may take only the arguments it uses. A module declared in a
+    kind's entry-point group is asked for ``bench`` commands only (``dcsim bench``
+    imports every such module to ask it); top-level commands come from modules of the
+    ``dcsim`` group, the only ones ``dcsim --help`` asks::
 
         @hookimpl
         def dcsim_register_commands(bench):
