@@ -204,3 +204,13 @@ def test_a_declared_plugin_whose_module_gives_another_name_fails_when_used(monke
         used.get("controller", "other")
     with pytest.warns(PluginLoadWarning, match="declares the controller plugin 'other'"):
         assert listed.plugins() == []
+
+
+def test_a_module_in_the_dcsim_group_and_its_kinds_group_registers_its_plugin_once(monkeypatch):
+    entry_point, _ = _declared_module(monkeypatch, [ThrowAwayController])
+    registry = PluginRegistry()
+    registry.register_module(sys.modules[entry_point.value], ORIGIN)
+    registry.declare(PluginEntry("controller", "throw-away", ORIGIN), entry_point)
+    assert [e.name for e in registry.entries("controller")] == ["throw-away"]
+    assert registry.get("controller", "throw-away").cls is ThrowAwayController
+    assert registry.warnings == [] and len(registry.plugins()) == 1

@@ -313,15 +313,13 @@ class PluginRegistry:
             )
 
     def register_module(self, module: ModuleType, origin: PluginOrigin) -> None:
-        """Register the classes returned by ``module``'s ``dcsim_plugin_classes`` hook."""
-        for plugin_cls in self._module_classes(module, origin):
+        """Register ``module``'s hooks and the classes its ``dcsim_plugin_classes`` returns."""
+        self._manager.register(module, name=origin.entry_point)
+        for plugin_cls in self._hook_classes(module):
             self.register_class(plugin_cls, origin)
 
-    def _module_classes(self, module: ModuleType, origin: PluginOrigin) -> list[Any]:
-        """Register ``module``'s hooks (once) and return what its ``dcsim_plugin_classes``
-        gives."""
-        if not self._manager.is_registered(module):
-            self._manager.register(module, name=origin.entry_point)
+    def _hook_classes(self, module: ModuleType) -> list[Any]:
+        """What the ``dcsim_plugin_classes`` hook of ``module`` (registered) returns."""
         found: list[Any] = []
         for impl in self._manager.hook.dcsim_plugin_classes.get_hookimpls():
             if impl.plugin is module:
@@ -361,19 +359,26 @@ class PluginRegistry:
             )
             return
         try:
-            module_or_class: Any = loaded
-            candidates = (
-                [loaded]
-                if inspect.isclass(loaded)
-                else self._module_classes(module_or_class, entry.origin)
-            )
-            self.register_class(self._declared_class(entry, candidates), entry.origin)
+            self._register_declared(entry, loaded)
         except PluginInterfaceError as exc:
             declared.error = PluginInterfaceError(f"{exc}; it comes from {entry.origin}")
         except Exception as exc:  # a third party's hook raised
             declared.error = PluginLoadError(
                 f"{label} failed while giving its classes: {type(exc).__name__}: {exc}"
             )
+
+    def _register_declared(self, entry: PluginEntry, loaded: Any) -> None:
+        """Register the class of ``entry`` from what its entry point loaded (a module, whose
+        hooks are registered once, or the class), unless the ``dcsim`` group gave it."""
+        if inspect.isclass(loaded):
+            candidates = [loaded]
+        else:
+            if not self._manager.is_registered(loaded):
+                self._manager.register(loaded, name=entry.origin.entry_point)
+            candidates = self._hook_classes(loaded)
+        plugin_cls = self._declared_class(entry, candidates)
+        if all(p.cls is not plugin_cls for p in self._plugins.get((entry.kind, entry.name), ())):
+            self.register_class(plugin_cls, entry.origin)
 
     @staticmethod
     def _declared_class(entry: PluginEntry, candidates: Iterable[Any]) -> type[Plugin]:
@@ -441,8 +446,14 @@ class PluginRegistry:
         any declared plugin; ordered by kind, name, then distribution."""
         if kind is not None:
             self._check_kind(kind)
-        declared = (d.entry for ds in self._declared.values() for d in ds if not d.tried)
-        loaded = (p.entry for ps in self._plugins.values() for p in ps)
+        loaded = [p.entry for ps in self._plugins.values() for p in ps]
+        seen = {(e.kind, e.name, e.origin.distribution) for e in loaded}
+        declared = [
+            d.entry
+            for ds in self._declared.values()
+            for d in ds
+            if not d.tried and (d.entry.kind, d.entry.name, d.entry.origin.distribution) not in seen
+        ]
         found = [e for e in (*declared, *loaded) if kind in (None, e.kind)]
         return sorted(found, key=lambda e: _order(e.kind, e.name, e.origin))
 
