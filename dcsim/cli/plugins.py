@@ -127,8 +127,9 @@ def _print_table(header: tuple[str, ...], rows: Sequence[tuple[str, ...]]) -> No
 def new_plugin_command(kind: str, name: str, directory: Path) -> None:
     """Write an out-of-tree package: a plugin of KIND called NAME, or a mission.
 
-    The package (DIR/dcsim-NAME) has a pyproject.toml with the dcsim entry point, the
-    plugin class with its parameter model and a simple working algorithm, a test file
+    The package (DIR/dcsim-NAME) has a pyproject.toml with its entry point in KIND's
+    group (dcsim.controllers, ...), the plugin class with its parameter model and a
+    simple working algorithm, a test file
     that runs the conformance suite, and a README. KIND `mission` writes a mission
     instead (mission.type NAME, found through the dcsim.missions entry point: its
     settings and a mission that flies to a point and holds it), with an example
