@@ -126,6 +126,11 @@ class PluginInterfaceError(PluginError):
     """A plugin class does not satisfy its kind's interface."""
 
 
+class PluginLoadError(PluginError):
+    """A plugin's module failed to import, or failed to give the plugin's class, when the
+    plugin was used."""
+
+
 class PluginParameterError(PluginError):
     """Parameters given to a plugin are invalid.
 

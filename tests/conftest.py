@@ -73,12 +73,17 @@ def default_run(tmp_path_factory) -> tuple[Runner, dict, Path]:
 
 
 def make_distribution(
-    root: Path, dist: str, version: str, modules: dict[str, str], entry_points: dict[str, str]
+    root: Path,
+    dist: str,
+    version: str,
+    modules: dict[str, str],
+    entry_points: dict[str, str],
+    group: str = "dcsim",
 ) -> Path:
     """Install a throw-away distribution under ``root``: modules plus a dist-info.
 
     ``importlib.metadata`` finds it like any installed package once ``root`` is on the
-    path, so the registry discovers its ``dcsim`` entry points for real.
+    path, so the registry discovers its entry points (of ``group``) for real.
     """
     root.mkdir(parents=True, exist_ok=True)
     for name, source in modules.items():
@@ -87,7 +92,7 @@ def make_distribution(
     info.mkdir()
     (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {dist}\nVersion: {version}\n")
     lines = "\n".join(f"{k} = {v}" for k, v in entry_points.items())
-    (info / "entry_points.txt").write_text(f"[dcsim]\n{lines}\n")
+    (info / "entry_points.txt").write_text(f"[{group}]\n{lines}\n")
     return root
 
 

@@ -46,7 +46,7 @@ def test_plugins_table_lists_builtins_with_origin(dcsim_cli):
     result = dcsim_cli("plugins")
     assert result.returncode == 0
     lines = result.stdout.splitlines()
-    assert lines[0].split() == ["KIND", "NAME", "SUMMARY", "ORIGIN"]
+    assert lines[0].split() == ["KIND", "NAME", "ORIGIN"]
     for kind, name in [
         ("localiser", "trilateration"),
         ("task_planner", "nearest"),
@@ -70,7 +70,9 @@ def test_plugins_json_and_kind_filter(dcsim_cli):
     ]
     assert entries[0]["kind"] == "controller"
     assert entries[0]["distribution"] == "dcsim"
-    assert entries[0]["summary"]
+    assert (
+        entries[0]["entry_point"] == "computed-torque = dcsim_plugins.controllers.computed_torque"
+    )
 
 
 def test_plugins_rejects_unknown_kind(dcsim_cli):

@@ -1,7 +1,10 @@
-"""The plugin registry in-process: built-ins through entry points, checks, lookup."""
+"""The plugin registry in-process: built-ins through entry points, checks, lookup, loading
+when used."""
 
 from __future__ import annotations
 
+import importlib.metadata as md
+import sys
 import types
 
 import numpy as np
@@ -20,7 +23,7 @@ from dcsim.api import (
     hookimpl,
     quantity,
 )
-from dcsim.registry.discovery import PluginOrigin, check_plugin_class
+from dcsim.registry.discovery import PluginEntry, PluginOrigin, check_plugin_class
 
 ORIGIN = PluginOrigin("test-dist", "0.0", "test")
 
@@ -160,3 +163,54 @@ def test_parameters_reject_strings_for_numbers_and_unknown_names():
 def test_parameters_round_trip():
     params = GainParams.parse("throw-away", {"gain": 4})
     assert GainParams.parse("throw-away", params.model_dump(mode="json")) == params
+
+
+def _declared_module(monkeypatch, classes, name="lazy_throw_away"):
+    """A module importable as ``name`` whose hook gives ``classes``, counting its calls."""
+    module = types.ModuleType(name)
+    calls = []
+
+    @hookimpl
+    def dcsim_plugin_classes():
+        calls.append(1)
+        return classes
+
+    module.dcsim_plugin_classes = dcsim_plugin_classes
+    monkeypatch.setitem(sys.modules, name, module)
+    return md.EntryPoint("throw-away", name, "dcsim.controllers"), calls
+
+
+def test_a_declared_plugin_is_listed_from_metadata_and_loaded_once_when_looked_up(monkeypatch):
+    entry_point, calls = _declared_module(monkeypatch, [ThrowAwayController])
+    registry = PluginRegistry()
+    registry.declare(PluginEntry("controller", "throw-away", ORIGIN), entry_point)
+    assert registry.names("controller") == ["throw-away"]
+    assert [e.name for e in registry.entries()] == ["throw-away"] and calls == []
+    assert registry.get("controller", "throw-away").cls is ThrowAwayController
+    assert registry.create("controller", "throw-away").params.gain == 2.0
+    assert calls == [1]
+
+
+def test_a_declared_plugin_whose_module_gives_another_name_fails_when_used(monkeypatch):
+    entry_point, _ = _declared_module(monkeypatch, [ThrowAwayController])
+    used, listed = PluginRegistry(), PluginRegistry()
+    for registry in (used, listed):
+        registry.declare(PluginEntry("controller", "other", ORIGIN), entry_point)
+    with pytest.raises(
+        PluginInterfaceError,
+        match=r"declares the controller plugin 'other', but its module gives no controller class "
+        r"with name = 'other'",
+    ):
+        used.get("controller", "other")
+    with pytest.warns(PluginLoadWarning, match="declares the controller plugin 'other'"):
+        assert listed.plugins() == []
+
+
+def test_a_module_in_the_dcsim_group_and_its_kinds_group_registers_its_plugin_once(monkeypatch):
+    entry_point, _ = _declared_module(monkeypatch, [ThrowAwayController])
+    registry = PluginRegistry()
+    registry.register_module(sys.modules[entry_point.value], ORIGIN)
+    registry.declare(PluginEntry("controller", "throw-away", ORIGIN), entry_point)
+    assert [e.name for e in registry.entries("controller")] == ["throw-away"]
+    assert registry.get("controller", "throw-away").cls is ThrowAwayController
+    assert registry.warnings == [] and len(registry.plugins()) == 1

@@ -14,11 +14,14 @@ EXIT_USER_ERROR = 2
 """Exit status of a command line that a user's error (a dcsim error) ended."""
 
 
-def plugin_registry() -> PluginRegistry:
-    """Discover plugins, printing loading problems as warnings on stderr."""
+def plugin_registry(load_all: bool = False) -> PluginRegistry:
+    """Discover plugins (importing every one if ``load_all``), printing loading problems as
+    warnings on stderr."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PluginLoadWarning)
         registry = PluginRegistry.discover()
+        if load_all:
+            registry.load_all()
     for message in registry.warnings:
         click.echo(f"warning: {message}", err=True)
     return registry

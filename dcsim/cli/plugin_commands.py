@@ -99,28 +99,32 @@ class PluginGroup(click.Group):
 
     def list_commands(self, ctx: click.Context) -> list[str]:
         """dcsim's own commands and the plugin packages', sorted."""
-        return sorted({*self.commands, *_added_commands(ctx)[self.hook_argument]})
+        return sorted({*self.commands, *_added_commands(ctx, self.hook_argument)})
 
     def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
         """dcsim's own command of that name, else a plugin package's."""
         own = self.commands.get(cmd_name)
-        return own if own is not None else _added_commands(ctx)[self.hook_argument].get(cmd_name)
+        return own if own is not None else _added_commands(ctx, self.hook_argument).get(cmd_name)
 
 
-def _added_commands(ctx: click.Context) -> dict[str, dict[str, click.Command]]:
-    """The commands plugin packages add, by hook argument (asked once per command line;
-    refused ones are printed as warnings on stderr).
+def _added_commands(ctx: click.Context, group: str) -> dict[str, click.Command]:
+    """The commands plugin packages add to ``group`` (a hook argument), asked once per
+    command line; refused ones are printed as warnings on stderr.
 
-    The names taken are those of dcsim's own commands in the plugin groups of the command
-    line: its root group and the groups directly under it.
+    Only ``bench`` imports the plugins declared in the kinds' entry-point groups, to ask
+    them for their benches; the other groups ask the ``dcsim`` group's modules, which
+    discovery imports anyway, so that ``dcsim --help`` imports no plugin. The names
+    taken are those of dcsim's own commands in the plugin groups of the command line:
+    its root group and the groups directly under it.
     """
     root = ctx.find_root()
-    if "dcsim.plugin_commands" not in root.meta:
+    key = f"dcsim.plugin_commands.{group}"
+    if key not in root.meta:
         groups = [root.command, *getattr(root.command, "commands", {}).values()]
         taken = {g.hook_argument: g.commands for g in groups if isinstance(g, PluginGroup)}
-        found = plugin_commands(plugin_registry(), taken)
+        found = plugin_commands(plugin_registry(load_all=group == "bench"), taken)
         for message in found.warnings:
             click.echo(f"warning: {message}", err=True)
-        root.meta["dcsim.plugin_commands"] = found.commands
-    commands: dict[str, dict[str, click.Command]] = root.meta["dcsim.plugin_commands"]
+        root.meta[key] = found.commands[group]
+    commands: dict[str, click.Command] = root.meta[key]
     return commands

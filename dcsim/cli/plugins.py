@@ -25,42 +25,43 @@ from dcsim.registry.interfaces import PLUGIN_KINDS
 )
 @click.option("--json", "as_json", is_flag=True, help="Print a JSON list instead of a table.")
 def plugins_command(name: str | None, kind: str | None, as_json: bool) -> None:
-    """List registered plugins: kind, name, summary and origin; or NAME's parameters.
+    """List installed plugins: kind, name and origin; or NAME's summary and parameters.
 
-    The origin is the installed distribution (and version) that provides the plugin.
-    With NAME, prints that plugin's robots and parameters (name, default, unit, bounds
-    or allowed values, description), the keys of its scenario section's params; --kind
-    picks one of two plugins of that name. Set DCSIM_LOAD_PLUGINS to a comma-separated
-    list of distributions to restrict which external plugins load.
+    The origin is the installed distribution (and version) that provides the plugin; the
+    listing is read from the packages' metadata, without importing any plugin. With NAME,
+    imports that plugin and prints its summary, robots and parameters (name, default,
+    unit, bounds or allowed values, description), the keys of its scenario section's
+    params; --kind picks one of two plugins of that name. Set DCSIM_LOAD_PLUGINS to a
+    comma-separated list of distributions to restrict which external plugins load.
     """
     registry = plugin_registry()
     if name is not None:
         _print_parameters(_plugins_named(registry, name, kind), as_json)
         return
-    entries = [p.as_dict() for p in registry.plugins(kind)]
+    entries = [e.as_dict() for e in registry.entries(kind)]
     if as_json:
         click.echo(json.dumps(entries, indent=2))
         return
-    rows = [
-        (e["kind"], e["name"], e["summary"], f"{e['distribution']} {e['version']}") for e in entries
-    ]
-    _print_table(("KIND", "NAME", "SUMMARY", "ORIGIN"), rows)
+    rows = [(e["kind"], e["name"], f"{e['distribution']} {e['version']}") for e in entries]
+    _print_table(("KIND", "NAME", "ORIGIN"), rows)
 
 
 def _plugins_named(registry: PluginRegistry, name: str, kind: str | None) -> list[RegisteredPlugin]:
-    """The registered plugins called ``name`` (of ``kind``, if given).
+    """The plugins called ``name`` (of ``kind``, if given), imported.
 
     Raises
     ------
     PluginNotFoundError
         Naming the closest names when there is none.
+    PluginLoadError
+        If one of them fails to import.
     """
-    found = [p for p in registry.plugins(kind) if p.name == name]
+    found = registry.find(name, kind)
     if found:
         return found
     if kind is not None:
         registry.get(kind, name)  # raises, with the names of that kind
-    names = sorted({p.name for p in registry.plugins()})
+    names = sorted({e.name for e in registry.entries()})
     raise PluginNotFoundError(
         f"no plugin named '{name}' (see dcsim plugins)" + did_you_mean(name, names)
     )
@@ -126,8 +127,9 @@ def _print_table(header: tuple[str, ...], rows: Sequence[tuple[str, ...]]) -> No
 def new_plugin_command(kind: str, name: str, directory: Path) -> None:
     """Write an out-of-tree package: a plugin of KIND called NAME, or a mission.
 
-    The package (DIR/dcsim-NAME) has a pyproject.toml with the dcsim entry point, the
-    plugin class with its parameter model and a simple working algorithm, a test file
+    The package (DIR/dcsim-NAME) has a pyproject.toml with its entry point in KIND's
+    group (dcsim.controllers, ...), the plugin class with its parameter model and a
+    simple working algorithm, a test file
     that runs the conformance suite, and a README. KIND `mission` writes a mission
     instead (mission.type NAME, found through the dcsim.missions entry point: its
     settings and a mission that flies to a point and holds it), with an example

@@ -1,7 +1,9 @@
 """Hook specifications: the points where plugin packages plug into dcsim.
 
-A plugin package exposes a module (or a plugin class) through the ``dcsim``
-entry-point group. Modules implement the hooks below, marked with
+A plugin package exposes a module (or a plugin class) through an entry point in its
+plugin's kind's group (``dcsim.controllers``, ...; imported when the plugin is used) or
+in the ``dcsim`` group (imported whenever the registry is built; see
+:mod:`dcsim.registry.discovery`). Modules implement the hooks below, marked with
 :data:`hookimpl`: :func:`dcsim_plugin_classes` provides plugin classes, and the
 lifecycle hooks :func:`dcsim_run_start`, :func:`dcsim_run_step`,
 :func:`dcsim_run_event` and :func:`dcsim_run_end` let a package observe runs (a
@@ -32,7 +34,8 @@ if TYPE_CHECKING:
     from dcsim.scenario.model import Scenario
 
 PROJECT_NAME = "dcsim"
-"""The pluggy project name and the entry-point group plugins are found in."""
+"""The pluggy project name, the entry-point group of hook modules, and the prefix of the
+kinds' groups plugins are declared in."""
 
 hookspec = pluggy.HookspecMarker(PROJECT_NAME)
 hookimpl = pluggy.HookimplMarker(PROJECT_NAME)
@@ -82,7 +85,10 @@ def dcsim_register_commands(cli: click.Group, bench: click.Group) -> None:
 
     Called once when a ``dcsim`` command line needs a command it does not hold itself
     (``dcsim --help``, ``dcsim bench NAME``). Add click commands or groups to either
-    group; the implementation may take only the arguments it uses::
+    group; the implementation may take only the arguments it uses. A module declared in a
+    kind's entry-point group is asked for ``bench`` commands only (``dcsim bench``
+    imports every such module to ask it); top-level commands come from modules of the
+    ``dcsim`` group, the only ones ``dcsim --help`` asks::
 
         @hookimpl
         def dcsim_register_commands(bench):

@@ -1,10 +1,11 @@
 """``dcsim new-plugin``: write an out-of-tree plugin or mission package that works as generated.
 
-The package has a ``pyproject.toml`` declaring its entry point (``dcsim`` for a plugin,
-``dcsim.missions`` for a mission), the plugin class with its parameter model (a simple
-but real algorithm of the kind) or the mission with its settings (flying to a point and
-holding it), a test file running dcsim's conformance suite (for a mission, on an example
-scenario it ships), and a README. It installs with ``pip install -e``.
+The package has a ``pyproject.toml`` declaring its entry point (in its kind's group, such
+as ``dcsim.controllers``, for a plugin; ``dcsim.missions`` for a mission), the plugin
+class with its parameter model (a simple but real algorithm of the kind) or the mission
+with its settings (flying to a point and holding it), a test file running dcsim's
+conformance suite (for a mission, on an example scenario it ships), and a README. It
+installs with ``pip install -e``.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from string import Template
 
 from dcsim import __version__
 from dcsim.errors import DcsimError
-from dcsim.registry.discovery import PluginRegistry
+from dcsim.registry.discovery import PluginRegistry, kind_group
 from dcsim.registry.interfaces import PLUGIN_KINDS
 
 MISSION = "mission"
@@ -128,7 +129,7 @@ def _refuse_taken(kind: str, name: str, registry: PluginRegistry | None) -> None
                 f"({known.__module__}.{known.__qualname__}); choose another name"
             )
         return
-    taken = [p for p in (registry.plugins(kind) if registry else ()) if p.name == name]
+    taken = [e for e in (registry.entries(kind) if registry else ()) if e.name == name]
     if taken:
         raise ScaffoldError(
             f"an installed {kind} plugin is already named '{name}' ({taken[0].origin}); "
@@ -140,7 +141,7 @@ def _entry_point(kind: str, name: str, module: str, class_name: str) -> str:
     """The ``pyproject.toml`` entry point through which dcsim finds the package's class."""
     if kind == MISSION:
         return f'[project.entry-points."dcsim.missions"]\n{name} = "{module}:{class_name}"'
-    return f'[project.entry-points.dcsim]\n{name} = "{module}"'
+    return f'[project.entry-points."{kind_group(kind)}"]\n{name} = "{module}"'
 
 
 def _files(kind: str, module: str) -> dict[str, str]:
