@@ -269,12 +269,14 @@ class WorldSpec(Section):
 
     frame: Literal["lvlh", "geocentric"] = Field(
         "lvlh",
-        description="lvlh: Clohessy–Wiltshire relative motion about the reference orbit; "
+        description="lvlh: relative motion in the LVLH frame of world.orbit (its model: "
+        "Clohessy–Wiltshire, two-body or j2); "
         "geocentric: the debris collector thesis's force-free spherical world.",
     )
     orbit: OrbitSpec = Field(
         default_factory=OrbitSpec,
-        description="Reference orbit (lvlh only); its mean motion is between "
+        description="The chief's orbit and the relative dynamics (lvlh only); its mean "
+        "motion is between "
         f"{MEAN_MOTION_RANGE[0]:g} and {MEAN_MOTION_RANGE[1]:g} rad/s.",
     )
     physics_step: float = quantity(
