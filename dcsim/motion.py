@@ -116,7 +116,7 @@ def batch_states(models: Sequence[MotionModel], t: float) -> tuple[Vector, Vecto
     return MotionSet(models).state_at(t)
 
 
-Scalars = float | Vector
+_Scalars = float | Vector
 """One value (a float) or many (an array) of a quantity that broadcasts element-wise."""
 
 
@@ -314,8 +314,8 @@ class ClohessyWiltshireMotion(MotionModel):
         the closed form are computed once per time rather than once per model.
         """
         means, epochs = _stack(models, "mean_motion"), _stack(models, "epoch")
-        n: Scalars = means
-        epoch: Scalars = epochs
+        n: _Scalars = means
+        epoch: _Scalars = epochs
         if (means == means[0]).all() and (epochs == epochs[0]).all():
             n, epoch = float(means[0]), float(epochs[0])
         return _stack(models, "position").T, _stack(models, "velocity").T, n, epoch
@@ -327,7 +327,7 @@ class ClohessyWiltshireMotion(MotionModel):
         return _cw_state(position, velocity, n, float(t) - epoch)
 
 
-def _elapsed(t: ArrayLike, epoch: float) -> Scalars:
+def _elapsed(t: ArrayLike, epoch: float) -> _Scalars:
     """Time (s) from ``epoch`` (s) to ``t`` (s): a float for a scalar ``t``, else an array."""
     if isinstance(t, (int, float)):
         return float(t) - epoch
@@ -336,10 +336,10 @@ def _elapsed(t: ArrayLike, epoch: float) -> Scalars:
 
 
 def _cw_state(
-    position: Sequence[Scalars] | Vector,
-    velocity: Sequence[Scalars] | Vector,
-    n: Scalars,
-    tau: Scalars,
+    position: Sequence[_Scalars] | Vector,
+    velocity: Sequence[_Scalars] | Vector,
+    n: _Scalars,
+    tau: _Scalars,
 ) -> tuple[Vector, Vector]:
     """The Clohessy–Wiltshire closed form; components of ``position`` (m) and ``velocity``
     (m/s) at the epoch broadcast with τ (s); ``n`` is the mean motion, rad/s.
@@ -365,14 +365,14 @@ def _cw_state(
 def _sin_cos(angle: float) -> tuple[float, float]: ...
 @overload
 def _sin_cos(angle: Vector) -> tuple[Vector, Vector]: ...
-def _sin_cos(angle: Scalars) -> tuple[float, float] | tuple[Vector, Vector]:
+def _sin_cos(angle: _Scalars) -> tuple[float, float] | tuple[Vector, Vector]:
     """``sin`` and ``cos`` of ``angle`` (rad): floats for a float, arrays otherwise."""
     if isinstance(angle, float):
         return float(np.sin(angle)), float(np.cos(angle))
     return np.sin(angle), np.cos(angle)
 
 
-def _columns(x: Scalars, y: Scalars, z: Scalars) -> Vector:
+def _columns(x: _Scalars, y: _Scalars, z: _Scalars) -> Vector:
     """``x``, ``y`` and ``z`` (broadcast together) as the last axis of one array."""
     if isinstance(x, float) and isinstance(y, float) and isinstance(z, float):
         return np.array((x, y, z))
