@@ -780,19 +780,23 @@ class Scenario(Section):
         orbit = self.world.orbit
         if orbit.model == "cw":
             return FrameDynamics(FrameKind.CLOHESSY_WILTSHIRE, self.mean_motion)
+        inclination, raan, perigee, anomaly = (
+            math.radians(angle)
+            for angle in (
+                orbit.inclination,
+                orbit.raan,
+                orbit.argument_of_perigee,
+                orbit.true_anomaly,
+            )
+        )
         chief = ChiefOrbit(
             OrbitModel(orbit.model),
             orbit.semi_major_axis,
             orbit.eccentricity,
-            *(
-                math.radians(angle)
-                for angle in (
-                    orbit.inclination,
-                    orbit.raan,
-                    orbit.argument_of_perigee,
-                    orbit.true_anomaly,
-                )
-            ),
+            inclination,
+            raan,
+            perigee,
+            anomaly,
             orbit.mu,
             orbit.j2,
             orbit.earth_radius,
