@@ -14,7 +14,7 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -116,6 +116,10 @@ def batch_states(models: Sequence[MotionModel], t: float) -> tuple[Vector, Vecto
     return MotionSet(models).state_at(t)
 
 
+_Scalars = float | Vector
+"""One value (a float) or many (an array) of a quantity that broadcasts element-wise."""
+
+
 def _stack(models: Sequence[Any], name: str) -> np.ndarray:
     return np.array([getattr(m, name) for m in models], dtype=float)
 
@@ -131,8 +135,8 @@ class StaticMotion(MotionModel):
 
     position: tuple[float, float, float]
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "position", _vec3(self.position))
+    def __init__(self, position: ArrayLike) -> None:
+        object.__setattr__(self, "position", _vec3(position))
 
     def state_at(self, t: ArrayLike) -> tuple[Vector, Vector]:
         """Return the fixed position and zero velocity at time(s) ``t``."""
@@ -168,9 +172,10 @@ class LinearMotion(MotionModel):
     velocity: tuple[float, float, float]
     epoch: float = 0.0
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "position", _vec3(self.position))
-        object.__setattr__(self, "velocity", _vec3(self.velocity))
+    def __init__(self, position: ArrayLike, velocity: ArrayLike, epoch: float = 0.0) -> None:
+        object.__setattr__(self, "position", _vec3(position))
+        object.__setattr__(self, "velocity", _vec3(velocity))
+        object.__setattr__(self, "epoch", epoch)
 
     def state_at(self, t: ArrayLike) -> tuple[Vector, Vector]:
         """Return position and velocity at time(s) ``t``."""
@@ -227,7 +232,7 @@ class SphericalMotion(MotionModel):
     def state_at(self, t: ArrayLike) -> tuple[Vector, Vector]:
         """Return position and velocity at time(s) ``t``, from the exact derivative."""
         tau = np.asarray(t, dtype=float) - self.epoch
-        return _spherical_state(*(getattr(self, n) for n in _SPHERICAL_PARAMETERS), tau)
+        return _spherical_state([getattr(self, n) for n in _SPHERICAL_PARAMETERS], tau)
 
     @classmethod
     def stack(cls, models: Sequence[MotionModel]) -> Any:
@@ -238,22 +243,16 @@ class SphericalMotion(MotionModel):
     def stacked_state(cls, stacked: Any, t: float) -> tuple[Vector, Vector]:
         """Vectorised :meth:`state_at` of many spherical motions at time ``t``."""
         *parameters, epoch = stacked
-        return _spherical_state(*parameters, t - epoch)
+        return _spherical_state(parameters, t - epoch)
 
 
 _SPHERICAL_PARAMETERS = ("r", "polar_deg", "azimuth_deg", "v", "alpha_deg_s", "beta_deg_s")
 
 
-def _spherical_state(
-    r0: ArrayLike,
-    polar_deg: ArrayLike,
-    azimuth_deg: ArrayLike,
-    v: ArrayLike,
-    alpha_deg_s: ArrayLike,
-    beta_deg_s: ArrayLike,
-    tau: np.ndarray,
-) -> tuple[Vector, Vector]:
-    """Eq. 2.1 and its time derivative; parameters broadcast against ``tau``."""
+def _spherical_state(parameters: Sequence[ArrayLike], tau: Vector) -> tuple[Vector, Vector]:
+    """Eq. 2.1 and its time derivative; ``parameters`` are the values named by
+    ``_SPHERICAL_PARAMETERS``, in that order, and broadcast against ``tau`` (s)."""
+    r0, polar_deg, azimuth_deg, v, alpha_deg_s, beta_deg_s = parameters
     r = r0 + np.multiply(v, tau)
     theta = np.radians(polar_deg + np.multiply(alpha_deg_s, tau))
     phi = np.radians(azimuth_deg + np.multiply(beta_deg_s, tau))
@@ -292,16 +291,19 @@ class ClohessyWiltshireMotion(MotionModel):
     mean_motion: float
     epoch: float = 0.0
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "position", _vec3(self.position))
-        object.__setattr__(self, "velocity", _vec3(self.velocity))
+    def __init__(
+        self, position: ArrayLike, velocity: ArrayLike, mean_motion: float, epoch: float = 0.0
+    ) -> None:
+        object.__setattr__(self, "position", _vec3(position))
+        object.__setattr__(self, "velocity", _vec3(velocity))
+        object.__setattr__(self, "mean_motion", mean_motion)
+        object.__setattr__(self, "epoch", epoch)
         if not self.mean_motion > 0:
             raise ValueError("mean_motion must be positive")
 
     def state_at(self, t: ArrayLike) -> tuple[Vector, Vector]:
         """Return the exact relative position and velocity at time(s) ``t``."""
-        tau = float(t) - self.epoch if np.ndim(t) == 0 else np.asarray(t, dtype=float) - self.epoch
-        return _cw_state(self.position, self.velocity, self.mean_motion, tau)
+        return _cw_state(self.position, self.velocity, self.mean_motion, _elapsed(t, self.epoch))
 
     @classmethod
     def stack(cls, models: Sequence[MotionModel]) -> Any:
@@ -311,9 +313,11 @@ class ClohessyWiltshireMotion(MotionModel):
         field) are kept as floats instead, so the trigonometry and the coefficients of
         the closed form are computed once per time rather than once per model.
         """
-        n, epoch = _stack(models, "mean_motion"), _stack(models, "epoch")
-        if (n == n[0]).all() and (epoch == epoch[0]).all():
-            n, epoch = float(n[0]), float(epoch[0])
+        means, epochs = _stack(models, "mean_motion"), _stack(models, "epoch")
+        n: _Scalars = means
+        epoch: _Scalars = epochs
+        if (means == means[0]).all() and (epochs == epochs[0]).all():
+            n, epoch = float(means[0]), float(epochs[0])
         return _stack(models, "position").T, _stack(models, "velocity").T, n, epoch
 
     @classmethod
@@ -323,8 +327,22 @@ class ClohessyWiltshireMotion(MotionModel):
         return _cw_state(position, velocity, n, float(t) - epoch)
 
 
-def _cw_state(p0: ArrayLike, v0: ArrayLike, n: ArrayLike, tau: ArrayLike) -> tuple[Vector, Vector]:
-    """The Clohessy–Wiltshire closed form; components of ``p0``, ``v0`` broadcast with τ.
+def _elapsed(t: ArrayLike, epoch: float) -> _Scalars:
+    """Time (s) from ``epoch`` (s) to ``t`` (s): a float for a scalar ``t``, else an array."""
+    if isinstance(t, (int, float)):
+        return float(t) - epoch
+    times = np.asarray(t, dtype=float)
+    return float(times) - epoch if times.ndim == 0 else times - epoch
+
+
+def _cw_state(
+    position: Sequence[_Scalars] | Vector,
+    velocity: Sequence[_Scalars] | Vector,
+    n: _Scalars,
+    tau: _Scalars,
+) -> tuple[Vector, Vector]:
+    """The Clohessy–Wiltshire closed form; components of ``position`` (m) and ``velocity``
+    (m/s) at the epoch broadcast with τ (s); ``n`` is the mean motion, rad/s.
 
     With floats for ``n`` and ``τ`` (one model, or models sharing them, at one time) the
     coefficients stay in Python floats: the same IEEE operations, in the same order, as
@@ -332,8 +350,8 @@ def _cw_state(p0: ArrayLike, v0: ArrayLike, n: ArrayLike, tau: ArrayLike) -> tup
     """
     nt = n * tau
     s, c = _sin_cos(nt)
-    x0, y0, z0 = p0
-    u0, v0, w0 = v0
+    x0, y0, z0 = position
+    u0, v0, w0 = velocity
     x = (4 - 3 * c) * x0 + s / n * u0 + 2 / n * (1 - c) * v0
     y = 6 * (s - nt) * x0 + y0 - 2 / n * (1 - c) * u0 + (4 * s - 3 * nt) / n * v0
     z = c * z0 + s / n * w0
@@ -343,14 +361,18 @@ def _cw_state(p0: ArrayLike, v0: ArrayLike, n: ArrayLike, tau: ArrayLike) -> tup
     return _columns(x, y, z), _columns(vx, vy, vz)
 
 
-def _sin_cos(angle: ArrayLike) -> tuple[Any, Any]:
+@overload
+def _sin_cos(angle: float) -> tuple[float, float]: ...
+@overload
+def _sin_cos(angle: Vector) -> tuple[Vector, Vector]: ...
+def _sin_cos(angle: _Scalars) -> tuple[float, float] | tuple[Vector, Vector]:
     """``sin`` and ``cos`` of ``angle`` (rad): floats for a float, arrays otherwise."""
     if isinstance(angle, float):
         return float(np.sin(angle)), float(np.cos(angle))
     return np.sin(angle), np.cos(angle)
 
 
-def _columns(x: np.ndarray, y: np.ndarray, z: np.ndarray) -> Vector:
+def _columns(x: _Scalars, y: _Scalars, z: _Scalars) -> Vector:
     """``x``, ``y`` and ``z`` (broadcast together) as the last axis of one array."""
     if isinstance(x, float) and isinstance(y, float) and isinstance(z, float):
         return np.array((x, y, z))

@@ -22,6 +22,7 @@ from types import UnionType
 from typing import Any, ClassVar, Literal, Union, get_args, get_origin
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic.json_schema import JsonDict
 from pydantic_core import ErrorDetails, to_jsonable_python
 
 from dcsim.errors import PluginParameterError, Problem, did_you_mean
@@ -62,7 +63,7 @@ def quantity(
     pydantic.fields.FieldInfo
         The field declaration.
     """
-    extra = {"unit": unit} if unit else {}
+    extra: JsonDict = {"unit": unit} if unit else {}
     if "default_factory" in kwargs:
         return Field(
             description=description, gt=gt, ge=ge, lt=lt, le=le, json_schema_extra=extra, **kwargs

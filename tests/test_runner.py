@@ -274,6 +274,12 @@ def test_a_target_entering_sensor_range_triggers_a_replan(tmp_path):
     assert summary["delivered"] == 2 and summary["status"] == "completed"
 
 
+def test_a_run_flown_before_it_is_opened_says_to_open_it():
+    runner = Runner(setup_run(None, (), None, registry=PluginRegistry.discover()))
+    with pytest.raises(RuntimeError, match=r"call open\(\) first"):
+        runner.advance()
+
+
 def test_same_scenario_and_seed_give_identical_files(tmp_path):
     for name in ("a", "b"):
         run(overrides=["world.duration=150"], out=tmp_path / name, seed=5)

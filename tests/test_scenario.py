@@ -418,3 +418,13 @@ def test_a_path_planners_own_clearance_is_refused_saying_where_the_margin_is(tmp
     assert found.startswith(f"{path}:1:")
     assert "path_planner.params.clearance: no longer a parameter: " in found
     assert "safety_margin" in found and "set mission.safety_distance instead" in found
+
+
+def test_the_mission_section_is_read_as_its_mission_s_settings_class_or_refused():
+    from dcsim.missions.debris.settings import DebrisMissionSection
+    from dcsim.missions.transfer.settings import TransferMissionSection
+
+    scenario = read_scenario(default_scenario_path())
+    assert scenario.mission_as(DebrisMissionSection) is scenario.mission
+    with pytest.raises(TypeError, match="not the TransferMissionSection"):
+        scenario.mission_as(TransferMissionSection)

@@ -162,11 +162,11 @@ def draw_value(
 
 def _normal(dispersion: NormalDispersion, nominal: Any, rng: np.random.Generator) -> np.ndarray:
     """A normal draw, truncated to [low, high] where given; ``sigma = 0`` gives the mean."""
-    mean = nominal if dispersion.mean is None else dispersion.mean
-    low = -np.inf if dispersion.low is None else dispersion.low
-    high = np.inf if dispersion.high is None else dispersion.high
+    centre = nominal if dispersion.mean is None else dispersion.mean
+    lowest = -np.inf if dispersion.low is None else dispersion.low
+    highest = np.inf if dispersion.high is None else dispersion.high
     mean, sigma, low, high = np.broadcast_arrays(
-        *_shaped(nominal, mean, dispersion.sigma, low, high)
+        *_shaped(nominal, centre, dispersion.sigma, lowest, highest)
     )
     scale = np.where(sigma > 0, sigma, 1.0)
     value = truncnorm.rvs(

@@ -274,6 +274,7 @@ def _execute(
         journal = stack.enter_context((directory / JOURNAL_FILE).open("a", encoding="utf-8"))
         try:
             if tasks:
+                assert client is not None  # made whenever cases are pending
                 run_tasks(client, run_case, tasks, _Recorder(journal, results, progress, client))
         except KeyboardInterrupt:
             interrupted = True

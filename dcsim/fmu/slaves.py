@@ -352,7 +352,9 @@ class ClosedLoopSlave(_ScenarioSlave):
         self.runner.advance(self._vector("disturbance_force"), self._vector("disturbance_torque"))
 
     def _world(self) -> World:
-        return self.runner.world
+        world = self.runner.world
+        assert world is not None  # the run is opened before the slave is stepped
+        return world
 
     def _outputs(self) -> dict[str, Any]:
         return self.runner.outputs
@@ -363,9 +365,9 @@ class ClosedLoopSlave(_ScenarioSlave):
         if "captured" in values:  # a robot that carries targets
             values["captured"] = int(out["captured"])
             values["delivered"] = int(out["delivered"])
-        values["localisation_error"] = float(
-            np.linalg.norm(out["position"] - runner.estimate.position)
-        )
+        estimate = runner.estimate
+        assert estimate is not None  # every decided control period makes one
+        values["localisation_error"] = float(np.linalg.norm(out["position"] - estimate.position))
         values["run_status"] = _RUN_STATUS[runner.status]
 
     def _healthy(self) -> None:
@@ -454,9 +456,9 @@ def _initial_state(scenario: Scenario) -> RobotState:
         angles = rates = np.zeros(0)
     return RobotState(
         position=point_to_cartesian(initial.position),
-        velocity=initial.velocity,
+        velocity=np.array(initial.velocity),
         attitude=attitude / np.linalg.norm(attitude),
-        angular_velocity=initial.angular_velocity,
+        angular_velocity=np.array(initial.angular_velocity),
         joint_positions=angles,
         joint_velocities=rates,
     )

@@ -14,7 +14,7 @@ from typing import Any, TypeVar, dataclass_transform
 import numpy as np
 from numpy.typing import ArrayLike
 
-T = TypeVar("T", bound=type)
+T = TypeVar("T")
 M = TypeVar("M", bound="Message")
 _NO_SHARED_DEFAULT = object()
 
@@ -163,6 +163,6 @@ class Message:
 
 
 @dataclass_transform(frozen_default=True, eq_default=False, field_specifiers=(field, array_field))
-def message(cls: T) -> T:
+def message(cls: type[T]) -> type[T]:
     """Class decorator making ``cls`` a frozen message dataclass."""
     return dataclass(frozen=True, eq=False)(cls)

@@ -371,13 +371,13 @@ class Trajectory(Message):
         position, velocity : ndarray, shape (..., 3)
             Linear between samples, m and m/s.
         """
-        times = self.times
-        if np.ndim(t) == 0 and times[0] < t < times[-1]:
-            row = self._interpolate_inside(float(t))
+        times, at = self.times, np.asarray(t, dtype=float)
+        if at.ndim == 0 and times[0] < at < times[-1]:
+            row = self._interpolate_inside(float(at))
             return row[:3], row[3:]
         table = self._sample_table
-        position = np.stack([np.interp(t, times, table[:, k]) for k in range(3)], axis=-1)
-        velocity = np.stack([np.interp(t, times, table[:, k]) for k in range(3, 6)], axis=-1)
+        position = np.stack([np.interp(at, times, table[:, k]) for k in range(3)], axis=-1)
+        velocity = np.stack([np.interp(at, times, table[:, k]) for k in range(3, 6)], axis=-1)
         return position, velocity
 
     def _interpolate_inside(self, t: float) -> Vector:

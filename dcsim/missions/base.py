@@ -12,6 +12,7 @@ fields it adds, and when it is finished.
 
 from __future__ import annotations
 
+import builtins
 import math
 import warnings
 from abc import ABC, abstractmethod
@@ -138,7 +139,7 @@ class Mission(ABC):
 
     type: ClassVar[str]
     summary: ClassVar[str]
-    Settings: ClassVar[type[MissionSettings]]
+    Settings: ClassVar[builtins.type[MissionSettings]]
     roles: ClassVar[tuple[str, ...]]
     modes: ClassVar[tuple[str, ...]]
     columns: ClassVar[tuple[str, ...]] = ()
@@ -150,7 +151,7 @@ class Mission(ABC):
         self, scenario: Scenario, world: MissionWorld, plugins: Mapping[str, Plugin], emit: Emit
     ) -> None:
         self.scenario = scenario
-        self.settings = scenario.mission
+        self.settings = scenario.mission_as(self.Settings)
         self.world = world
         self.plugins = plugins
         self.emit = emit

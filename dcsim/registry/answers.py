@@ -17,7 +17,6 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator
 from dataclasses import dataclass, fields, is_dataclass
-from functools import cache
 from typing import Any
 
 import numpy as np
@@ -106,7 +105,7 @@ def output_problem(kind: str, method: str, output: Any, joints: int | None = Non
     return None
 
 
-def _numbers(message: Any, prefix: str = "") -> Iterator[tuple[str, Any]]:
+def _numbers(message: object, prefix: str = "") -> Iterator[tuple[str, Any]]:
     """Every number a message holds, by field path: floats, arrays, and those of the
     messages in its tuples (a plan's tasks and drop visits)."""
     for name in _field_names(type(message)):
@@ -130,10 +129,15 @@ def _sum_of_numbers(message: Any) -> float:
     return total
 
 
-@cache
+_FIELD_NAMES: dict[type, tuple[str, ...]] = {}
+
+
 def _field_names(cls: type) -> tuple[str, ...]:
     """The field names of a message class (once per class: answers are checked every tick)."""
-    return tuple(f.name for f in fields(cls))
+    names = _FIELD_NAMES.get(cls)
+    if names is None:
+        names = _FIELD_NAMES[cls] = tuple(f.name for f in fields(cls))
+    return names
 
 
 def _finite(value: float | np.ndarray) -> bool:

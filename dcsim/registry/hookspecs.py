@@ -77,6 +77,7 @@ def dcsim_plugin_classes() -> list[type[Plugin]]:
     list of type
         The plugin classes; their order does not matter.
     """
+    raise NotImplementedError  # a specification: pluggy calls the implementations
 
 
 @hookspec

@@ -185,10 +185,13 @@ def thesis_manipulator() -> DHRobot:
         (0.7, 0.0, 20.0, (0.2, 1.87, 1.87)),
     ]
     links = tuple(
-        DHLink(a=a, alpha=alpha, d=0.0, mass=mass, inertia=inertia)
+        DHLink(a=a, alpha=alpha, d=0.0, mass=mass, inertia=np.array(inertia))
         for a, alpha, mass, inertia in table
     )
     base = ManipulatorBase(
-        mass=1000.0, inertia=(166.67, 166.67, 166.67), size=(1.0, 1.0, 1.0), mount=(0.5, 0, 0)
+        mass=1000.0,
+        inertia=np.array((166.67, 166.67, 166.67)),
+        size=np.array((1.0, 1.0, 1.0)),
+        mount=np.array((0.5, 0.0, 0.0)),
     )
     return DHRobot(base=base, links=links, name="thesis_manipulator")

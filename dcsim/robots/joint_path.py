@@ -19,7 +19,9 @@ which a computed-torque controller needs to track them to its model's accuracy.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -55,6 +57,27 @@ class JointSample:
 class SingularPath(ValueError):
     """The path leads the arm into a singularity (``det(J Jᵀ)`` at its tolerance), or
     starts in one."""
+
+
+@dataclass(frozen=True)
+class _Singularity:
+    """scipy's terminal event of a joint path: ``det(J Jᵀ)`` falls to its tolerance.
+
+    Attributes
+    ----------
+    det_jjt : callable
+        ``det(J Jᵀ)`` of the joint angles (rad).
+    tolerance : float
+        Value of ``det(J Jᵀ)`` at which the integration stops.
+    """
+
+    det_jjt: Callable[[Array], float]
+    tolerance: float
+    terminal: ClassVar[bool] = True
+
+    def __call__(self, t: float, theta: Array) -> float:
+        """Zero where the arm meets the tolerance; ``t`` (s) is unused."""
+        return self.det_jjt(theta) - self.tolerance
 
 
 class JointPath:
@@ -110,18 +133,14 @@ class JointPath:
         )
         self._initial = np.asarray(start[7:], dtype=float)
         self._final = self._initial
-        self._angles = None
+        self._angles: Callable[[float], Array] | None = None
         if self.end_time > self.start_time:
             self._angles = self._integrate(self._initial)
 
-    def _integrate(self, angles: Array):
+    def _integrate(self, angles: Array) -> Callable[[float], Array]:
         """Solve the module's equation from ``angles``; keep the final angles and return
         the dense solution."""
-
-        def singular(t: float, theta: Array) -> float:
-            return self._det_jjt(theta) - self.singular_tolerance
-
-        singular.terminal = True
+        singular = _Singularity(self._det_jjt, self.singular_tolerance)
         try:
             solution = self._solve(angles, singular)
         except np.linalg.LinAlgError:
@@ -135,7 +154,7 @@ class JointPath:
         self._final = solution.y[:, -1]
         return solution.sol
 
-    def _solve(self, angles: Array, singular):
+    def _solve(self, angles: Array, singular: _Singularity) -> Any:
         """scipy's DOP853 over the path, to 1e-8 relative, stopping at a singularity."""
         return solve_ivp(
             self._rates,
@@ -178,6 +197,7 @@ class JointPath:
             return self._initial.copy()
         if t >= self.end_time:
             return self._final.copy()
+        assert self._angles is not None  # integrated whenever end_time > start_time
         return self._angles(t)
 
     def at(self, t: float) -> JointSample:

@@ -84,6 +84,7 @@ def load_reach_problem(
     model = load_robot_model(path, overrides)
     if scenario.mission.type != "reach":
         raise DcsimError(f"{path}: mission.type is '{scenario.mission.type}', not 'reach'")
+    assert isinstance(scenario.robot, ManipulatorSection)  # load_robot_model refused others
     angles, rates = scenario.robot.initial_joints()
     initial = scenario.robot.initial
     attitude = np.asarray(initial.attitude, dtype=float)
@@ -94,7 +95,7 @@ def load_reach_problem(
         solved = model.inverse_kinematics(end_effector, q)
         if not solved.converged:
             raise DcsimError(
-                f"{path}: the end effector cannot start at {list(end_effector)} "
+                f"{path}: the end effector cannot start at {np.asarray(end_effector).tolist()} "
                 f"({solved.status}, {solved.error:.3g} m away)"
             )
         q, rates = solved.q, np.zeros_like(rates)
@@ -102,8 +103,8 @@ def load_reach_problem(
         time=0.0,
         position=q[:3],
         attitude=q[3:7],
-        velocity=initial.velocity,
-        angular_velocity=initial.angular_velocity,
+        velocity=np.array(initial.velocity),
+        angular_velocity=np.array(initial.angular_velocity),
         joint_positions=q[7:],
         joint_velocities=rates,
     )

@@ -344,8 +344,8 @@ class ManipulatorModel:
             if base == "centre-of-mass":  # a pure translation of the whole robot
                 q[:3] += centre - self._centre(kin)
                 kin = self.kinematics(q)
-        error = np.linalg.norm(target - kin.end_effector)
-        status: IKStatus = "converged" if error <= tolerance else "not-converged"
+        distance = np.linalg.norm(target - kin.end_effector)
+        status: IKStatus = "converged" if distance <= tolerance else "not-converged"
         return self._ik_result(q, target, status, max_iterations)
 
     def _centre(self, kin: Kinematics) -> Array:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from dcsim.robots.dh import DHLink, DHRobot
 
@@ -119,7 +119,8 @@ def urdf_text(robot: DHRobot) -> str:
         ±:data:`UNLIMITED_ANGLE` are clipped to it) and ``end_effector_joint`` (fixed).
     """
     parts = [f'<?xml version="1.0"?>\n<robot name="{robot.name}">', _base(robot)]
-    parent, xyz, fixed = "base", robot.base.mount, np.eye(3)
+    xyz: ArrayLike = robot.base.mount
+    parent, fixed = "base", np.eye(3)
     for index, link in enumerate(robot.links, start=1):
         parts.append(_arm_link(index, link))
         parts.append(_joint(index, parent, xyz, fixed @ _rot_z(link.theta_offset), link))

@@ -30,11 +30,12 @@ import time as wallclock
 import warnings
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 
 import numpy as np
 
 from dcsim.errors import CwValidityWarning, PlannerModelWarning
+from dcsim.geometry import Vector
 from dcsim.messages import Command, Observations, Prior, StateEstimate
 from dcsim.missions import Mission, mission_class
 from dcsim.registry.calls import PluginFailure, call_plugin
@@ -203,6 +204,20 @@ class Runner:
         return self.status is not None
 
     @property
+    def _opened_world(self) -> World:
+        """The world, which exists once :meth:`open` has built it."""
+        if self.world is None:
+            raise RuntimeError("the run is not open: call open() first")
+        return self.world
+
+    @property
+    def _opened_mission(self) -> Mission:
+        """The mission, which exists once :meth:`open` has started the run."""
+        if self.mission is None:
+            raise RuntimeError("the run is not open: call open() first")
+        return self.mission
+
+    @property
     def mode(self) -> str | None:
         """The mission mode decided for the current control period."""
         return None if self.mission is None else self.mission.mode
@@ -263,12 +278,13 @@ class Runner:
         disturbance_force = np.zeros(3) if disturbance_force is None else disturbance_force
         disturbance_torque = np.zeros(3) if disturbance_torque is None else disturbance_torque
         if self.ended:
-            self.world.step(
+            world = self._opened_world
+            world.step(
                 WorldInputs(
                     disturbance_force=disturbance_force, disturbance_torque=disturbance_torque
                 )
             )
-            self.outputs = self.world.outputs()
+            self.outputs = world.outputs()
             return
         self._guarded(self._advance, disturbance_force, disturbance_torque)
 
@@ -280,9 +296,9 @@ class Runner:
         self.summary = self._summary(wallclock.perf_counter() - self._started)
         if linearisation is not None:
             self.summary["cw_error_estimate_m"] = linearisation
-        self.world.close()
+        self._opened_world.close()
         try:
-            for name, text in self.mission.records().items():
+            for name, text in self._opened_mission.records().items():
                 self.recorder.write_file(name, text)
             self.recorder.finish(self.summary)
             self._plot()
@@ -328,7 +344,7 @@ class Runner:
         if self.info.out_dir is None or not self.plots:
             return
         try:
-            self.mission.plot(
+            self._opened_mission.plot(
                 self.info.out_dir,
                 self.recorder.telemetry(max_points=PLOT_POINTS),
                 self.recorder.events,
@@ -344,11 +360,13 @@ class Runner:
         except _RunEnded as end:
             self._end(end.status, end.reason)
         except PluginFailure as failure:
-            failure.time = self.world.time
+            failure.time = self._opened_world.time
             self.failure = failure
             self._end("failed", str(failure))
             error = failure.problem if failure.error is None else str(failure.error)
-            details = {} if failure.traceback is None else {"traceback": failure.traceback}
+            details: dict[str, Any] = (
+                {} if failure.traceback is None else {"traceback": failure.traceback}
+            )
             self._event(
                 "plugin_failed",
                 role=failure.role,
@@ -364,7 +382,7 @@ class Runner:
         self.status, self.reason = status, reason
 
     def _start(self) -> None:
-        world = self.world
+        world = self._opened_world
         self.mission = self.mission_class(self.scenario, world, self.plugins, self._event)
         self.recorder.start(dump_scenario(self.scenario), self._summary_head("running", ""))
         self._hook("dcsim_run_start", run=self.info)
@@ -406,18 +424,19 @@ class Runner:
 
     def _decide(self) -> None:
         """Sense, localise, run the mission and the controller at the current time."""
-        world, laps, plugins = self.world, self.laps, self.plugins
+        world, mission = self._opened_world, self._opened_mission
+        laps, plugins = self.laps, self.plugins
         t = world.time
         observations = world.observations()
         laps.lap("sensors")
         estimate = self.estimate = _with_readings(self._localise(observations), observations)
         laps.lap("localiser")
-        reference = self.mission.tick(t, estimate, observations)
+        reference = mission.tick(t, estimate, observations)
         laps.lap("mission")
         if world.robot_changes != self._robot_changes:  # a grab or a release
             self._robot_changes = world.robot_changes
             call_plugin(plugins, "controller", "reset", world.robot_spec())
-        surroundings = self.mission.surroundings(observations)
+        surroundings = mission.surroundings(observations)
         self._command = call_plugin(
             plugins,
             "controller",
@@ -429,13 +448,13 @@ class Runner:
             joints=len(observations.joint_positions),
         )
         laps.lap("controller")
-        self._record(t, estimate, self.mission.mode, self._command)
+        self._record(t, estimate, mission.mode, self._command)
         self._check_stop(t)
         laps.lap("recording")
 
     def _localise(self, observations: Observations) -> StateEstimate:
         """The localiser's estimate now, or the true state when the mission flies without one."""
-        world, plugins = self.world, self.plugins
+        world, plugins = self._opened_world, self.plugins
         if "localiser" not in plugins:
             position, velocity, _, _ = world.base_state()
             return StateEstimate(
@@ -454,7 +473,7 @@ class Runner:
             disturbance_torque=disturbance_torque,
             joint_torques=self._command.joint_torques,
         )
-        collisions = self.world.step(inputs)
+        collisions = self._opened_world.step(inputs)
         self.laps.lap("world")
         for collision in collisions:
             self._event(
@@ -465,21 +484,21 @@ class Runner:
                 penetration=collision.penetration,
             )
             if self.scenario.stop.on_collision:
-                self._record_final(self.mission.mode)
+                self._record_final(self._opened_mission.mode)
                 raise _RunEnded("stopped", f"collision with object {collision.object_id}")
         self._decide()
 
     def _report_progress(self) -> None:
+        if self.progress is None:
+            return
+        mission = self._opened_mission
         self.progress(
-            self.world.time,
-            self.scenario.world.duration,
-            self.mission.mode,
-            self.mission.progress(),
+            self._opened_world.time, self.scenario.world.duration, mission.mode, mission.progress()
         )
 
     def _check_stop(self, t: float) -> None:
         stop = self.scenario.stop
-        finished = self.mission.finished()
+        finished = self._opened_mission.finished()
         if finished is not None:
             raise _RunEnded(*finished)
         if t >= self.scenario.world.duration - 1e-9:
@@ -500,7 +519,7 @@ class Runner:
 
     # ------------------------------------------------------------------ records
     def _record(self, t: float, estimate: StateEstimate, mode: str, command: Command) -> None:
-        out = self.outputs = self.world.outputs()
+        out = self.outputs = self._opened_world.outputs()
         out["command"] = command
         row: dict[str, Any] = {"time": t}  # floats from tolist(): the same values, quicker
         row.update(zip(("x", "y", "z"), out["position"].tolist(), strict=True))
@@ -509,7 +528,7 @@ class Runner:
         row.update(zip(("est_vx", "est_vy", "est_vz"), estimate.velocity.tolist(), strict=True))
         row.update(zip(("qx", "qy", "qz", "qw"), out["attitude"].tolist(), strict=True))
         row.update(mode=mode, converged=int(estimate.converged))
-        row.update(self.mission.telemetry(out))
+        row.update(self._opened_mission.telemetry(out))
         row.update(
             fuel_used=out["fuel_used"],
             delta_v=out["delta_v"],
@@ -526,10 +545,11 @@ class Runner:
     def _record_final(self, mode: str) -> None:
         """Record the state reached by the last step (the run ends after it), with the
         last estimate (no new one is made)."""
-        self._record(self.world.time, self.estimate, mode, Command())
+        assert self.estimate is not None  # every control period's decision makes one
+        self._record(self._opened_world.time, self.estimate, mode, Command())
 
     def _event(self, name: str, at: float | None = None, **data: Any) -> None:
-        event = {"t": self.world.time if at is None else at, "event": name, **data}
+        event = {"t": self._opened_world.time if at is None else at, "event": name, **data}
         self.recorder.event(event)
         self._hook("dcsim_run_event", run=self.info, event=event)
 
@@ -567,7 +587,8 @@ class Runner:
         }
 
     def _summary(self, wall: float) -> dict[str, Any]:
-        world = self.world
+        world, mission = self._opened_world, self._opened_mission
+        assert self.status is not None  # close() ends the run before it sums it up
         sim_time = world.time
         rmse = (
             float(np.sqrt(self._squared_error_sum / self._converged_rows))
@@ -579,9 +600,9 @@ class Runner:
             "sim_time_s": sim_time,
             "wall_time_s": wall,
             "real_time_factor": sim_time / wall if wall > 0 else None,
-            "outcome": self.mission.progress(),
-            "goal_met": self.mission.goal_met(),
-            **self.mission.summary_fields(),
+            "outcome": mission.progress(),
+            "goal_met": mission.goal_met(),
+            **mission.summary_fields(),
             "collisions": len(world.collisions),
             "fuel_used_kg": world.fuel_used,
             "delta_v_mps": world.delta_v,
@@ -600,6 +621,15 @@ def _position_sigmas(covariance: np.ndarray) -> list[float]:
     return [*np.sqrt(variances).tolist(), *[float("nan")] * (3 - len(variances))]
 
 
+class _Readings(TypedDict):
+    """The attitude sensors' and encoders' readings that an estimate carries."""
+
+    attitude: Vector
+    angular_velocity: Vector
+    joint_positions: Vector
+    joint_velocities: Vector
+
+
 def _with_readings(estimate: StateEstimate, observations: Observations) -> StateEstimate:
     """The localiser's estimate with the attitude sensors' and encoders' readings.
 
@@ -608,7 +638,7 @@ def _with_readings(estimate: StateEstimate, observations: Observations) -> State
     arrays (PyBullet's unit quaternion, and as many joint rates as angles). A subclass
     a plugin returns is rebuilt through its constructor, so its own rules still apply.
     """
-    readings = {
+    readings: _Readings = {
         "attitude": observations.attitude,
         "angular_velocity": observations.angular_velocity,
         "joint_positions": observations.joint_positions,

@@ -319,7 +319,8 @@ class Recorder:
         self._telemetry_file = self._events_file = None
 
     def _writing(self, name: str) -> _WriteGuard:
-        return _WriteGuard(self, name)
+        assert self.out_dir is not None  # only a run directory is written to
+        return _WriteGuard(self, self.out_dir / name)
 
 
 class _WriteGuard:
@@ -329,19 +330,18 @@ class _WriteGuard:
     recording in memory, so the run can end ``failed`` with its reason.
     """
 
-    def __init__(self, recorder: Recorder, name: str) -> None:
-        self.recorder, self.name = recorder, name
+    def __init__(self, recorder: Recorder, path: Path) -> None:
+        self.recorder, self.path = recorder, path
 
     def __enter__(self) -> None:
         return None
 
-    def __exit__(self, kind: type | None, error: BaseException | None, trace: Any) -> bool:
+    def __exit__(self, kind: type | None, error: BaseException | None, trace: Any) -> None:
         if isinstance(error, OSError):
             recorder = self.recorder
             recorder._close()
             recorder._pending.clear()
-            raise RecordingError(f"cannot write {recorder.out_dir / self.name}: {error}") from error
-        return False
+            raise RecordingError(f"cannot write {self.path}: {error}") from error
 
 
 def _stride(rows: int, max_points: int | None) -> int:
@@ -384,7 +384,7 @@ def read_telemetry(path: Path, max_points: int | None = None) -> dict[str, np.nd
             if not text.endswith("\n") or len(fields) != len(header):
                 continue  # the line a killed run was writing
             switched = mode is not None and last is not None and fields[mode] != last[mode]
-            if switched and kept[-1] is not last:
+            if switched and last is not None and kept[-1] is not last:
                 kept.append(last)  # a mode change stays sharp however thin the rows
             if index % step == 0 or switched:
                 kept.append(fields)

@@ -35,6 +35,7 @@ from dcsim.scenario.model import (
     MAX_PHYSICS_STEPS,
     MAX_STEPS_PER_CONTROL_PERIOD,
     MEAN_MOTION_RANGE,
+    MissionSettings,
     OrbitSpec,
     Scenario,
     scenario_model,
@@ -148,12 +149,20 @@ def validate(doc: ScenarioDocument) -> Scenario:
     return scenario
 
 
+def _mission_section(model: type[Scenario]) -> type[MissionSettings]:
+    """The mission section class a scenario model validates (:func:`scenario_model`)."""
+    section = model.model_fields["mission"].annotation
+    if not (isinstance(section, type) and issubclass(section, MissionSettings)):
+        raise TypeError(f"{model.__name__}.mission is not a mission section: {section!r}")
+    return section
+
+
 def _without_moved_keys(
     doc: ScenarioDocument, model: type[Scenario]
 ) -> tuple[dict[str, Any], list[Problem]]:
     """The document's data without the keys its mission moved elsewhere
     (``MissionSettings.moved_keys``), and one problem per such key naming its new place."""
-    moved = model.model_fields["mission"].annotation.moved_keys
+    moved = _mission_section(model).moved_keys
     present = ScenarioValues(doc.data, model).given
     found = [(old, new) for old, new in moved.items() if present(*old)]
     if not found:
@@ -299,7 +308,7 @@ def _rule_violations(data: dict[str, Any], model: type[Scenario]) -> list[tuple[
     the schema's. A rule reading a key the scenario's mission does not have is skipped.
     """
     get = ScenarioValues(data, model)
-    rules = [*_RULES, *model.model_fields["mission"].annotation.rules]
+    rules = [*_RULES, *_mission_section(model).rules]
     return [found for rule in rules for found in _checked(rule, get)]
 
 
@@ -427,7 +436,7 @@ def _object_rules(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
     shapes."""
     found: list[tuple[KeyPath, str]] = []
     owners: dict[int, str] = {}
-    targets_key = get.model.model_fields["mission"].annotation.targets_key
+    targets_key = _mission_section(get.model).targets_key
     targets = [] if targets_key is None else [("mission", targets_key)]
     for section in (*targets, ("obstacles",)):
         for index in get.items(*section):
@@ -564,8 +573,10 @@ def _field_value(model: type[BaseModel], name: str, section: dict[str, Any]) -> 
 def _field_adapter(model: type[BaseModel], name: str) -> TypeAdapter[Any]:
     """A validator of field ``name`` of ``model`` on its own: type, bounds and config."""
     info = model.model_fields[name]
+    assert info.annotation is not None  # pydantic gives every field of a model its type
     annotation = Annotated[info.annotation, *info.metadata] if info.metadata else info.annotation
-    return TypeAdapter(annotation, config=model.model_config)
+    # mypy types an Annotated built at run time as a special form, which pydantic accepts
+    return TypeAdapter(annotation, config=model.model_config)  # type: ignore[arg-type]
 
 
 def _scenario_model(doc: ScenarioDocument) -> type[Scenario]:

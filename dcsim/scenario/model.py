@@ -11,7 +11,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable
-from typing import Annotated, Any, ClassVar, Literal
+from typing import Annotated, Any, ClassVar, Literal, TypeVar
 
 import numpy as np
 from pydantic import (
@@ -443,7 +443,7 @@ class DHLinkSpec(Section):
             alpha=math.radians(self.alpha_deg),
             d=self.d,
             mass=self.mass,
-            inertia=self.inertia,
+            inertia=np.array(self.inertia),
             theta_offset=math.radians(self.theta_offset_deg),
             joint_limits=(math.radians(lower), math.radians(upper)),
             torque_limit=math.inf if self.torque_limit is None else self.torque_limit,
@@ -499,7 +499,10 @@ class ManipulatorSection(RobotBaseSection):
     def dh_robot(self) -> DHRobot:
         """The robot's DH description in SI units (radians)."""
         base = ManipulatorBase(
-            mass=self.mass, inertia=self.inertia, size=self.size, mount=self.mount
+            mass=self.mass,
+            inertia=np.array(self.inertia),
+            size=np.array(self.size),
+            mount=np.array(self.mount),
         )
         return DHRobot(base=base, links=tuple(link.build() for link in self.links))
 
@@ -587,7 +590,9 @@ class BoxShapeSpec(Section):
     def build(self) -> Shape:
         """The shape this spec describes."""
         return Shape(
-            ShapeKind.BOX, half_extents=self.half_extents, orientation=_unit(self.orientation)
+            ShapeKind.BOX,
+            half_extents=np.array(self.half_extents),
+            orientation=_unit(self.orientation),
         )
 
 
@@ -724,6 +729,9 @@ class StopSection(Section):
     )
 
 
+SettingsT = TypeVar("SettingsT", bound=MissionSettings)
+
+
 class Scenario(Section):
     """A complete scenario: world, robot, obstacles, sensors, plugins, mission, stop rules."""
 
@@ -758,6 +766,27 @@ class Scenario(Section):
     )
     stop: StopSection = Field(default_factory=StopSection, description="Stop rules.")
 
+    def mission_as(self, settings: type[SettingsT]) -> SettingsT:
+        """The ``mission`` section as the settings class of the mission that reads it.
+
+        Parameters
+        ----------
+        settings : type of MissionSettings
+            The mission's settings class (its ``Settings``).
+
+        Raises
+        ------
+        TypeError
+            If the section is not of that class (the scenario was not validated with
+            its mission's model, :func:`scenario_model`).
+        """
+        if not isinstance(self.mission, settings):
+            raise TypeError(
+                f"the scenario's mission section is a {type(self.mission).__name__}, "
+                f"not the {settings.__name__} its mission reads"
+            )
+        return self.mission
+
     @property
     def mean_motion(self) -> float:
         """Mean motion of the reference orbit, rad/s (used by ``cw`` motions)."""
@@ -771,19 +800,23 @@ class Scenario(Section):
         orbit = self.world.orbit
         if orbit.model == "cw":
             return FrameDynamics(FrameKind.CLOHESSY_WILTSHIRE, self.mean_motion)
+        inclination, raan, perigee, anomaly = (
+            math.radians(angle)
+            for angle in (
+                orbit.inclination,
+                orbit.raan,
+                orbit.argument_of_perigee,
+                orbit.true_anomaly,
+            )
+        )
         chief = ChiefOrbit(
             OrbitModel(orbit.model),
             orbit.semi_major_axis,
             orbit.eccentricity,
-            *(
-                math.radians(angle)
-                for angle in (
-                    orbit.inclination,
-                    orbit.raan,
-                    orbit.argument_of_perigee,
-                    orbit.true_anomaly,
-                )
-            ),
+            inclination,
+            raan,
+            perigee,
+            anomaly,
             orbit.mu,
             orbit.j2,
             orbit.earth_radius,

@@ -31,6 +31,7 @@ from __future__ import annotations
 import dataclasses
 import weakref
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -170,7 +171,9 @@ class World:
         self._client = connect_direct()
         # A world dropped without close() (an FMU reset does that) still disconnects.
         self._disconnect = weakref.finalize(self, pb.disconnect, physicsClientId=self._client)
-        self._state_cache: tuple[int, tuple[np.ndarray, ...]] | None = None
+        self._state_cache: (
+            tuple[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] | None
+        ) = None
         pb.setTimeStep(self.physics_step, physicsClientId=self._client)
         self._robot = _build_robot_body(self._client, robot)
         self._links_mass = sum(mass for _, mass in self._robot.links)
@@ -240,7 +243,7 @@ class World:
                 self.robot_id, physicsClientId=self._client
             )
             velocity, angular = pb.getBaseVelocity(self.robot_id, physicsClientId=self._client)
-            state = tuple(np.array(v) for v in (position, velocity, attitude, angular))
+            state = (np.array(position), np.array(velocity), np.array(attitude), np.array(angular))
             for array in state:
                 array.setflags(write=False)
             self._state_cache = (self._steps, state)
@@ -396,7 +399,7 @@ class World:
             else 0.0,
         }
 
-    def outputs(self) -> dict[str, object]:
+    def outputs(self) -> dict[str, Any]:
         """Named outputs of the world as a system (true state and bookkeeping)."""
         position, velocity, attitude, angular = self.base_state()
         return {
@@ -463,8 +466,8 @@ class World:
     def _fly_period(
         self,
         thrusts: list[tuple[float, float, float]],
-        disturbance: tuple[float, float, float],
-        torque: tuple[float, float, float],
+        disturbance: tuple[float, ...],
+        torque: tuple[float, ...],
     ) -> list[CollisionEvent]:
         """The control period's physics steps: thrust, disturbance and orbital forces on
         the assembly (and the arm's joint torques), the broad phase's candidates checked
@@ -620,9 +623,8 @@ class World:
     # ------------------------------------------------------------------ lifetime
     def close(self) -> None:
         """Disconnect from PyBullet; the world cannot be used afterwards."""
-        if self._client is not None:
+        if self._disconnect.alive:
             self._disconnect()
-            self._client = None
 
     def __enter__(self) -> World:
         return self

@@ -23,7 +23,9 @@ Force = tuple[float, float, float]
 
 
 def cw_acceleration(
-    mean_motion: float, position: Sequence[float], velocity: Sequence[float]
+    mean_motion: float,
+    position: Sequence[float] | np.ndarray,
+    velocity: Sequence[float] | np.ndarray,
 ) -> Force:
     """Clohessy–Wiltshire acceleration at an LVLH state.
 
@@ -31,7 +33,7 @@ def cw_acceleration(
     ----------
     mean_motion : float
         Mean motion ``n`` of the reference orbit, rad/s.
-    position, velocity : sequence of 3 floats
+    position, velocity : sequence of 3 floats or ndarray (3,)
         LVLH state (x radial, y along-track), m and m/s.
 
     Returns

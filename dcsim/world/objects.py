@@ -148,7 +148,7 @@ class ObjectField:
         )
         self._status = np.full(len(self.objects), ObjectStatus.FREE, dtype=int)
         self.status = _read_only(self._status.view())
-        self._derived: dict[object, object] = {}
+        self._derived = _Derived()
         self.index = {o.id: i for i, o in enumerate(self.objects)}
         self._motions = MotionSet([o.motion for o in self.objects])
         self._cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
@@ -167,42 +167,64 @@ class ObjectField:
         if t not in self._cache:
             if len(self._cache) >= 2:
                 self._cache.pop(min(self._cache))
-            self._cache[t] = tuple(_read_only(a) for a in self._motions.state_at(t))
+            positions, velocities = self._motions.state_at(t)
+            self._cache[t] = (_read_only(positions), _read_only(velocities))
         return self._cache[t]
 
     def set_status(self, index: int, status: ObjectStatus) -> None:
         """Make object ``index`` free, carried or delivered (a grab or a delivery)."""
         self._status[index] = status
-        self._derived.clear()
+        self._derived = _Derived()
 
     def free_mask(self) -> np.ndarray:
         """Boolean mask of the objects that are free (read-only)."""
-        mask = self._derived.get("free")
+        mask = self._derived.free
         if mask is None:
-            mask = self._derived["free"] = _read_only(self.status == _FREE)
+            mask = self._derived.free = _read_only(self.status == _FREE)
         return mask
 
     def free_obstacles(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Indices of the free obstacles, their bounding radii (m) and whether each is a
         sphere (read-only arrays, kept until a status changes)."""
-        found = self._derived.get("obstacles")
+        found = self._derived.obstacles
         if found is None:
             indices = np.flatnonzero(self.free_mask() & ~self.is_target)
-            found = self._derived["obstacles"] = tuple(
-                _read_only(a) for a in (indices, self.radii[indices], self.is_sphere[indices])
+            found = self._derived.obstacles = (
+                _read_only(indices),
+                _read_only(self.radii[indices]),
+                _read_only(self.is_sphere[indices]),
             )
-        return found  # type: ignore[return-value]
+        return found
 
     def count(self, status: ObjectStatus, targets_only: bool = True) -> int:
         """Number of objects (targets only, by default) with ``status``."""
         key = (int(status), targets_only)  # a plain int: numpy probes an enum at length
-        found = self._derived.get(key)
+        found = self._derived.counts.get(key)
         if found is None:
             mask = self.status == key[0]
-            found = self._derived[key] = int(
+            found = self._derived.counts[key] = int(
                 np.count_nonzero(mask & self.is_target if targets_only else mask)
             )
         return found
+
+
+@dataclass
+class _Derived:
+    """What the objects' statuses determine, kept until a status changes.
+
+    Attributes
+    ----------
+    free : ndarray of bool or None
+        :meth:`ObjectField.free_mask`, once asked for.
+    obstacles : tuple of 3 ndarray or None
+        :meth:`ObjectField.free_obstacles`, once asked for.
+    counts : dict of (int, bool) to int
+        :meth:`ObjectField.count` by status and whether only targets count.
+    """
+
+    free: np.ndarray | None = None
+    obstacles: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+    counts: dict[tuple[int, bool], int] = field(default_factory=dict)
 
 
 def _read_only(array: np.ndarray) -> np.ndarray:

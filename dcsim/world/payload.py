@@ -134,5 +134,5 @@ class Payload:
     def _measure_protrusion(self, centre: np.ndarray) -> float:
         radius = self._radius
         return max(
-            (np.linalg.norm(c - centre) + r - radius for c, r in self.spheres()), default=0.0
+            (float(np.linalg.norm(c - centre)) + r - radius for c, r in self.spheres()), default=0.0
         )

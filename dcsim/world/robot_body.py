@@ -34,7 +34,11 @@ class RobotBody(Protocol):
 
     body: int
     links: tuple[tuple[int, float], ...]
-    n_joints: int
+
+    @property
+    def n_joints(self) -> int:
+        """Number of actuated joints (0 for a rigid body)."""
+        ...
 
     def joint_state(self) -> tuple[np.ndarray, np.ndarray]:
         """Joint angles (rad) and rates (rad/s), (n,) each (empty without joints)."""

@@ -167,6 +167,7 @@ def min_clearance(
     distance, where, nearest, collides = np.inf, 0, None, False
     for obstacle in obstacles:
         centres, _ = obstacle.predict(times)
+        assert obstacle.shape is not None  # a track without one is given its radius's sphere
         gaps = surface_distance(obstacle.shape, centres, positions) - robot_radius
         i = int(np.argmin(gaps))
         collides = collides or bool(gaps[i] < 0.0)

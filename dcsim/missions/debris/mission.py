@@ -361,6 +361,7 @@ class DebrisMission(Mission):
 
     def _move_to_next(self) -> Reference:
         task = self.task
+        assert task is not None  # the pickup that selected this mode set it
         track = self.known[task.target_id]
         newcomer = self._new_target()
         if newcomer is not None:
@@ -390,9 +391,9 @@ class DebrisMission(Mission):
         return self._follow(lambda: self._standoff(track, self.time))
 
     def _grab(self) -> Reference:
-        result = grab(
-            self.world, self.task.target_id, self.robot.capacity, self.robot.grab_distance
-        )
+        task = self.task
+        assert task is not None  # the pickup that selected this mode set it
+        result = grab(self.world, task.target_id, self.robot.capacity, self.robot.grab_distance)
         self.emit(
             "grab",
             target=result.target_id,
@@ -400,16 +401,18 @@ class DebrisMission(Mission):
             reason=result.reason,
             gap=result.gap,
         )
-        track = self.known[self.task.target_id]
+        track = self.known[task.target_id]
         reference = Reference(self.time, *self._standoff(track, self.time))
         if not result.success:
             self._go(Mode.DEVISE_PLAN, "grab failed")
             return reference
-        self.known.pop(self.task.target_id, None)
+        self.known.pop(task.target_id, None)
         self.trajectory = None
         full = len(self.world.carried_ids()) >= self.robot.capacity
-        if self.steps and isinstance(self.steps[0], DropVisit):
-            self.visit = self.steps.popleft()
+        following = self.steps[0] if self.steps else None
+        if isinstance(following, DropVisit):
+            self.steps.popleft()
+            self.visit = following
             self._go(Mode.MOVE_TO_DROP, "drop visit")
         elif full or not self.steps:
             self.visit = None

@@ -29,6 +29,7 @@ from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
 from dcsim.messages import ObjectKind, Shape  # noqa: E402
+from dcsim.missions.debris.settings import DebrisMissionSection  # noqa: E402
 from dcsim.motion import MotionSet  # noqa: E402
 from dcsim.report.outlines import outline  # noqa: E402
 from dcsim.report.plots import (  # noqa: E402
@@ -163,11 +164,12 @@ def _trajectory_paths(
     true = stacked(telemetry, ("x", "y", "z"))
     grabs = [e["t"] for e in events if e["event"] == "grab" and e["success"]]
     grab_points = true[np.searchsorted(times, grabs).clip(0, len(times) - 1)]
+    drop_point = scenario.mission_as(DebrisMissionSection).drop_point
     return _Paths(
         true=true,
         estimated=stacked(telemetry, ("est_x", "est_y", "est_z")),
         grabs=grab_points.reshape(-1, 3),
-        drop=scenario.mission.drop_point.build(scenario.mean_motion).state_at(sample)[0],
+        drop=drop_point.build(scenario.mean_motion).state_at(sample)[0],
         objects=list(_object_paths(scenario, sample, events)),
     )
 
@@ -182,7 +184,8 @@ def _draw_paths(axis, paths: _Paths, dims: Sequence[int], annotate: bool = False
         colour = _TARGET if target else OBSTACLE_COLOUR
         axis.plot(*obj_path[:, columns].T, color=colour, lw=0.8, alpha=0.7)
         if flat and len(obj_path):
-            _draw_footprint(axis, obj.shape, obj_path[[0, -1]][:, columns], colour, dims)
+            view = (columns[0], columns[1])
+            _draw_footprint(axis, obj.shape, obj_path[[0, -1]][:, columns], colour, view)
         named = target or obstacles <= NAMED_OBSTACLES
         if annotate and named and len(obj_path):
             axis.annotate(str(obj.id), obj_path[0, columns], fontsize=7, color=colour)
@@ -213,11 +216,11 @@ def _trajectory_legend() -> list:
 
 
 def _draw_footprint(
-    axis, shape: Shape, centres: np.ndarray, colour: str, view: Sequence[int]
+    axis, shape: Shape, centres: np.ndarray, colour: str, view: tuple[int, int]
 ) -> None:
     """Outline ``shape`` in the view of world axes ``view`` about each of ``centres``
     (K, 2), m."""
-    footprint = outline(shape, tuple(view))
+    footprint = outline(shape, view)
     for centre in np.unique(centres, axis=0):
         axis.fill(*(centre + footprint).T, facecolor=colour, edgecolor=colour, alpha=0.3, lw=0.8)
 

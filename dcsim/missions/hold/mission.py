@@ -12,11 +12,10 @@ is fed).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike
 
 from dcsim.geometry import length
 from dcsim.messages import Observations, Reference, StateEstimate
@@ -126,7 +125,9 @@ class HoldMission(Mission):
         }
 
 
-def attitude_error(attitude: ArrayLike, reference: ArrayLike) -> float:
+def attitude_error(
+    attitude: Sequence[float] | np.ndarray, reference: Sequence[float] | np.ndarray
+) -> float:
     """Angle of the rotation from ``attitude`` to ``reference``, rad in ``[0, π]``.
 
     The angle of ``reference ⊗ attitude⁻¹`` from its vector and scalar parts (with
@@ -134,7 +135,7 @@ def attitude_error(attitude: ArrayLike, reference: ArrayLike) -> float:
 
     Parameters
     ----------
-    attitude, reference : array_like (4,)
+    attitude, reference : sequence of float or ndarray (4,)
         Unit quaternions ``[x, y, z, w]``.
     """
     x, y, z, w = (float(v) for v in attitude)

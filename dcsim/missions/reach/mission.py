@@ -50,7 +50,8 @@ from dcsim.missions.base import Emit, Mission, MissionWorld
 from dcsim.missions.reach.settings import ReachMissionSection
 from dcsim.registry.interfaces import Plugin
 from dcsim.robots.joint_path import JointPath, SingularPath
-from dcsim.scenario.model import Scenario
+from dcsim.robots.manipulator import ManipulatorModel
+from dcsim.scenario.model import ManipulatorSection, Scenario
 
 
 class ReachMission(Mission):
@@ -94,7 +95,7 @@ class ReachMission(Mission):
         self, scenario: Scenario, world: MissionWorld, plugins: Mapping[str, Plugin], emit: Emit
     ) -> None:
         super().__init__(scenario, world, plugins, emit)
-        self.model = world.robot_spec().model
+        self.model = self._arm_model()
         self.target = np.asarray(self.settings.target, dtype=float)
         self.state = "PLAN"
         self.joint_path: JointPath | None = None
@@ -138,6 +139,7 @@ class ReachMission(Mission):
         sample = self.joint_path.at(time)
         self.reference_end_effector = sample.end_effector
         base = self.base_reference
+        assert base is not None  # set by the plan the joint path follows
         self.reference = Reference(
             time=time,
             position=base.position,
@@ -161,6 +163,12 @@ class ReachMission(Mission):
         if self.state == "HOLD":
             return "stopped", f"no path: {self.reason}"
         return None
+
+    def _arm_model(self) -> ManipulatorModel:
+        """The world's model of the arm now (its base's mass follows the propellant used)."""
+        model = self.world.robot_spec().model
+        assert isinstance(model, ManipulatorModel)  # the mission flies only manipulators
+        return model
 
     # ------------------------------------------------------------------ planning
     def _plan(self, start: RobotState) -> None:
@@ -240,7 +248,7 @@ class ReachMission(Mission):
             if reference is None or not reference.joint_positions.size
             else reference.joint_positions
         )
-        momentum = self.world.robot_spec().model.momentum(q, state.generalised_velocity)
+        momentum = self._arm_model().momentum(q, state.generalised_velocity)
         angular = momentum[3:] + np.cross(state.position, momentum[:3])
         command = outputs["command"]
         values = _Row(
@@ -307,7 +315,9 @@ class ReachMission(Mission):
 
 def _column_units(scenario: Scenario) -> dict[str, str]:
     """The mission's telemetry columns in order, each with its unit suffix."""
-    joints = range(1, len(scenario.robot.links) + 1)
+    robot = scenario.robot
+    assert isinstance(robot, ManipulatorSection)  # other robots are refused before a run
+    joints = range(1, len(robot.links) + 1)
     return {
         **dict.fromkeys(("ee_x", "ee_y", "ee_z", "ref_ee_x", "ref_ee_y", "ref_ee_z"), "m"),
         **dict.fromkeys(("ee_error", "target_distance"), "m"),
@@ -407,10 +417,10 @@ def reach_problem(scenario: Scenario, start: RobotState, model: Any) -> PathProb
         For the end effector: a goal region of radius ``tolerance`` about the target, the
         end effector's speed and acceleration limits.
     """
-    settings = scenario.mission
+    settings = scenario.mission_as(ReachMissionSection)
     return PathProblem(
         start=start,
-        goal=GoalRegion(position=settings.target, tolerance=settings.tolerance),
+        goal=GoalRegion(position=np.array(settings.target), tolerance=settings.tolerance),
         robot_radius=scenario.robot.radius,
         max_speed=settings.max_speed,
         max_acceleration=settings.max_acceleration,

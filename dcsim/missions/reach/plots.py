@@ -29,6 +29,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
 import numpy as np  # noqa: E402
 
+from dcsim.missions.reach.settings import ReachMissionSection  # noqa: E402
 from dcsim.report.plots import FrameAxes, plots_folder, save, stacked  # noqa: E402
 from dcsim.scenario.model import Scenario  # noqa: E402
 
@@ -105,7 +106,7 @@ def _path_figure(
     flown = stacked(telemetry, ("ee_x", "ee_y", "ee_z"))
     reference = stacked(telemetry, ("ref_ee_x", "ref_ee_y", "ref_ee_z"))
     base = stacked(telemetry, ("x", "y", "z"))
-    target = np.asarray(scenario.mission.target, dtype=float)
+    target = np.asarray(scenario.mission_as(ReachMissionSection).target, dtype=float)
     figure = plt.figure(figsize=(13, 6))
     axis = figure.add_subplot(1, 2, 1, projection="3d")
     axis.plot(*reference.T, color=_REFERENCE, ls="--", lw=1.0, label="reference")
@@ -145,7 +146,7 @@ def _timeline_figure(
     axes[0].semilogy(times, np.maximum(telemetry["ee_error"], 1e-12), color=_FLOWN)
     axes[0].set(ylabel="error [m]", title="End-effector tracking error |flown - reference|")
     axes[1].semilogy(times, np.maximum(telemetry["target_distance"], 1e-12), color=_FLOWN)
-    axes[1].axhline(scenario.mission.tolerance, color="k", ls="--", lw=0.8)
+    axes[1].axhline(scenario.mission_as(ReachMissionSection).tolerance, color="k", ls="--", lw=0.8)
     axes[1].set(ylabel="distance [m]", title="End effector to target (dashed: tolerance)")
     axes[2].plot(times, telemetry["det_jjt"], color=_FLOWN)
     axes[2].set(ylabel="det(J Jᵀ) [m⁶]", title="Singularity measure (0: singular)")

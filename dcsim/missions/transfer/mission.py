@@ -130,14 +130,14 @@ class TransferMission(Mission):
             self._plan(state, observations)
         if self.trajectory is None:
             return self._holding(state)
-        reference = self._follow(time)
+        reference = self._follow(self.trajectory, time)
         self.tracking_error = float(np.linalg.norm(reference.position - estimate.position))
         if self.tracking_error > self.settings.tracking_tolerance:
             self.emit("off_track", error=self.tracking_error)
             self._plan(state, observations)
             if self.trajectory is None:
                 return self._holding(state)
-            reference = self._follow(time)
+            reference = self._follow(self.trajectory, time)
             self.tracking_error = float(np.linalg.norm(reference.position - estimate.position))
         return reference
 
@@ -183,9 +183,8 @@ class TransferMission(Mission):
         self._go("FLY")
 
     # ------------------------------------------------------------------ references
-    def _follow(self, time: float) -> Reference:
+    def _follow(self, trajectory: Trajectory, time: float) -> Reference:
         """The trajectory's state at ``time`` with its feed-forward (held after the end)."""
-        trajectory = self.trajectory
         state = trajectory.state_at(time)
         attitude = state.attitude if trajectory.attitudes is not None else self._held_attitude()
         acceleration, angular_acceleration = self._feed_forward(trajectory, time)
@@ -334,10 +333,10 @@ def transfer_problem(
         With the acceleration limit ``acceleration_fraction`` of the thrust-limited one
         and the angular acceleration the torque gives about the stiffest axis.
     """
-    settings = scenario.mission
+    settings = scenario.mission_as(TransferMissionSection)
     bounds = None
     if settings.bounds is not None:
-        bounds = Bounds(settings.bounds.lower, settings.bounds.upper)
+        bounds = Bounds(np.array(settings.bounds.lower), np.array(settings.bounds.upper))
     weights = settings.weights
     max_delta_v = np.inf if settings.max_delta_v is None else settings.max_delta_v
     return PathProblem(

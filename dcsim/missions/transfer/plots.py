@@ -34,6 +34,7 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
 from dcsim.messages import ObjectKind, Shape, ShapeKind  # noqa: E402
+from dcsim.missions.transfer.settings import TransferMissionSection  # noqa: E402
 from dcsim.report.outlines import outline, wireframe  # noqa: E402
 from dcsim.report.plots import (  # noqa: E402
     LEGEND_ROW,
@@ -221,9 +222,9 @@ def _extent(points: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _goal(scenario: Scenario) -> Placed:
-    goal = scenario.mission.goal
+    goal = scenario.mission_as(TransferMissionSection).goal.build()
     shape = (
-        Shape(ShapeKind.SPHERE, radius=goal.radius)
+        Shape(ShapeKind.SPHERE, radius=goal.tolerance)
         if goal.half_extents is None
         else Shape(ShapeKind.BOX, half_extents=goal.half_extents)
     )
@@ -231,7 +232,7 @@ def _goal(scenario: Scenario) -> Placed:
 
 
 def _bounds(scenario: Scenario) -> Placed | None:
-    bounds = scenario.mission.bounds
+    bounds = scenario.mission_as(TransferMissionSection).bounds
     if bounds is None:
         return None
     lower, upper = np.asarray(bounds.lower, float), np.asarray(bounds.upper, float)

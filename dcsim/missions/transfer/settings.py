@@ -54,11 +54,11 @@ class GoalSection(Section):
     def build(self) -> GoalRegion:
         """The goal region message."""
         return GoalRegion(
-            position=self.position,
+            position=np.array(self.position),
             tolerance=0.0 if self.radius is None else self.radius,
-            velocity=self.velocity,
+            velocity=np.array(self.velocity),
             time=self.arrival_time,
-            half_extents=self.half_extents,
+            half_extents=None if self.half_extents is None else np.array(self.half_extents),
             attitude=None
             if self.attitude is None
             else np.asarray(self.attitude) / np.linalg.norm(self.attitude),

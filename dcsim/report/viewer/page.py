@@ -125,4 +125,6 @@ def _numbers(array: np.ndarray) -> Any:
     finite = np.isfinite(rounded)
     if finite.all():
         return rounded.tolist()
-    return np.where(finite, rounded, None).tolist()
+    values = rounded.astype(object)
+    values[~finite] = None
+    return values.tolist()

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from dcsim.messages import ObjectKind, Shape, ShapeKind
+from dcsim.missions.debris.settings import DebrisMissionSection
 from dcsim.report.outlines import wireframe
 from dcsim.report.viewer.meshes import Mesh, shape_mesh
 from dcsim.report.viewer.objects import Handling, ObjectTrack, Status, object_tracks
@@ -225,7 +226,7 @@ def _drop_body(context: _Context) -> list[dict[str, Any]]:
     """The drop point's tolerance sphere, for missions that deliver (debris)."""
     if context.mission != "debris":
         return []
-    drop = context.scenario.mission.drop_point
+    drop = context.scenario.mission_as(DebrisMissionSection).drop_point
     positions = drop.build(context.scenario.mean_motion).state_at(context.times)[0]
     mesh = shape_mesh(Shape(ShapeKind.SPHERE, radius=drop.tolerance))
     trace = _mesh_trace("drop point (tolerance)", _DROP, 0.25, flat=False)
@@ -408,7 +409,9 @@ def _plans(context: _Context) -> list[dict[str, Any]]:
     if not plans:
         return []
     motions = {t.object.id: t.object.motion for t in context.tracks}
-    drop = context.scenario.mission.drop_point.build(context.scenario.mean_motion)
+    drop = context.scenario.mission_as(DebrisMissionSection).drop_point.build(
+        context.scenario.mean_motion
+    )
     stages = []
     for plan in plans:
         start = context.path.positions[context.path.row_at(np.array([plan["t"]]))[0]]
