@@ -13,14 +13,14 @@ $(STAMP): pyproject.toml setup.cfg
 	$(BIN)/python -m pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
-# One pytest-xdist worker per core; tests marked with one xdist_group share a worker
+# `make lint` (ruff and mypy) runs first. One pytest-xdist worker per core; tests marked with one xdist_group share a worker
 # (and the set-up they share). `.venv/bin/pytest` alone runs the suite in one process.
 # dcsim's and the plugins' bytecode is compiled first: where PYTHONDONTWRITEBYTECODE is
 # set, every process the suite starts (`dcsim` commands, Dask workers) would otherwise
 # compile them again, about 1.3 s each. The tests marked `slow` (every shipped scenario
 # with every planner and controller that can fly it, the FMU examples' exits in 40 fresh
 # processes) are left out: `make test-slow`.
-test: $(STAMP)
+test: lint
 	$(BIN)/python -m compileall -q dcsim plugins
 	$(BIN)/python -m pytest -n auto --dist loadgroup -m "not slow"
 
@@ -32,6 +32,7 @@ run: $(STAMP)
 	$(BIN)/dcsim run
 
 # Types and style of dcsim/ and plugins/ (settings in pyproject.toml); tests/ is linted too.
+# `make test` runs it first.
 lint: $(STAMP)
 	$(BIN)/ruff check dcsim plugins tests
 	$(BIN)/ruff format --check dcsim plugins tests

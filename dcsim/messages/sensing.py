@@ -86,8 +86,8 @@ class ObjectTrack(Message):
     motion : MotionModel or None
         The object's motion parameters, for prediction; None if unknown, in which case
         prediction assumes constant velocity.
-    shape : Shape or None
-        The object's true shape; None means a sphere of ``radius``.
+    shape : Shape
+        The object's true shape; given as None (the default), a sphere of ``radius``.
     """
 
     id: int
@@ -98,7 +98,9 @@ class ObjectTrack(Message):
     mass: float = 0.0
     radius: float = 0.0
     motion: MotionModel | None = None
-    shape: Shape | None = None
+    # None at construction means a sphere of ``radius``; __post_init__ replaces it, so the
+    # attribute is always a Shape (mypy cannot type a field's converter).
+    shape: Shape = None  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         super().__post_init__()

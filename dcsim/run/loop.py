@@ -315,23 +315,22 @@ class Runner:
         other worlds."""
         world_spec = self.scenario.world
         orbit = world_spec.orbit
+        world = self._opened_world
         if world_spec.frame != "lvlh" or orbit.model != "cw":
             return None
-        objects = [self.world.field.free_states(t)[0] for t in (0.0, self.world.time)]
+        objects = [world.field.free_states(t)[0] for t in (0.0, world.time)]
         separation = max(
             self._max_separation,
             *(float(np.max(np.linalg.norm(p, axis=1), initial=0.0)) for p in objects),
         )
-        error = cw_error_estimate(
-            separation, self.world.time, orbit.semi_major_axis, orbit.mean_motion
-        )
+        error = cw_error_estimate(separation, world.time, orbit.semi_major_axis, orbit.mean_motion)
         if error > orbit.cw_tolerance:
             self._event(
                 "cw_linearisation", error=error, tolerance=orbit.cw_tolerance, separation=separation
             )
             warnings.warn(
                 f"Clohessy-Wiltshire may be off by up to {error:.3g} m here ({separation:.0f} m "
-                f"from the chief for {self.world.time:.0f} s), more than world.orbit.cw_tolerance "
+                f"from the chief for {world.time:.0f} s), more than world.orbit.cw_tolerance "
                 f"({orbit.cw_tolerance:g} m); set world.orbit.model to two-body or j2 for the "
                 "exact relative motion",
                 CwValidityWarning,

@@ -164,9 +164,8 @@ def obstacle_track(
         position,
         velocity,
         mass=50.0,
-        radius=0.0 if shape is not None else radius,
         motion=motion,
-        shape=shape,
+        shape=Shape(ShapeKind.SPHERE, radius=radius) if shape is None else shape,
     )
 
 
