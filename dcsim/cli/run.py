@@ -144,13 +144,16 @@ def _print_summary(summary: dict, out: Path) -> None:
     if summary["goal_met"] is False:
         reason += f" — goal not met: {summary['outcome']}"
     click.echo(f"{summary['scenario']} seed {summary['seed']}: {summary['status']}{reason}")
-    outcome = f"{summary['outcome']}, " if summary["outcome"] else ""
+    said = summary["goal_met"] is False  # the first line gave the outcome already
+    outcome = f"{summary['outcome']}, " if summary["outcome"] and not said else ""
     click.echo(f"  {outcome}collisions {summary['collisions']}")
     click.echo(
         f"  delta-v {number('delta_v_mps', 'm/s')}, propellant {number('fuel_used_kg', 'kg')}, "
         f"localisation RMSE {number('localisation_rmse_m', 'm')}, "
         f"closest obstacle {number('min_obstacle_distance_m', 'm')}"
     )
+    if summary.get("cw_error_estimate_m") is not None:
+        click.echo(f"  Clohessy-Wiltshire error up to {number('cw_error_estimate_m', 'm', 2)}")
     click.echo(
         f"  simulated {summary['sim_time_s']:.1f} s in {summary['wall_time_s']:.1f} s of wall time "
         f"(x{summary['real_time_factor']:.0f} real time)"
