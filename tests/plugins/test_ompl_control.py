@@ -277,3 +277,17 @@ def test_seeds_take_in_workers_even_when_ompl_already_runs_in_the_planning_proce
 def test_a_moment_of_inertia_must_be_positive():
     with pytest.raises(PluginParameterError, match="every principal moment must be positive"):
         OmplControlPlanner({"inertia": [0.1, 0.0, 0.1]}, np.random.default_rng(0))
+
+
+def test_a_deadline_sooner_than_the_budget_is_the_budget_the_answer_quotes():
+    wall = tuple(
+        obstacle_track(10 + i, c, radius=2.0)
+        for i, c in enumerate(
+            [(12 + dx, dy, dz) for dx, dy, dz in np.vstack([np.eye(3), -np.eye(3)]) * 3.2]
+        )
+    )
+    problem = dataclasses.replace(
+        small_problem(time_budget=5.0, obstacles=wall), deadline=time.monotonic() + 0.3
+    )
+    answer = plan(problem, controls="discrete")
+    assert isinstance(answer, NoPath) and "within the 0.3 s budget" in answer.reason

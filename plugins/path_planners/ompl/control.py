@@ -688,17 +688,18 @@ class OmplControlPlanner(PathPlanner):
     def plan(self, problem: PathProblem) -> Trajectory | NoPath:
         """Plan from the start state into the goal region by ``problem.due()``."""
         deadline = problem.due()
+        budget = deadline - time.monotonic()  # the deadline, not time_budget, may govern
         refusal = endpoint_refusal(problem, ObstacleField(problem))
         if refusal is not None:
             return refusal
         seed = int(self.rng.integers(1, 2**31 - 1))
         solution = in_worker(solve, (self.params, problem, seed, deadline), deadline)
         if solution is None:
-            return NoPath(f"the planner gave no answer within the {problem.time_budget:g} s budget")
+            return NoPath(f"the planner gave no answer within the {budget:.3g} s budget")
         if not solution.exact:
             iterations = solution.statistics["iterations"]
             return NoPath(
-                f"no path within the {problem.time_budget:g} s budget: after {iterations:.0f} "
+                f"no path within the {budget:.3g} s budget: after {iterations:.0f} "
                 f"iterations the closest state is {solution.gap:.2f} m from the goal region"
             )
         return to_trajectory(solution, self.params.mass)

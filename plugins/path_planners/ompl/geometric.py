@@ -232,6 +232,7 @@ class OmplGeometricPlanner(PathPlanner):
     def plan(self, problem: PathProblem) -> Trajectory | NoPath:
         """Plan, simplify and time a path to the goal region by ``problem.due()``."""
         deadline = problem.due()
+        budget = deadline - time.monotonic()  # the deadline, not time_budget, may govern
         field = ObstacleField(problem)
         if field.moving:
             return NoPath(MOVING_REFUSAL)
@@ -253,7 +254,7 @@ class OmplGeometricPlanner(PathPlanner):
         args = (self.params, problem, stop, goal, seed, deadline)
         found = in_worker(solve, args, deadline)
         if found is None or found.points is None:
-            return NoPath(f"no path within the {problem.time_budget:g} s budget")
+            return NoPath(f"no path within the {budget:.3g} s budget")
         return self._timed(problem, stopping, found.points, found.statistics)
 
     def _timed(

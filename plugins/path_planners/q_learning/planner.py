@@ -29,6 +29,7 @@ from __future__ import annotations
 import hashlib
 import os
 import tempfile
+import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -218,6 +219,7 @@ class QLearningPlanner(PathPlanner):
         if refusal is not None:
             return refusal
         deadline = problem.due()
+        budget = deadline - time.monotonic()  # the deadline, not time_budget, may govern
         try:
             environment = self.environment(problem, deadline)
             if environment.start == environment.target:  # nothing to learn: one move
@@ -230,7 +232,7 @@ class QLearningPlanner(PathPlanner):
             return NoPath(str(large))
         except OutOfTime as late:
             return NoPath(
-                f"the planning budget of {problem.time_budget:g} s ran out ({late} done): "
+                f"the planning budget of {budget:.3g} s ran out ({late} done): "
                 "give it more time, or fewer cells or episodes (a q_table_file trained on this "
                 "environment skips the training)"
             )
