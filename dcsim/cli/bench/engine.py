@@ -1,7 +1,7 @@
-"""Benches of dcsim's engine: the closed loop against PyBullet (``world``), a long run
-(``soak``), the FMU (``fmu``), the campaign engine (``campaign``), the attitude loop
-beside Basilisk's (``peers``) and the manipulator model against Pinocchio's
-(``manipulator``)."""
+"""Benches of dcsim's engine: the closed loop against PyBullet (``world``), the orbit
+models against an inertial reference (``dynamics``), a long run (``soak``), the FMU
+(``fmu``), the campaign engine (``campaign``), the attitude loop beside Basilisk's
+(``peers``) and the manipulator model against Pinocchio's (``manipulator``)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from pathlib import Path
 
 import click
 
-from dcsim.bench.options import comma_numbers
+from dcsim.bench.options import comma_numbers, comma_words
 from dcsim.cli.common import plugin_registry, progress
 from dcsim.cli.options import (
     count_option,
@@ -19,6 +19,7 @@ from dcsim.cli.options import (
     positive_option,
     scenario_argument,
 )
+from dcsim.errors import DcsimError
 from dcsim.run.directory import prepare_run_directory
 from dcsim.run.setup import setup_run
 
@@ -59,6 +60,96 @@ def bench_world_command(objects: str, duration: float) -> None:
         f"real-time factor {summary['real_time_factor']:.0f}"
     )
     click.echo(floor_line(loop_floor(summary["sim_time_s"], summary["wall_time_s"], registry)))
+
+
+@click.command("dynamics", short_help="The orbit models' free drift against an inertial reference.")
+@click.option(
+    "--models", default="cw,two-body,j2", show_default=True, help="World orbit models flown."
+)
+@click.option(
+    "--separations",
+    default="100,1000,10000",
+    show_default=True,
+    help="Comma-separated start distances from the chief, m.",
+)
+@click.option("--axes", default="x,y,z", show_default=True, help="LVLH axes started on.")
+@click.option(
+    "--eccentricities",
+    default="0,0.01",
+    show_default=True,
+    help="Chief eccentricities (semi-major axis 6,778,137 m; cw is circular only).",
+)
+@positive_option("--orbits", 1.0, "Chief orbits each case drifts.")
+@positive_option("--physics-step", 0.01, "world.physics_step of the drifting worlds, s.")
+@positive_option("--control-period", 0.1, "world.control_period of the drifting worlds, s.")
+@click.option(
+    "--planners/--no-planners",
+    default=True,
+    show_default=True,
+    help="Also fly the CW-based planners' missions under cw and j2.",
+)
+@click.option(
+    "--scenarios",
+    "scenario_dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=Path("scenarios"),
+    show_default=True,
+    help="Folder holding station_inspection.yaml and default.yaml (for the planners).",
+)
+@plot_option("Write the worst drift error against separation (log-log) as a PNG.")
+def bench_dynamics_command(
+    models: str,
+    separations: str,
+    axes: str,
+    eccentricities: str,
+    orbits: float,
+    physics_step: float,
+    control_period: float,
+    planners: bool,
+    scenario_dir: Path,
+    plot_path: Path | None,
+) -> None:
+    """The orbit models against an independent inertial reference.
+
+    The robot of a bare world starts at each separation on each LVLH axis with a
+    drift-free velocity and drifts free for ORBITS chief orbits under each model, on each
+    orbit; its position is compared every 10 s with an inertial propagation (scipy) under
+    the exact physics: cw and two-body worlds with the two-body reference, j2 with the
+    J2 one. Then the integration cost of a thrust (physics step against half of it), and
+    with --planners the station inspection (grid-astar, multi-burn) and default (ga)
+    missions flown under cw and j2. Prints Markdown tables for docs/benchmarks.md.
+    """
+    from dcsim.bench import dynamics
+
+    chosen = comma_words(models, "--models")
+    chosen_axes = comma_words(axes, "--axes")
+    for option, words, allowed in (
+        ("--models", chosen, dynamics.MODELS),
+        ("--axes", chosen_axes, dynamics.AXES),
+    ):
+        unknown = [w for w in words if w not in allowed]
+        if unknown:
+            raise DcsimError(f"{option}: unknown {', '.join(unknown)}; use {', '.join(allowed)}")
+    distances = comma_numbers(separations, "--separations")
+    if min(distances) <= 0:
+        raise DcsimError("--separations: every distance must be above 0 m")
+    cases = dynamics.drift_cases(
+        chosen, comma_numbers(eccentricities, "--eccentricities"), distances, chosen_axes
+    )
+    results = dynamics.bench_drift(cases, orbits, physics_step, control_period, progress)
+    click.echo(dynamics.drift_table(results))
+    click.echo(f"\n{dynamics.verdict(results)}")
+    progress("thrust: the 1 km j2 case at two physics steps")
+    cost = dynamics.thrust_cost(orbits, physics_step, control_period)
+    click.echo(f"\n{dynamics.thrust_line(cost)}")
+    if plot_path is not None:
+        dynamics.plot(results, plot_path)
+        click.echo(f"\nplot: {plot_path}")
+    if planners:
+        flights = dynamics.bench_flights(
+            scenario_dir, registry=plugin_registry(), progress=progress
+        )
+        click.echo(f"\n{dynamics.flights_table(flights)}")
 
 
 @click.command("soak", short_help="A long run's memory and time per tick; FMU lifetimes.")
