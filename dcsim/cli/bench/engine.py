@@ -5,6 +5,7 @@ models against an inertial reference (``dynamics``), a long run (``soak``), the 
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import click
@@ -19,7 +20,7 @@ from dcsim.cli.options import (
     positive_option,
     scenario_argument,
 )
-from dcsim.errors import DcsimError
+from dcsim.errors import DcsimError, PlannerModelWarning
 from dcsim.run.directory import prepare_run_directory
 from dcsim.run.setup import setup_run
 
@@ -32,7 +33,14 @@ from dcsim.run.setup import setup_run
     help="Comma-separated field sizes (targets and obstacles in all), each >= 0.",
 )
 @duration_option(60.0)
-def bench_world_command(objects: str, duration: float) -> None:
+@click.option(
+    "--orbit-model",
+    type=click.Choice(["cw", "two-body", "j2"]),
+    default="cw",
+    show_default=True,
+    help="world.orbit.model of the synthetic scenarios and the default scenario's run.",
+)
+def bench_world_command(objects: str, duration: float, orbit_model: str) -> None:
     """Closed-loop wall time per simulated second against PyBullet stepping alone.
 
     For each field size, one synthetic LVLH scenario is stepped bare (stepSimulation
@@ -40,6 +48,7 @@ def bench_world_command(objects: str, duration: float) -> None:
     loop. Then the default scenario is flown once for its real-time factor. Prints a
     Markdown table for docs/benchmarks.md, and the floor under the default scenario's
     real-time factor: stepping, the per-step force calls and the localiser plugin alone.
+    Every world moves by ORBIT_MODEL's dynamics.
     """
     from dcsim.bench.world import bench_world, floor_line, loop_floor, markdown_table
     from dcsim.run.loop import Runner
@@ -50,16 +59,20 @@ def bench_world_command(objects: str, duration: float) -> None:
             f"expected integers >= 0 like 10,100,1000, got {objects!r}", param_hint="--objects"
         )
     sizes = [int(word) for word in words]
-    rows = bench_world(sizes, duration, progress=progress)
-    click.echo(markdown_table(rows))
+    overrides = [] if orbit_model == "cw" else [f"world.orbit.model={orbit_model}"]
     registry = plugin_registry()
-    summary = Runner(setup_run(registry=registry)).run()
+    with warnings.catch_warnings():  # the planners model cw only: expected in other worlds
+        warnings.simplefilter("ignore", PlannerModelWarning)
+        rows = bench_world(sizes, duration, progress=progress, orbit_model=orbit_model)
+        click.echo(markdown_table(rows))
+        summary = Runner(setup_run(overrides=overrides, registry=registry)).run()
     click.echo(
         f"\ndefault scenario: {summary['status']} ({summary['reason']}), "
         f"{summary['sim_time_s']:.1f} s simulated in {summary['wall_time_s']:.2f} s, "
         f"real-time factor {summary['real_time_factor']:.0f}"
     )
-    click.echo(floor_line(loop_floor(summary["sim_time_s"], summary["wall_time_s"], registry)))
+    floor = loop_floor(summary["sim_time_s"], summary["wall_time_s"], registry, overrides=overrides)
+    click.echo(floor_line(floor))
 
 
 @click.command("dynamics", short_help="The orbit models' free drift against an inertial reference.")
