@@ -147,8 +147,8 @@ def drift_scenario(
     control_period: float = 0.1,
     velocity: Sequence[float] = (0.0, 0.0, 0.0),
 ) -> Scenario:
-    """The bare world of a drift case: a 100 kg sphere at :attr:`DriftCase.start` holding
-    no station (mission ``hold`` is never asked), no objects.
+    """The scenario of a drift case: a 100 kg sphere at :attr:`DriftCase.start` and no
+    objects; its mission (``hold``) is not flown, the world is stepped bare.
 
     Parameters
     ----------
