@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import time
 import timeit
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -77,8 +77,11 @@ class WorldBenchRow:
         return self.closed_loop / self.bare - 1.0
 
 
-def field_scenario(objects: int, duration: float, seed: int = 0) -> Scenario:
-    """The synthetic benchmark scenario with ``objects`` targets and obstacles in all."""
+def field_scenario(
+    objects: int, duration: float, seed: int = 0, orbit_model: str = "cw"
+) -> Scenario:
+    """The synthetic benchmark scenario with ``objects`` targets and obstacles in all,
+    in a world of orbit model ``orbit_model`` (``cw``, ``two-body`` or ``j2``)."""
     rng = np.random.default_rng(seed)
     n = mean_motion(ORBIT_RADIUS)
 
@@ -99,7 +102,11 @@ def field_scenario(objects: int, duration: float, seed: int = 0) -> Scenario:
     return read_scenario(
         {
             "name": f"bench-{objects}",
-            "world": {"frame": "lvlh", "orbit": {"radius": ORBIT_RADIUS}, "duration": duration},
+            "world": {
+                "frame": "lvlh",
+                "orbit": {"radius": ORBIT_RADIUS, "model": orbit_model},
+                "duration": duration,
+            },
             "robot": {"radius": 0.5, "max_force": 5.0, "max_speed": 0.5, "sensor_range": 120.0},
             "obstacles": obstacles,
             "beacons": {"positions": _BEACONS, "noise_sigma": 0.05, "report_nearest": 4},
@@ -133,14 +140,18 @@ def closed_loop(scenario: Scenario, registry: PluginRegistry) -> tuple[float, di
 
 
 def bench_world(
-    sizes: list[int], duration: float, progress: Callable[[str], None] = print
+    sizes: list[int],
+    duration: float,
+    progress: Callable[[str], None] = print,
+    orbit_model: str = "cw",
 ) -> list[WorldBenchRow]:
-    """Measure every field size; ``progress`` receives a line per finished size."""
+    """Measure every field size in worlds of ``orbit_model``; ``progress`` receives a
+    line per finished size."""
     registry = PluginRegistry.discover()
-    closed_loop(field_scenario(4, 5.0), registry)  # warm up: imports, caches
+    closed_loop(field_scenario(4, 5.0, orbit_model=orbit_model), registry)  # warm up
     rows = []
     for objects in sizes:
-        scenario = field_scenario(objects, duration)
+        scenario = field_scenario(objects, duration, orbit_model=orbit_model)
         bare = bare_stepping(scenario)
         loop, phases = closed_loop(scenario, registry)
         rows.append(WorldBenchRow(objects, bare, loop, phases))
@@ -201,7 +212,11 @@ class LoopFloor:
 
 
 def loop_floor(
-    sim_time: float, closed_loop: float, registry: PluginRegistry, repeats: int = 3
+    sim_time: float,
+    closed_loop: float,
+    registry: PluginRegistry,
+    repeats: int = 3,
+    overrides: Sequence[str] = (),
 ) -> LoopFloor:
     """Measure the floor of the default scenario over the span a run of it flew.
 
@@ -215,12 +230,14 @@ def loop_floor(
         Where the scenario's localiser plugin comes from.
     repeats : int
         Each part is timed this many times; the shortest counts.
+    overrides : sequence of str
+        Overrides of the default scenario the run flew (``world.orbit.model=j2``).
 
     Returns
     -------
     LoopFloor
     """
-    setup = setup_run(registry=registry)
+    setup = setup_run(overrides=overrides, registry=registry)
     with World(setup.scenario, component_rng(0, "world")) as world:
         ticks = round(sim_time / world.control_period)
         steps = ticks * world.steps_per_control

@@ -43,6 +43,12 @@ SMALLEST = {
         *("--planners", "straight-line", "--problems", "static-spheres", "--runs", "1"),
         *("--no-memory", "--plot", "{tmp}/paths.png"),
     ],
+    # One exact model, one case, a hundredth of an orbit; no missions flown.
+    "dynamics": [
+        *("--models", "two-body", "--separations", "100", "--axes", "x"),
+        *("--eccentricities", "0", "--orbits", "0.01", "--no-planners"),
+        *("--plot", "{tmp}/dynamics.png"),
+    ],
     "campaign": ["--cases", "1", "--workers", "1", "--duration", "0.01", "--out", "{tmp}/cases"],
     # One controller; the crowded field's whole crossing takes 35 s, 10 s of it do here.
     "controllers": [

@@ -25,6 +25,7 @@ def bench_group() -> None:
 
 
 bench_group.add_command(engine.bench_world_command)
+bench_group.add_command(engine.bench_dynamics_command)
 bench_group.add_command(engine.bench_soak_command)
 bench_group.add_command(engine.bench_fmu_command)
 bench_group.add_command(engine.bench_campaign_command)

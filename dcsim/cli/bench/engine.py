@@ -1,15 +1,16 @@
-"""Benches of dcsim's engine: the closed loop against PyBullet (``world``), a long run
-(``soak``), the FMU (``fmu``), the campaign engine (``campaign``), the attitude loop
-beside Basilisk's (``peers``) and the manipulator model against Pinocchio's
-(``manipulator``)."""
+"""Benches of dcsim's engine: the closed loop against PyBullet (``world``), the orbit
+models against an inertial reference (``dynamics``), a long run (``soak``), the FMU
+(``fmu``), the campaign engine (``campaign``), the attitude loop beside Basilisk's
+(``peers``) and the manipulator model against Pinocchio's (``manipulator``)."""
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import click
 
-from dcsim.bench.options import comma_numbers
+from dcsim.bench.options import comma_numbers, comma_words
 from dcsim.cli.common import plugin_registry, progress
 from dcsim.cli.options import (
     count_option,
@@ -19,6 +20,7 @@ from dcsim.cli.options import (
     positive_option,
     scenario_argument,
 )
+from dcsim.errors import DcsimError, PlannerModelWarning
 from dcsim.run.directory import prepare_run_directory
 from dcsim.run.setup import setup_run
 
@@ -31,7 +33,14 @@ from dcsim.run.setup import setup_run
     help="Comma-separated field sizes (targets and obstacles in all), each >= 0.",
 )
 @duration_option(60.0)
-def bench_world_command(objects: str, duration: float) -> None:
+@click.option(
+    "--orbit-model",
+    type=click.Choice(["cw", "two-body", "j2"]),
+    default="cw",
+    show_default=True,
+    help="world.orbit.model of the synthetic scenarios and the default scenario's run.",
+)
+def bench_world_command(objects: str, duration: float, orbit_model: str) -> None:
     """Closed-loop wall time per simulated second against PyBullet stepping alone.
 
     For each field size, one synthetic LVLH scenario is stepped bare (stepSimulation
@@ -39,6 +48,7 @@ def bench_world_command(objects: str, duration: float) -> None:
     loop. Then the default scenario is flown once for its real-time factor. Prints a
     Markdown table for docs/benchmarks.md, and the floor under the default scenario's
     real-time factor: stepping, the per-step force calls and the localiser plugin alone.
+    Every world moves by ORBIT_MODEL's dynamics.
     """
     from dcsim.bench.world import bench_world, floor_line, loop_floor, markdown_table
     from dcsim.run.loop import Runner
@@ -49,16 +59,110 @@ def bench_world_command(objects: str, duration: float) -> None:
             f"expected integers >= 0 like 10,100,1000, got {objects!r}", param_hint="--objects"
         )
     sizes = [int(word) for word in words]
-    rows = bench_world(sizes, duration, progress=progress)
-    click.echo(markdown_table(rows))
+    overrides = [] if orbit_model == "cw" else [f"world.orbit.model={orbit_model}"]
     registry = plugin_registry()
-    summary = Runner(setup_run(registry=registry)).run()
+    with warnings.catch_warnings():  # the planners model cw only: expected in other worlds
+        warnings.simplefilter("ignore", PlannerModelWarning)
+        rows = bench_world(sizes, duration, progress=progress, orbit_model=orbit_model)
+        click.echo(markdown_table(rows))
+        summary = Runner(setup_run(overrides=overrides, registry=registry)).run()
     click.echo(
         f"\ndefault scenario: {summary['status']} ({summary['reason']}), "
         f"{summary['sim_time_s']:.1f} s simulated in {summary['wall_time_s']:.2f} s, "
         f"real-time factor {summary['real_time_factor']:.0f}"
     )
-    click.echo(floor_line(loop_floor(summary["sim_time_s"], summary["wall_time_s"], registry)))
+    floor = loop_floor(summary["sim_time_s"], summary["wall_time_s"], registry, overrides=overrides)
+    click.echo(floor_line(floor))
+
+
+@click.command("dynamics", short_help="The orbit models' free drift against an inertial reference.")
+@click.option(
+    "--models", default="cw,two-body,j2", show_default=True, help="World orbit models flown."
+)
+@click.option(
+    "--separations",
+    default="100,1000,10000",
+    show_default=True,
+    help="Comma-separated start distances from the chief, m.",
+)
+@click.option("--axes", default="x,y,z", show_default=True, help="LVLH axes started on.")
+@click.option(
+    "--eccentricities",
+    default="0,0.01",
+    show_default=True,
+    help="Chief eccentricities (semi-major axis 6,778,137 m; cw is circular only).",
+)
+@positive_option("--orbits", 1.0, "Chief orbits each case drifts.")
+@positive_option("--physics-step", 0.01, "world.physics_step of the drifting worlds, s.")
+@positive_option("--control-period", 0.1, "world.control_period of the drifting worlds, s.")
+@click.option(
+    "--planners/--no-planners",
+    default=True,
+    show_default=True,
+    help="Also fly the CW-based planners' missions under cw and j2.",
+)
+@click.option(
+    "--scenarios",
+    "scenario_dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=Path("scenarios"),
+    show_default=True,
+    help="Folder holding station_inspection.yaml and default.yaml (for the planners).",
+)
+@plot_option("Write the worst drift error against separation (log-log) as a PNG.")
+def bench_dynamics_command(
+    models: str,
+    separations: str,
+    axes: str,
+    eccentricities: str,
+    orbits: float,
+    physics_step: float,
+    control_period: float,
+    planners: bool,
+    scenario_dir: Path,
+    plot_path: Path | None,
+) -> None:
+    """The orbit models against an independent inertial reference.
+
+    The robot of a bare world starts at each separation on each LVLH axis with a
+    drift-free velocity and drifts free for ORBITS chief orbits under each model, on each
+    orbit; its position is compared every 10 s with an inertial propagation (scipy) under
+    the exact physics: cw and two-body worlds with the two-body reference, j2 with the
+    J2 one. Then the integration cost of a thrust (physics step against half of it), and
+    with --planners the station inspection (grid-astar, multi-burn) and default (ga)
+    missions flown under cw and j2. Prints Markdown tables for docs/benchmarks.md.
+    """
+    from dcsim.bench import dynamics
+
+    chosen = comma_words(models, "--models")
+    chosen_axes = comma_words(axes, "--axes")
+    for option, words, allowed in (
+        ("--models", chosen, dynamics.MODELS),
+        ("--axes", chosen_axes, dynamics.AXES),
+    ):
+        unknown = [w for w in words if w not in allowed]
+        if unknown:
+            raise DcsimError(f"{option}: unknown {', '.join(unknown)}; use {', '.join(allowed)}")
+    distances = comma_numbers(separations, "--separations")
+    if min(distances) <= 0:
+        raise DcsimError("--separations: every distance must be above 0 m")
+    cases = dynamics.drift_cases(
+        chosen, comma_numbers(eccentricities, "--eccentricities"), distances, chosen_axes
+    )
+    results = dynamics.bench_drift(cases, orbits, physics_step, control_period, progress)
+    click.echo(dynamics.drift_table(results))
+    click.echo(f"\n{dynamics.verdict(results)}")
+    progress("thrust: the 1 km j2 case at two physics steps")
+    cost = dynamics.thrust_cost(orbits, physics_step, control_period)
+    click.echo(f"\n{dynamics.thrust_line(cost)}")
+    if plot_path is not None:
+        dynamics.plot(results, plot_path)
+        click.echo(f"\nplot: {plot_path}")
+    if planners:
+        flights = dynamics.bench_flights(
+            scenario_dir, registry=plugin_registry(), progress=progress
+        )
+        click.echo(f"\n{dynamics.flights_table(flights)}")
 
 
 @click.command("soak", short_help="A long run's memory and time per tick; FMU lifetimes.")
