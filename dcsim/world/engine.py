@@ -478,6 +478,7 @@ class World:
         cargo = [(c, self.field.objects[i].mass) for i, (c, _) in self._payload.held.items()]
         robot, links = self._robot, self._robot.links
         exact, dt = self._exact_forces, self.physics_step
+        parts = exact is not None and exact.has_parts
         apply_torque = torque != (0.0, 0.0, 0.0)
         check_contacts = len(self._candidates) > 0
         dx, dy, dz = disturbance
@@ -496,7 +497,8 @@ class World:
                 velocity = get_velocity(body, client)[0]
                 ax, ay, az = exact.base_acceleration(k * dt, body, position, velocity)
                 fx, fy, fz = fx + mass * ax, fy + mass * ay, fz + mass * az
-                exact.apply_to_parts(k * dt)
+                if parts:
+                    exact.apply_to_parts(k * dt)
             robot.apply_joint_torques(self._joint_torques)
             apply_force(body, -1, (fx, fy, fz), position, pb.WORLD_FRAME, client)
             if apply_torque:

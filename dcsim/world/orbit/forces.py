@@ -144,9 +144,10 @@ class ExactOrbitalForces:
         the Coriolis term would act on a velocity ``a Δt/2`` out (6.6 mm after a tenth
         of an orbit at 1 km).
         """
-        previous = self._previous.get(key, velocity)
+        u, v, w = self._previous.get(key, velocity)
         self._previous[key] = velocity
-        return tuple(1.5 * v - 0.5 * p for v, p in zip(velocity, previous, strict=True))
+        x, y, z = velocity
+        return (1.5 * x - 0.5 * u, 1.5 * y - 0.5 * v, 1.5 * z - 0.5 * w)
 
     def base_acceleration(
         self, tau: float, body: int, position: tuple[float, ...], velocity: tuple[float, ...]
@@ -154,6 +155,11 @@ class ExactOrbitalForces:
         """The base's orbital acceleration (m/s², LVLH) for the next physics step,
         ``tau`` (s) into the period, from PyBullet's reading of its state."""
         return self.base.at(tau, position, self._on_step((body, -1), velocity))
+
+    @property
+    def has_parts(self) -> bool:
+        """Whether the robot has bodies besides its base this period (cargo, links)."""
+        return bool(self._parts)
 
     def apply_to_parts(self, tau: float) -> None:
         """Apply each part's orbital force for the next physics step, ``tau`` (s) into
