@@ -96,14 +96,34 @@ class RelativeDynamics:
             The bodies' LVLH states at the period's start, m and m/s.
         """
         h = JACOBIAN_STEP
-        offsets = np.concatenate((np.zeros((1, 3)), np.eye(3) * h, -np.eye(3) * h))  # (7, 3)
-        around = self.acceleration(
-            start, rho[:, None, :] + offsets, np.repeat(rho_dot[:, None, :], 7, axis=1)
-        )  # (N, 7, 3): at the state, then shifted by +h and -h along each axis
-        at_start = around[:, 0]
-        at_end = self.acceleration(end, rho, rho_dot)
-        jacobians = np.swapaxes((around[:, 1:4] - around[:, 4:7]) / (2.0 * h), 1, 2)
-        velocity_jacobian = start.frame_terms[1]
+        count = len(rho)
+        # one gravity call: each body at the start, shifted by ±h along each LVLH axis,
+        # and at the end (only the gravity depends nonlinearly on position)
+        start_points = start.position + rho @ start.axes.T  # (N, 3), inertial
+        shifts = np.concatenate((np.eye(3), -np.eye(3))) * h @ start.axes.T  # (6, 3)
+        points = np.concatenate(
+            (
+                start_points,
+                (start_points[:, None, :] + shifts).reshape(-1, 3),
+                end.position + rho @ end.axes.T,
+            )
+        )
+        pulls = self.gravity(points)
+        shifted = pulls[count : 7 * count].reshape(count, 6, 3)
+        starts_terms, end_terms = start.frame_terms, end.frame_terms
+        at_start = (
+            (pulls[:count] - start.acceleration) @ start.axes
+            + rho @ starts_terms[0].T
+            + rho_dot @ starts_terms[1].T
+        )
+        at_end = (
+            (pulls[7 * count :] - end.acceleration) @ end.axes
+            + rho @ end_terms[0].T
+            + rho_dot @ end_terms[1].T
+        )
+        gradient = (shifted[:, :3] - shifted[:, 3:]) @ start.axes / (2.0 * h)  # (N, axis j, i)
+        jacobians = np.swapaxes(gradient, 1, 2) + starts_terms[0]
+        velocity_jacobian = starts_terms[1]
         drift = (at_end - at_start) / period
         return [
             AffineAcceleration.of(a, d, j, velocity_jacobian, p, v)
