@@ -144,6 +144,31 @@ def test_rules_across_sections(tmp_path):
     ]
 
 
+@pytest.mark.parametrize(
+    ("inertia", "message"),
+    [
+        ("[1, 2, 4]", "each principal moment must be at most the sum of the other two"),
+        ("[0, 1, 1]", "Input should be greater than 0"),
+        ("[1, -2, 2]", "Input should be greater than 0"),
+        ("[.inf, 1, 1]", "Input should be a finite number"),
+        ("[1, 2]", "has too few items"),
+        ("[[2, 0, 0], [0, 2, 0], [0, 0, 3]]", "a full inertia tensor is not supported"),
+    ],
+)
+def test_a_free_flyer_inertia_no_rigid_body_has_is_refused_naming_the_key(
+    tmp_path, inertia, message
+):
+    path = write(tmp_path, f"robot: {{mass: 50, inertia: {inertia}}}\n")
+    (found,) = problems(path)
+    assert found.startswith(f"{path}:1:") and "robot.inertia" in found and message in found
+
+
+def test_a_free_flyer_inertia_is_kept_and_absent_by_default(tmp_path):
+    assert read_scenario(write(tmp_path, "robot: {mass: 50}\n")).robot.inertia is None
+    given = read_scenario(write(tmp_path, "robot: {mass: 50, inertia: [2, 3, 4.5]}\n"))
+    assert given.robot.inertia == (2.0, 3.0, 4.5)
+
+
 def test_object_shapes_build_and_fill_in_the_bounding_radius(tmp_path):
     path = write(
         tmp_path,

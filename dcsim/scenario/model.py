@@ -17,6 +17,7 @@ import numpy as np
 from pydantic import (
     AfterValidator,
     BaseModel,
+    BeforeValidator,
     ConfigDict,
     Discriminator,
     Field,
@@ -354,6 +355,25 @@ class RobotBaseSection(Section):
     )
 
 
+def _rigid(moments: tuple[float, float, float]) -> tuple[float, float, float]:
+    if any(2.0 * m > sum(moments) * (1.0 + 1e-12) for m in moments):
+        raise ValueError("each principal moment must be at most the sum of the other two")
+    return moments
+
+
+Moments = Annotated[PositiveVec3, AfterValidator(_rigid)]
+"""Principal moments of inertia of a rigid body: positive, each at most the sum of the others."""
+
+
+def _no_tensor(value: Any) -> Any:
+    if isinstance(value, list | tuple) and any(isinstance(row, list | tuple) for row in value):
+        raise ValueError(
+            "a full inertia tensor is not supported: give the three principal moments "
+            "[Ixx, Iyy, Izz] along body axes that are the principal axes"
+        )
+    return value
+
+
 class RobotSection(RobotBaseSection):
     """The robot: a free flyer (the debris collector) with mass, limits, sensors, grabber."""
 
@@ -369,19 +389,18 @@ class RobotSection(RobotBaseSection):
         2.0, unit="m", gt=0, description="Largest centre distance at which a grab succeeds."
     )
     capacity: int = quantity(2, ge=1, description="Targets carried at once.")
+    inertia: Annotated[Moments | None, BeforeValidator(_no_tensor)] = quantity(
+        None,
+        unit="kg*m^2",
+        description="Principal moments of inertia [Ixx, Iyy, Izz] about the centre of mass, "
+        "along the body axes, at the initial mass `mass`; each at most the sum of the "
+        "other two. They scale with the mass as propellant burns (as a uniform body's "
+        "would). A full 3x3 tensor is refused: turn the body axes to the principal axes. "
+        "null: a uniform sphere's of `radius`, 2/5 m r^2.",
+    )
     initial: InitialStateSpec = Field(
         default_factory=InitialStateSpec, description="State at t = 0."
     )
-
-
-def _rigid(moments: tuple[float, float, float]) -> tuple[float, float, float]:
-    if any(2.0 * m > sum(moments) * (1.0 + 1e-12) for m in moments):
-        raise ValueError("each principal moment must be at most the sum of the other two")
-    return moments
-
-
-Moments = Annotated[PositiveVec3, AfterValidator(_rigid)]
-"""Principal moments of inertia of a rigid body: positive, each at most the sum of the others."""
 
 
 def _ordered(limits: tuple[float, float]) -> tuple[float, float]:

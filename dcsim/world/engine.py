@@ -5,7 +5,7 @@ passes the client id, so several worlds live side by side in one process. The wo
 composes its pieces:
 
 - :mod:`~dcsim.world.robot_body`: the robot, one of two body types behind one
-  interface — :mod:`~dcsim.world.free_flyer` (a rigid sphere) and
+  interface — :mod:`~dcsim.world.free_flyer` (a rigid body) and
   :mod:`~dcsim.world.manipulator` (a floating-base arm);
 - :mod:`~dcsim.world.bodies`: the PyBullet bodies of the objects;
 - :mod:`~dcsim.world.environment`: Clohessy–Wiltshire forces and the propellant;

@@ -1,8 +1,9 @@
-"""The free flyer in the PyBullet world: a rigid sphere driven at its centre of mass.
+"""The free flyer in the PyBullet world: a rigid body driven at its centre of mass.
 
 The debris collector of the source thesis: one rigid body with the scenario's mass and
-the inertia of a uniform sphere of its radius, no joints. Its mass is set every control
-period from the propellant left.
+the principal moments of inertia ``robot.inertia`` (by default a uniform sphere's of its
+radius), no joints. Its mass is set every control period from the propellant left; the
+given moments scale with it, as a uniform body's would (the sphere's do the same).
 """
 
 from __future__ import annotations
@@ -17,7 +18,8 @@ from dcsim.world.robot_body import base_spec_fields
 
 
 class FreeFlyerBody:
-    """A free flyer's rigid sphere (a :class:`~dcsim.world.robot_body.RobotBody`).
+    """A free flyer's rigid body, colliding as a sphere
+    (a :class:`~dcsim.world.robot_body.RobotBody`).
 
     Parameters
     ----------
@@ -38,6 +40,8 @@ class FreeFlyerBody:
         self.body = create_body(
             client, Shape(ShapeKind.SPHERE, radius=robot.radius), robot.mass, position, False
         )
+        if robot.inertia is not None:
+            self.set_base_mass(robot.mass)
         attitude = np.asarray(initial.attitude) / np.linalg.norm(initial.attitude)
         pb.resetBasePositionAndOrientation(
             self.body, position.tolist(), attitude.tolist(), physicsClientId=client
@@ -61,12 +65,25 @@ class FreeFlyerBody:
         """No joints: nothing to apply."""
 
     def set_base_mass(self, mass: float) -> None:
-        """Set the sphere's mass, kg (PyBullet scales its inertia with it)."""
-        pb.changeDynamics(self.body, -1, mass=mass, physicsClientId=self._client)
+        """Set the body's mass, kg, and scale its inertia with it: ``robot.inertia`` is the
+        inertia at the initial mass ``robot.mass`` (without it PyBullet gives the sphere's,
+        2/5 m r²)."""
+        if self.robot.inertia is None:
+            pb.changeDynamics(self.body, -1, mass=mass, physicsClientId=self._client)
+            return
+        # PyBullet recomputes the collision sphere's inertia when only the mass changes
+        moments = np.array(self.robot.inertia) * (mass / self.robot.mass)
+        pb.changeDynamics(
+            self.body,
+            -1,
+            mass=mass,
+            localInertiaDiagonal=moments.tolist(),
+            physicsClientId=self._client,
+        )
 
     def spec(self, assembly_mass: float, base_mass: float, protrusion: float) -> RobotSpec:
-        """Mass with cargo, the sphere's inertia as PyBullet holds it, limits, and the
-        bounding radius grown by the cargo's protrusion."""
+        """Mass with cargo, the base's inertia as PyBullet holds it (body frame), limits,
+        and the bounding radius grown by the cargo's protrusion."""
         inertia = pb.getDynamicsInfo(self.body, -1, physicsClientId=self._client)[2]
         return RobotSpec(
             **base_spec_fields(self.robot, assembly_mass, np.diag(inertia), protrusion)

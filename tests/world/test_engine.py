@@ -264,3 +264,40 @@ def test_the_world_is_a_system_with_named_inputs_outputs_and_parameters():
     world.inputs = WorldInputs(disturbance_force=np.array([0.0, 0.0, 2.0]))
     world.step()
     assert world.outputs()["velocity"][2] > 0 and world.outputs()["fuel_used"] == 0.0
+
+
+FLYER = """\
+    world: {frame: geocentric, physics_step: 0.01, control_period: 0.1}
+    robot: {mass: 100, propellant_mass: 10, max_force: 10, max_torque: 1, specific_impulse: 20,
+            inertia: [2, 3, 4]}
+    """
+
+
+def spin_up(world: World, torque: np.ndarray, periods: int = 5) -> np.ndarray:
+    """Angular velocity gained from rest under ``torque`` (world frame) over ``periods``."""
+    before = world.base_state()[3].copy()
+    for _ in range(periods):
+        world.step(WorldInputs(torque=torque))
+    return world.base_state()[3] - before
+
+
+@pytest.mark.parametrize("axis", [0, 1, 2])
+def test_a_free_flyer_spins_up_at_its_given_inertia(axis):
+    world = world_from(FLYER)
+    torque = 0.5 * np.eye(3)[axis]
+    # About a principal axis the rate grows linearly: ω = τ t / I (the sphere's I is 40).
+    np.testing.assert_allclose(spin_up(world, torque), torque * 0.5 / [2, 3, 4], rtol=1e-9)
+    np.testing.assert_allclose(world.robot_spec().inertia, np.diag([2.0, 3.0, 4.0]), rtol=1e-12)
+
+
+def test_a_free_flyer_inertia_scales_with_its_mass_as_propellant_burns():
+    world = world_from(FLYER)
+    for _ in range(100):
+        world.step(WorldInputs(force=np.array([10.0, 0.0, 0.0])))
+    mass = world.base_mass()
+    assert mass < 99.6  # half a kilogram burnt
+    moments = np.array([2.0, 3.0, 4.0]) * mass / 100.0
+    np.testing.assert_allclose(world.robot_spec().inertia, np.diag(moments), rtol=1e-12)
+    torque = np.array([0.0, 0.0, 0.5])
+    np.testing.assert_allclose(spin_up(world, torque), torque * 0.5 / moments, rtol=1e-9)
+
