@@ -8,6 +8,7 @@ physics convention of the source thesis: polar angle from +z, azimuth from +x to
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -227,3 +228,30 @@ def slerp(q0: ArrayLike, q1: ArrayLike, fraction: ArrayLike) -> Vector:
     w1 = np.where(near, s, np.sin(s * theta) / safe)
     q = w0 * q0 + w1 * q1
     return q / np.linalg.norm(q, axis=-1, keepdims=True)
+
+
+def combined_inertia(
+    parts: Sequence[tuple[float, ArrayLike, ArrayLike]],
+) -> tuple[Vector, np.ndarray]:
+    """Centre of mass and inertia of rigidly joined bodies (the parallel-axis theorem).
+
+    Parameters
+    ----------
+    parts : sequence of (float, array_like (3,), array_like (3, 3))
+        Each body's mass (kg), centre of mass (m) and inertia about it (kg·m²), all in
+        one frame.
+
+    Returns
+    -------
+    centre : ndarray (3,)
+        The whole's centre of mass, m, same frame.
+    inertia : ndarray (3, 3)
+        The whole's inertia about ``centre``, kg·m², same frame's axes.
+    """
+    masses = np.array([m for m, _, _ in parts], dtype=float)
+    centres = np.array([c for _, c, _ in parts], dtype=float)
+    centre = masses @ centres / masses.sum()
+    inertia = np.array([i for _, _, i in parts], dtype=float).sum(axis=0)
+    for mass, offset in zip(masses, centres - centre, strict=True):
+        inertia += mass * (offset @ offset * np.eye(3) - np.outer(offset, offset))
+    return centre, inertia

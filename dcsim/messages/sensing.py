@@ -64,6 +64,18 @@ class Shape(Message):
             return float(np.hypot(self.radius, 0.5 * self.height))
         return float(self.radius)
 
+    def moments_of_inertia(self, mass: float) -> np.ndarray:
+        """Principal moments (3,) of a uniform solid of this shape and ``mass`` (kg) about
+        its centre, along its body axes, kg·m² (a cylinder's axis is z)."""
+        if self.kind is ShapeKind.BOX:
+            squares = (2.0 * np.asarray(self.half_extents, dtype=float)) ** 2
+            return mass / 12.0 * (squares.sum() - squares)
+        if self.kind is ShapeKind.CYLINDER:
+            r2 = self.radius**2
+            across = mass * (3.0 * r2 + self.height**2) / 12.0
+            return np.array([across, across, 0.5 * mass * r2])
+        return np.full(3, 0.4 * mass * self.radius**2)
+
 
 @message
 class ObjectTrack(Message):

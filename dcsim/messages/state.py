@@ -211,7 +211,9 @@ class RobotSpec(Message):
     mass : float
         Current mass of the base and anything it carries, kg.
     inertia : ndarray (3, 3)
-        Inertia tensor of the base about its centre of mass, body frame, kg·m².
+        Inertia tensor about the centre of mass of the base and any cargo it holds
+        (each object a uniform solid of its shape), body axes, kg·m²; a manipulator's
+        arm is in ``model``.
     radius : float
         Radius of a sphere about the base's centre that holds it and any cargo, m.
     max_force : float

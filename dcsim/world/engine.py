@@ -35,7 +35,7 @@ from typing import Any
 
 import numpy as np
 
-from dcsim.geometry import clip_norm, length, row_lengths
+from dcsim.geometry import clip_norm, combined_inertia, length, row_lengths
 from dcsim.messages import (
     BeaconRange,
     MotionInput,
@@ -295,10 +295,18 @@ class World:
         """The robot's current mass (cargo included), inertia, limits and bounding radius
         (grown by the cargo's protrusion); a manipulator's joint limits and model.
 
-        The inertia is the base's own, as PyBullet holds it, about its centre of mass in
-        the body frame.
+        The inertia is about the centre of mass of the base and its cargo, along the body
+        axes: the base's own as PyBullet holds it, plus each object held as a uniform
+        solid of its shape, by the parallel-axis theorem.
         """
-        return self._robot.spec(self.assembly_mass(), self.base_mass(), self.cargo_protrusion())
+        spec = self._robot.spec(self.assembly_mass(), self.base_mass(), self.cargo_protrusion())
+        if not self._payload.held:
+            return spec
+        position, _, attitude, _ = self.base_state()
+        rotation = np.reshape(pb.getMatrixFromQuaternion(attitude.tolist()), (3, 3))
+        base = (self.base_mass(), position, rotation @ spec.inertia @ rotation.T)
+        _, inertia = combined_inertia([base, *self._payload.parts()])
+        return dataclasses.replace(spec, inertia=rotation.T @ inertia @ rotation)
 
     def carried_ids(self) -> list[int]:
         """Ids of the targets on board."""

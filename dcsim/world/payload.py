@@ -75,6 +75,19 @@ class Payload:
             spheres.append((np.array(p), self._field.objects[index].radius))
         return spheres
 
+    def parts(self) -> list[tuple[float, np.ndarray, np.ndarray]]:
+        """Every object held as a uniform solid of its shape: mass (kg), centre (3,) and
+        inertia (3, 3) about that centre, world frame, m and kg·m²."""
+        parts = []
+        for index, (body, _) in self.held.items():
+            obj = self._field.objects[index]
+            p, q = pb.getBasePositionAndOrientation(body, physicsClientId=self._client)
+            # the body's attitude is its shape's (bodies.create_body)
+            rotation = np.reshape(pb.getMatrixFromQuaternion(q), (3, 3))
+            inertia = rotation @ np.diag(obj.shape.moments_of_inertia(obj.mass)) @ rotation.T
+            parts.append((obj.mass, np.array(p), inertia))
+        return parts
+
     def remove_all(self) -> tuple[int, ...]:
         """Take every object held out of the world (its status becomes removed).
 

@@ -6,6 +6,7 @@ import textwrap
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from dcsim.api import (
     ClohessyWiltshireMotion,
@@ -301,3 +302,38 @@ def test_a_free_flyer_inertia_scales_with_its_mass_as_propellant_burns():
     torque = np.array([0.0, 0.0, 0.5])
     np.testing.assert_allclose(spin_up(world, torque), torque * 0.5 / moments, rtol=1e-9)
 
+
+def test_the_spec_inertia_is_the_assembly_s_about_its_centre_of_mass():
+    world = world_from("""\
+        world: {frame: lvlh, physics_step: 0.01, control_period: 0.1}
+        robot: {mass: 100, propellant_mass: 10, radius: 0.5, grab_distance: 2, capacity: 1,
+                inertia: [2, 3, 4], initial: {attitude: [0.1, 0.2, 0.3, 0.9]}}
+        mission:
+          targets:
+            - id: 1
+              mass: 5
+              shape: {type: box, half_extents: [0.2, 0.3, 0.4], orientation: [0.3, -0.1, 0.2, 0.9]}
+              motion: {type: static, position: [0.4, 1.1, -0.3]}
+        """)
+    assert grab_target(world, 1).success
+    base_position, _, base_attitude, _ = world.base_state()
+    cargo_position = world.object_states()[0][0]
+    base_rotation = Rotation.from_quat(base_attitude).as_matrix()
+    box_rotation = Rotation.from_quat([0.3, -0.1, 0.2, 0.9]).as_matrix()
+    sides = np.array([0.4, 0.6, 0.8]) ** 2
+    box = 5.0 / 12.0 * np.diag([sides[1] + sides[2], sides[0] + sides[2], sides[0] + sides[1]])
+    base_mass = world.base_mass()
+    centre = (base_mass * base_position + 5.0 * cargo_position) / (base_mass + 5.0)
+
+    def shifted(mass: float, offset: np.ndarray) -> np.ndarray:
+        return mass * (offset @ offset * np.eye(3) - np.outer(offset, offset))
+
+    expected = (
+        base_rotation @ np.diag([2.0, 3.0, 4.0]) @ base_rotation.T
+        + shifted(base_mass, base_position - centre)
+        + box_rotation @ box @ box_rotation.T
+        + shifted(5.0, cargo_position - centre)
+    )
+    expected = base_rotation.T @ expected @ base_rotation
+    np.testing.assert_allclose(world.robot_spec().inertia, expected, rtol=1e-9, atol=0)
+    assert world.robot_spec().mass == pytest.approx(base_mass + 5.0)

@@ -7,10 +7,12 @@ import textwrap
 import numpy as np
 import pytest
 
-from dcsim.api import ShapeKind
+from dcsim.api import Shape, ShapeKind
 from dcsim.missions.debris.services import grab
 from dcsim.scenario import ScenarioDocument, validate
 from dcsim.world import World, WorldInputs
+from dcsim.world.bodies import create_body
+from dcsim.world.pybullet_client import pb
 
 SQRT_HALF = 0.5**0.5
 CURVED = 1e-6  # m: PyBullet's closest points on a cylinder's curved side
@@ -182,3 +184,24 @@ def test_nearest_gap_among_shapes_is_not_the_nearest_bounding_sphere():
     )
     # Bounding gaps: box -2.0 m, cylinder 0.79 m, sphere 2.0 m; true gaps 1.8, 1.0 and 2.0 m.
     assert world.nearest_obstacle_distance() == pytest.approx(1.0, abs=CURVED)
+
+
+@pytest.mark.parametrize(
+    ("shape", "moments"),
+    [
+        (Shape(ShapeKind.SPHERE, radius=0.7), [0.588, 0.588, 0.588]),  # 2/5 m r²
+        (Shape(ShapeKind.BOX, half_extents=[0.2, 0.3, 0.5]), [0.34, 0.29, 0.13]),  # m/12 (b² + c²)
+        # across m (3 r² + h²) / 12, about the axis m r² / 2
+        (Shape(ShapeKind.CYLINDER, radius=0.4, height=1.5), [0.6825, 0.6825, 0.24]),
+    ],
+    ids=lambda v: getattr(v, "kind", ""),
+)
+def test_a_shape_s_uniform_solid_inertia_is_pybullet_s(shape, moments):
+    client = pb.connect(pb.DIRECT)
+    try:
+        body = create_body(client, shape, 3.0, np.zeros(3), False)
+        held = pb.getDynamicsInfo(body, -1, physicsClientId=client)[2]
+    finally:
+        pb.disconnect(client)
+    np.testing.assert_allclose(shape.moments_of_inertia(3.0), moments, rtol=1e-12)
+    np.testing.assert_allclose(held, moments, rtol=1e-12)
