@@ -46,11 +46,17 @@ from dcsim.run.recording import (
     RecordingError,
     telemetry_columns,
     telemetry_units,
+    wheel_columns,
 )
 from dcsim.run.seeding import component_rng
 from dcsim.run.setup import RunSetup
 from dcsim.scenario import dump_scenario
-from dcsim.scenario.model import point_to_cartesian
+from dcsim.scenario.model import (
+    ManipulatorSection,
+    ReactionWheelsSpec,
+    RobotSection,
+    point_to_cartesian,
+)
 from dcsim.world import World, WorldInputs
 from dcsim.world.orbit.validity import cw_error_estimate
 
@@ -175,8 +181,10 @@ class Runner:
         self.scenario = setup.scenario
         self.plugins = setup.plugins
         self.mission_class = mission_class(self.scenario.mission.type)
-        columns = telemetry_columns(self.mission_class.telemetry_columns(self.scenario))
-        units = telemetry_units(self.mission_class.telemetry_units(self.scenario))
+        self._wheel_columns = wheel_columns(_wheel_count(self.scenario.robot))
+        wheels = len(self._wheel_columns)
+        columns = telemetry_columns(self.mission_class.telemetry_columns(self.scenario), wheels)
+        units = telemetry_units(self.mission_class.telemetry_units(self.scenario), wheels)
         self.recorder = Recorder(out_dir, columns, keep_rows, units)
         self.info = RunInfo(self.scenario, self.scenario.world.seed, out_dir)
         self.progress = progress
@@ -472,8 +480,17 @@ class Runner:
             disturbance_torque=disturbance_torque,
             joint_torques=self._command.joint_torques,
         )
-        collisions = self._opened_world.step(inputs)
+        world = self._opened_world
+        saturated = len(world.wheel_saturations)
+        collisions = world.step(inputs)
         self.laps.lap("world")
+        for saturation in world.wheel_saturations[saturated:]:
+            self._event(
+                "wheel_saturated",
+                at=saturation.time,
+                wheel=saturation.wheel,
+                momentum=saturation.momentum,
+            )
         for collision in collisions:
             self._event(
                 "collision",
@@ -536,6 +553,9 @@ class Runner:
         row.update(zip(("fx", "fy", "fz"), command.force.tolist(), strict=True))
         row.update(zip(("wx", "wy", "wz"), out["angular_velocity"].tolist(), strict=True))
         row.update(zip(SIGMA_COLUMNS, _position_sigmas(estimate.covariance), strict=True))
+        if self._wheel_columns:
+            momenta = out["wheel_momentum"].tolist()
+            row.update(zip(self._wheel_columns, momenta, strict=True))
         self._accumulate(out, estimate)
         self.recorder.row(row)
         if self._step_observed:
@@ -585,6 +605,12 @@ class Runner:
             "seed": self.scenario.world.seed,
         }
 
+    def _wheel_summary(self) -> dict[str, Any]:
+        """The reaction wheels' largest momentum as a fraction of their limit (each its
+        own), over the whole run; nothing without wheels."""
+        wheels = self._opened_world.wheels
+        return {} if wheels is None else {"peak_wheel_momentum_fraction": wheels.peak_fraction}
+
     def _summary(self, wall: float) -> dict[str, Any]:
         world, mission = self._opened_world, self._opened_mission
         assert self.status is not None  # close() ends the run before it sums it up
@@ -607,10 +633,18 @@ class Runner:
             "delta_v_mps": world.delta_v,
             "localisation_rmse_m": rmse,
             "min_obstacle_distance_m": self._min_gap if self.recorder.count else None,
+            **self._wheel_summary(),
             "plugins": self.setup.plugin_versions(),
             "localiser": self._localiser_note(),
             "wall_time_by_phase_s": dict(sorted(self.laps.totals.items())),
         }
+
+
+def _wheel_count(robot: RobotSection | ManipulatorSection) -> int:
+    """How many reaction wheels the robot has (0 for ideal torque)."""
+    if isinstance(robot, RobotSection) and isinstance(robot.actuators, ReactionWheelsSpec):
+        return len(robot.actuators.wheels)
+    return 0
 
 
 def _position_sigmas(covariance: np.ndarray) -> list[float]:

@@ -79,7 +79,14 @@ class RecordingError(DcsimError):
     """The run directory could not be written (disk full, permissions, a vanished folder)."""
 
 
-def telemetry_columns(mission_columns: Sequence[str]) -> tuple[str, ...]:
+def wheel_columns(wheels: int) -> tuple[str, ...]:
+    """The telemetry columns of ``wheels`` reaction wheels' momenta: ``wheel_h_1``, ...
+    (N·m·s, about each wheel's spin axis, numbered in the order of
+    ``robot.actuators.wheels``)."""
+    return tuple(f"wheel_h_{i}" for i in range(1, wheels + 1))
+
+
+def telemetry_columns(mission_columns: Sequence[str], wheels: int = 0) -> tuple[str, ...]:
     """Columns of ``telemetry.csv`` for a mission with its own ``mission_columns``.
 
     Every run records time (s); true and estimated position (m) and velocity (m/s);
@@ -88,14 +95,16 @@ def telemetry_columns(mission_columns: Sequence[str]) -> tuple[str, ...]:
     propellant used (kg), delta-v (m/s), the surface gap to the nearest obstacle (m),
     the commanded thrust (N), the true angular velocity (world frame, rad/s) and the
     standard deviations of the estimated position (:data:`SIGMA_COLUMNS`, m; 0 when
-    the mission flies on the true state).
+    the mission flies on the true state); last, with ``wheels`` reaction wheels, each
+    wheel's momentum (:func:`wheel_columns`, N·m·s).
     """
-    return (*_LEADING_COLUMNS, *mission_columns, *_TRAILING_COLUMNS)
+    return (*_LEADING_COLUMNS, *mission_columns, *_TRAILING_COLUMNS, *wheel_columns(wheels))
 
 
-def telemetry_units(mission_units: Mapping[str, str]) -> dict[str, str]:
-    """Unit suffix of each telemetry column: :data:`COLUMN_UNITS` and the mission's own."""
-    return {**COLUMN_UNITS, **mission_units}
+def telemetry_units(mission_units: Mapping[str, str], wheels: int = 0) -> dict[str, str]:
+    """Unit suffix of each telemetry column: :data:`COLUMN_UNITS`, the mission's own and
+    those of ``wheels`` reaction wheels' momenta."""
+    return {**COLUMN_UNITS, **mission_units, **dict.fromkeys(wheel_columns(wheels), "Nms")}
 
 
 def header_name(column: str, unit: str = "") -> str:

@@ -37,6 +37,7 @@ from dcsim.scenario.model import (
     MEAN_MOTION_RANGE,
     MissionSettings,
     OrbitSpec,
+    ReactionWheelsSpec,
     Scenario,
     scenario_model,
 )
@@ -408,6 +409,23 @@ def _propellant_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
     return [(("robot", "propellant_mass"), message)]
 
 
+def _wheel_torque_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
+    """With reaction wheels, a ``robot.max_torque`` given must be theirs."""
+    if get("robot", "type") != "free-flyer" or not get.given("robot", "max_torque"):
+        return []
+    wheels = get("robot", "actuators")
+    if not isinstance(wheels, ReactionWheelsSpec):
+        return []
+    given, limit = get("robot", "max_torque"), wheels.torque_limit()
+    if math.isclose(given, limit, rel_tol=1e-9):
+        return []
+    message = (
+        f"{given:g} N*m disagrees with the reaction wheels' torque limit ({limit:.6g} N*m, the "
+        "largest delivered in every direction); leave max_torque out when giving wheels"
+    )
+    return [(("robot", "max_torque"), message)]
+
+
 def _joint_count_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
     """A manipulator's initial joint angles and rates: one per link."""
     if get("robot", "type") != "manipulator":
@@ -483,6 +501,7 @@ _RULES: list[Rule] = [
     _duration_rule,
     _orbit_rule,
     _propellant_rule,
+    _wheel_torque_rule,
     _joint_count_rule,
     _attitude_rule,
     _object_rules,

@@ -374,6 +374,101 @@ def _no_tensor(value: Any) -> Any:
     return value
 
 
+class IdealActuatorsSpec(Section):
+    """Ideal attitude actuators: the commanded torque, clipped to `robot.max_torque`."""
+
+    type: Literal["ideal"] = Field(
+        "ideal",
+        description="`ideal`: the base receives the commanded torque (world frame), its "
+        "magnitude clipped to `robot.max_torque`.",
+    )
+
+
+def _nonzero_axis(axis: Vec3) -> Vec3:
+    if sum(a * a for a in axis) < 1e-12:
+        raise ValueError("the axis must not be zero")
+    return axis
+
+
+class WheelSpec(Section):
+    """One reaction wheel: its spin axis in the body frame and its limits."""
+
+    axis: Annotated[Vec3, AfterValidator(_nonzero_axis)] = quantity(
+        description="Spin axis [x, y, z] in the body frame (normalised; not zero)."
+    )
+    inertia: float = quantity(
+        unit="kg*m^2", gt=0, description="The wheel's moment of inertia about its spin axis."
+    )
+    max_torque: float = quantity(unit="N*m", gt=0, description="Largest wheel torque magnitude.")
+    max_momentum: float = quantity(
+        unit="N*m*s",
+        gt=0,
+        description="Largest angular momentum magnitude about the spin axis; a wheel there "
+        "gives no more torque in that direction (saturated).",
+    )
+
+
+def _spanning(wheels: list[WheelSpec]) -> list[WheelSpec]:
+    axes = wheel_axes(wheels)
+    singular = np.linalg.svd(axes, compute_uv=False)
+    if singular[-1] < 1e-6 * singular[0]:
+        raise ValueError("the wheels' axes must span three dimensions (no common plane)")
+    return wheels
+
+
+def wheel_axes(wheels: list[WheelSpec]) -> Vector:
+    """The wheels' unit spin axes as the columns of a (3, N) matrix, body frame."""
+    axes = np.array([wheel.axis for wheel in wheels], dtype=float).T
+    return axes / np.linalg.norm(axes, axis=0)
+
+
+class ReactionWheelsSpec(Section):
+    """Reaction wheels: the base's torque is the reaction of three or more wheels.
+
+    The commanded torque is turned into body axes and shared among the wheels by the
+    minimum-norm solution; each wheel's torque is clipped to its `max_torque` and
+    to what keeps its momentum within `max_momentum` (docs/architecture.md, World).
+    """
+
+    type: Literal["reaction_wheels"] = Field(
+        description="`reaction_wheels`: three or more wheels whose axes span 3-D."
+    )
+    wheels: Annotated[list[WheelSpec], Field(min_length=3), AfterValidator(_spanning)] = Field(
+        description="The wheels, at least three, their axes spanning three dimensions."
+    )
+
+    def torque_limit(self) -> float:
+        """The largest torque magnitude, N·m, delivered exactly in every direction.
+
+        The minimum-norm allocation gives wheel ``i`` the torque ``(A⁺ t)_i`` for a body
+        torque ``t``; it stays within ``max_torque_i`` for every direction of ``t`` while
+        ``|t| ≤ max_torque_i / |row i of A⁺|``. The smallest of these bounds the weakest axis.
+        """
+        rows = np.linalg.norm(np.linalg.pinv(wheel_axes(self.wheels)), axis=1)
+        limits = np.array([wheel.max_torque for wheel in self.wheels]) / rows
+        return float(limits.min())
+
+
+def _actuator_type(data: Any) -> str | None:
+    """The tag of an actuator section: its ``type`` (``ideal`` when absent)."""
+    if isinstance(data, dict):
+        value = data.get("type", "ideal")
+        return value if isinstance(value, str) else None
+    return getattr(data, "type", "ideal")
+
+
+ActuatorsSpec = Annotated[
+    Annotated[IdealActuatorsSpec, Tag("ideal")]
+    | Annotated[ReactionWheelsSpec, Tag("reaction_wheels")],
+    Discriminator(
+        _actuator_type,
+        custom_error_type="actuator_type",
+        custom_error_message="robot.actuators.type must be `ideal` or `reaction_wheels`",
+    ),
+]
+"""The free flyer's attitude actuators, chosen by their ``type`` (``ideal`` when absent)."""
+
+
 class RobotSection(RobotBaseSection):
     """The robot: a free flyer (the debris collector) with mass, limits, sensors, grabber."""
 
@@ -398,9 +493,26 @@ class RobotSection(RobotBaseSection):
         "would). A full 3x3 tensor is refused: turn the body axes to the principal axes. "
         "null: a uniform sphere's of `radius`, 2/5 m r^2.",
     )
+    actuators: ActuatorsSpec = Field(
+        default_factory=IdealActuatorsSpec,
+        description="Attitude actuators: `{type: ideal}` (the default) or `{type: "
+        "reaction_wheels, wheels: [...]}`. With wheels, `max_torque` is theirs: the largest "
+        "torque delivered exactly in every direction (filled in when left out; given, it "
+        "must agree). Thrust stays ideal.",
+    )
     initial: InitialStateSpec = Field(
         default_factory=InitialStateSpec, description="State at t = 0."
     )
+
+    @model_validator(mode="wrap")
+    @classmethod
+    def _wheel_torque(cls, data: Any, handler: ModelWrapValidatorHandler[Any]) -> Any:
+        """Fill in ``max_torque`` from the reaction wheels when it is not given."""
+        robot = handler(data)
+        wheels = robot.actuators
+        if isinstance(wheels, ReactionWheelsSpec) and "max_torque" not in robot.model_fields_set:
+            return robot.model_copy(update={"max_torque": wheels.torque_limit()})
+        return robot
 
 
 def _ordered(limits: tuple[float, float]) -> tuple[float, float]:

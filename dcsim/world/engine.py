@@ -14,9 +14,10 @@ composes its pieces:
 - :mod:`~dcsim.world.objects`: the targets and obstacles and their motion.
 
 - **Robot**: its base is driven by thrust (clipped to ``max_force`` and to the
-  propellant left) and torque (clipped to ``max_torque``, from reaction wheels: no
-  propellant); a manipulator's joints by joint torques. The base's mass is updated
-  once per control period.
+  propellant left) and torque (no propellant): ideal, clipped to ``max_torque``, or
+  the reaction of the free flyer's reaction wheels (:mod:`~dcsim.world.wheels`); a
+  manipulator's joints by joint torques. The base's mass is updated once per control
+  period.
 - **Objects**: targets and obstacles, spheres, boxes or cylinders of fixed orientation,
   follow their motion models exactly while free.
 - **Collisions**: every physics step, the robot and what it carries against every
@@ -44,7 +45,7 @@ from dcsim.messages import (
     RobotSpec,
     RobotState,
 )
-from dcsim.scenario.model import ManipulatorSection, RobotSection, Scenario
+from dcsim.scenario.model import ManipulatorSection, ReactionWheelsSpec, RobotSection, Scenario
 from dcsim.world.bodies import ObjectBodies, surface_gap
 from dcsim.world.environment import (
     Propellant,
@@ -61,6 +62,7 @@ from dcsim.world.payload import Payload
 from dcsim.world.pybullet_client import connect_direct, pb
 from dcsim.world.robot_body import RobotBody
 from dcsim.world.sensors import Sensors
+from dcsim.world.wheels import ReactionWheels
 
 _BROAD_PHASE_SLACK = 1e-3  # m added to the swept reach of each control period
 
@@ -120,6 +122,32 @@ class CollisionEvent:
     penetration: float
 
 
+@dataclass(frozen=True)
+class WheelSaturation:
+    """A reaction wheel reaching its momentum limit (once per episode at the limit).
+
+    Attributes
+    ----------
+    time : float
+        s.
+    wheel : int
+        The wheel's number, from 1 in the order of ``robot.actuators.wheels``.
+    momentum : float
+        Its angular momentum about its spin axis, N·m·s (``±max_momentum``).
+    """
+
+    time: float
+    wheel: int
+    momentum: float
+
+
+def _build_wheels(robot: RobotSection | ManipulatorSection) -> ReactionWheels | None:
+    """The free flyer's reaction wheels, or None for ideal torque."""
+    if isinstance(robot, RobotSection) and isinstance(robot.actuators, ReactionWheelsSpec):
+        return ReactionWheels(robot.actuators)
+    return None
+
+
 class World:
     """A steppable PyBullet world built from a scenario.
 
@@ -147,6 +175,10 @@ class World:
         Every collision so far.
     robot_id : int
         The robot's PyBullet body id (its base is link -1).
+    wheels : ReactionWheels or None
+        The free flyer's reaction wheels (``robot.actuators``); None for ideal torque.
+    wheel_saturations : list of WheelSaturation
+        Every wheel saturation so far.
     """
 
     def __init__(self, scenario: Scenario, rng: np.random.Generator) -> None:
@@ -176,6 +208,8 @@ class World:
         ) = None
         pb.setTimeStep(self.physics_step, physicsClientId=self._client)
         self._robot = _build_robot_body(self._client, robot)
+        self.wheels = _build_wheels(robot)
+        self.wheel_saturations: list[WheelSaturation] = []
         self._links_mass = sum(mass for _, mass in self._robot.links)
         self.robot_id = self._robot.body
         self._joint_torques = np.zeros(0)
@@ -426,6 +460,18 @@ class World:
             "delivered": self.field.count(ObjectStatus.REMOVED),
             "collisions": len(self.collisions),
             "nearest_obstacle_distance": self.nearest_obstacle_distance(),
+            **self._wheel_outputs(),
+        }
+
+    def _wheel_outputs(self) -> dict[str, Any]:
+        """The reaction wheels' momenta (N·m·s), spin rates (rad/s) and the torque they
+        gave the base over the last physics step (body frame, N·m); none without wheels."""
+        if self.wheels is None:
+            return {}
+        return {
+            "wheel_momentum": self.wheels.momentum.copy(),
+            "wheel_speed": self.wheels.speeds,
+            "wheel_torque": self.wheels.delivered(),
         }
 
     # ------------------------------------------------------------------ stepping
@@ -440,7 +486,7 @@ class World:
         if inputs is not None:
             self.inputs = inputs
         force = clip_norm(self.inputs.force, self.robot.max_force)
-        torque = clip_norm(self.inputs.torque, self.robot.max_torque)
+        torque = self._ideal_torque()
         self._period_mass = self.assembly_mass()
         self._joint_torques = self._robot.clip_joint_torques(self.inputs.joint_torques)
         if self._exact_forces is not None:
@@ -455,6 +501,17 @@ class World:
         self._set_body_mass(self.base_mass())
         self.collisions += started
         return started
+
+    def _ideal_torque(self) -> np.ndarray:
+        """The commanded torque clipped to ``max_torque``, world frame, N·m; with reaction
+        wheels, zero: the wheels take the command (in body axes) and the base gets their
+        reaction step by step."""
+        if self.wheels is None:
+            return clip_norm(self.inputs.torque, self.robot.max_torque)
+        attitude = self.base_state()[2]
+        rotation = np.reshape(pb.getMatrixFromQuaternion(attitude.tolist()), (3, 3))
+        self.wheels.command(rotation.T @ np.asarray(self.inputs.torque, dtype=float))
+        return np.zeros(3)
 
     def _linearise_orbital_forces(self) -> None:
         """Expand the exact orbital acceleration of every body of the robot (base, cargo,
@@ -509,13 +566,39 @@ class World:
                     exact.apply_to_parts(k * dt)
             robot.apply_joint_torques(self._joint_torques)
             apply_force(body, -1, (fx, fy, fz), position, pb.WORLD_FRAME, client)
-            if apply_torque:
+            if self.wheels is not None:
+                self._apply_wheel_torque(torque)
+            elif apply_torque:
                 pb.applyExternalTorque(body, -1, torque, pb.WORLD_FRAME, client)
             step(client)
             self._steps += 1
+            if self.wheels is not None:
+                self._note_saturations()
             if check_contacts:
                 started += self._detect_collisions()
         return started
+
+    def _apply_wheel_torque(self, disturbance: tuple[float, ...]) -> None:
+        """Step the reaction wheels and put their reaction, with ``disturbance`` (world
+        frame, N·m), on the base for the coming physics step."""
+        assert self.wheels is not None
+        client, body = self._client, self.robot_id
+        attitude = pb.getBasePositionAndOrientation(body, client)[1]
+        rotation = np.reshape(pb.getMatrixFromQuaternion(attitude), (3, 3))
+        angular = np.array(pb.getBaseVelocity(body, client)[1])
+        moments = pb.getDynamicsInfo(body, -1, physicsClientId=client)[2]
+        inertia = (rotation * moments) @ rotation.T
+        external = np.array(disturbance)
+        reaction = self.wheels.step(rotation, angular, inertia, external, self.physics_step)
+        torque = (reaction + external).tolist()
+        pb.applyExternalTorque(body, -1, torque, pb.WORLD_FRAME, client)
+
+    def _note_saturations(self) -> None:
+        """Record the wheels that reached their momentum limit in the last physics step."""
+        assert self.wheels is not None
+        for index in self.wheels.newly_saturated():
+            momentum = float(self.wheels.momentum[index])
+            self.wheel_saturations.append(WheelSaturation(self.time, index + 1, momentum))
 
     def _update_broad_phase(self, force: np.ndarray) -> None:
         """Find the free objects that could touch the assembly in the coming period."""
