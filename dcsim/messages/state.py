@@ -219,7 +219,10 @@ class RobotSpec(Message):
     max_force : float
         Largest thrust magnitude, N.
     max_torque : float
-        Largest base torque magnitude, N·m.
+        Largest base torque magnitude, N·m. With reaction wheels
+        (``robot.actuators``), the largest delivered exactly in every direction: the
+        weakest direction of the wheels' minimum-norm allocation. Larger commands are
+        clipped wheel by wheel, and a wheel at its momentum limit gives less.
     max_speed : float
         Speed the robot must not exceed, m/s.
     max_angular_rate : float
