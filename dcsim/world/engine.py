@@ -83,7 +83,8 @@ class WorldInputs:
     force : ndarray (3,)
         Commanded thrust, world frame, N (clipped to the limits).
     torque : ndarray (3,)
-        Commanded torque, world frame, N·m (clipped to the limit).
+        Commanded torque, world frame, N·m (clipped to the limit; with reaction wheels,
+        turned into body axes at the period's start and shared among the wheels).
     disturbance_force : ndarray (3,)
         External force on the robot's base, N (not clipped, uses no propellant).
     disturbance_torque : ndarray (3,)
