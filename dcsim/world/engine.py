@@ -587,10 +587,9 @@ class World:
         attitude = pb.getBasePositionAndOrientation(body, client)[1]
         rotation = np.reshape(pb.getMatrixFromQuaternion(attitude), (3, 3))
         angular = np.array(pb.getBaseVelocity(body, client)[1])
-        moments = pb.getDynamicsInfo(body, -1, physicsClientId=client)[2]
-        inertia = (rotation * moments) @ rotation.T
+        moments = np.array(pb.getDynamicsInfo(body, -1, physicsClientId=client)[2])
         external = np.array(disturbance)
-        reaction = self.wheels.step(rotation, angular, inertia, external, self.physics_step)
+        reaction = self.wheels.step(rotation, angular, moments, external, self.physics_step)
         torque = (reaction + external).tolist()
         pb.applyExternalTorque(body, -1, torque, pb.WORLD_FRAME, client)
 
