@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import yaml
 
 from dcsim.errors import ScenarioError
 from dcsim.missions import mission_class
@@ -66,7 +67,7 @@ def test_wheels_fill_in_max_torque_and_survive_a_dump():
     rows = np.linalg.norm(np.linalg.pinv(wheel_axes(loaded.robot.actuators.wheels)), axis=1)
     assert loaded.robot.max_torque == pytest.approx(0.05 / rows.max(), rel=1e-12)
     assert loaded.robot.max_torque > 0.05  # four wheels give more than one alone
-    assert read_scenario(__import__("yaml").safe_load(dump_scenario(loaded))) == loaded
+    assert read_scenario(yaml.safe_load(dump_scenario(loaded))) == loaded
 
 
 @pytest.mark.parametrize(
@@ -174,24 +175,35 @@ def test_a_run_records_wheel_momenta_saturation_events_and_the_peak_fraction():
 
 
 # ------------------------------------------------------------------ conservation
-def test_base_plus_wheel_momentum_is_conserved_over_a_600_s_slew():
-    data = scenario()
+@pytest.mark.parametrize(
+    ("inertia", "bound"),
+    [
+        (None, 1e-9),  # the 100 kg sphere's 40 kg m^2 about every axis: 1.7e-13 measured
+        # unequal moments: PyBullet's explicit gyroscopic term drifts the base's own
+        # momentum, wheels or not (first order in the step); 1.9e-3 measured
+        ([8.0, 12.0, 15.0], 5e-3),
+    ],
+)
+def test_base_plus_wheel_momentum_is_conserved_over_a_600_s_slew(inertia, bound):
+    data = scenario(inertia=inertia)
     with World(read_scenario(data), np.random.default_rng(0)) as world:
-        inertia = world.robot_spec().inertia  # body axes, kg m^2 (the 100 kg sphere's)
-        axes = world.wheels.axes if world.wheels is not None else None
+        spec_inertia = world.robot_spec().inertia  # body axes, kg m^2
+        assert world.wheels is not None
+        axes = world.wheels.axes
     result = run(data)
     summary, telemetry = result.summary, result.telemetry
     assert summary["final_attitude_error_deg"] < 1e-6 and summary["fuel_used_kg"] == 0.0
-    assert 0.5 < summary["peak_wheel_momentum_fraction"] < 1.0  # a real slew, unsaturated
+    assert 0.2 < summary["peak_wheel_momentum_fraction"] < 1.0  # a real slew, unsaturated
     quaternions = telemetry[["qx", "qy", "qz", "qw"]].to_numpy()
     rates = telemetry[["wx_radps", "wy_radps", "wz_radps"]].to_numpy()
     momenta = telemetry[[f"wheel_h_{i}_Nms" for i in range(1, 5)]].to_numpy()
     rotations = np.array(
         [np.reshape(pb.getMatrixFromQuaternion(q.tolist()), (3, 3)) for q in quaternions]
     )
-    base = np.einsum("nij,jk,nlk,nl->ni", rotations, inertia, rotations, rates)
+    base = np.einsum("nij,jk,nlk,nl->ni", rotations, spec_inertia, rotations, rates)
     carried = np.einsum("nij,jk,nk->ni", rotations, axes, momenta)
     total = base + carried
-    assert np.linalg.norm(carried, axis=1).max() > 2.0  # the wheels took most of it
+    assert np.linalg.norm(carried, axis=1).max() > 2 * np.linalg.norm(total[0])  # wheels took it
     drift = np.linalg.norm(total - total[0], axis=1).max() / np.linalg.norm(total[0])
-    assert drift <= 1e-9
+    print(f"inertia {inertia}: relative drift of base plus wheel momentum {drift:.2g}")
+    assert drift <= bound
