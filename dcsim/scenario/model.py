@@ -397,7 +397,10 @@ class WheelSpec(Section):
         description="Spin axis [x, y, z] in the body frame (normalised; not zero)."
     )
     inertia: float = quantity(
-        unit="kg*m^2", gt=0, description="The wheel's moment of inertia about its spin axis."
+        unit="kg*m^2",
+        gt=0,
+        description="The wheel's moment of inertia about its spin axis; it gives the "
+        "wheel's spin rate (momentum / inertia). The base's `inertia` includes the wheels.",
     )
     max_torque: float = quantity(unit="N*m", gt=0, description="Largest wheel torque magnitude.")
     max_momentum: float = quantity(
