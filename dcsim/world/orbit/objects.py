@@ -189,20 +189,28 @@ class PropagatedMotion(MotionModel):
 
     @classmethod
     def stack(cls, models: Sequence[MotionModel]) -> Any:
-        """The propagations and each model's index in its own."""
-        return [(m.orbits, m.index) for m in models if isinstance(m, PropagatedMotion)]
+        """The models grouped by propagation: each propagation with the rows of its
+        models and their indices in it (arrays), and the number of models."""
+        groups: dict[int, tuple[ObjectOrbits, list[int], list[int]]] = {}
+        for row, model in enumerate(models):
+            assert isinstance(model, PropagatedMotion)
+            entry = groups.setdefault(id(model.orbits), (model.orbits, [], []))
+            entry[1].append(row)
+            entry[2].append(model.index)
+        stacked = [(o, np.array(rows), np.array(indices)) for o, rows, indices in groups.values()]
+        return stacked, len(models)
 
     @classmethod
     def stacked_state(cls, stacked: Any, t: float) -> tuple[Vector, Vector]:
-        """States (N, 3) at ``t`` (s) of models gathered by :meth:`stack`, one
+        """States (N, 3) at ``t`` (s) of models gathered by :meth:`stack`, each
         propagation evaluated once."""
-        groups: dict[int, tuple[ObjectOrbits, list[int], list[int]]] = {}
-        for row, (orbits, index) in enumerate(stacked):
-            groups.setdefault(id(orbits), (orbits, [], []))
-            groups[id(orbits)][1].append(row)
-            groups[id(orbits)][2].append(index)
-        positions, velocities = np.zeros((len(stacked), 3)), np.zeros((len(stacked), 3))
-        for orbits, rows, indices in groups.values():
+        groups, count = stacked
+        if len(groups) == 1 and len(groups[0][1]) == count:  # every model, one propagation
+            orbits, _, indices = groups[0]
+            positions, velocities = orbits.relative_states(t)
+            return positions[indices], velocities[indices]
+        positions, velocities = np.zeros((count, 3)), np.zeros((count, 3))
+        for orbits, rows, indices in groups:
             p, v = orbits.relative_states(t)
             positions[rows], velocities[rows] = p[indices], v[indices]
         return positions, velocities
