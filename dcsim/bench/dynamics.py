@@ -21,7 +21,6 @@ transfer's final distance to its goal, whether the goal was met, collisions.
 
 from __future__ import annotations
 
-import math
 import time
 import warnings
 from collections.abc import Callable, Sequence
@@ -230,13 +229,14 @@ def reference_positions(
 ) -> np.ndarray:
     """The robot's positions (m, LVLH) at ``times`` (s) by the inertial reference under
     the case's exact physics, from its start and ``velocity`` (m/s)."""
+    chief = orbit.chief_orbit()
     elements = reference.OrbitElements(
-        orbit.semi_major_axis,
-        orbit.eccentricity,
-        math.radians(orbit.inclination),
-        math.radians(orbit.raan),
-        math.radians(orbit.argument_of_perigee),
-        math.radians(orbit.true_anomaly),
+        chief.semi_major_axis,
+        chief.eccentricity,
+        chief.inclination,
+        chief.raan,
+        chief.argument_of_perigee,
+        chief.true_anomaly,
     )
     trajectory = reference.propagate_relative(
         elements,

@@ -264,6 +264,21 @@ class OrbitSpec(Section):
         """Mean motion of the orbit, rad/s."""
         return mean_motion(self.semi_major_axis, self.mu)
 
+    def chief_orbit(self) -> ChiefOrbit:
+        """The orbit as a :class:`~dcsim.messages.ChiefOrbit`: SI units, angles in rad."""
+        return ChiefOrbit(
+            OrbitModel(self.model),
+            self.semi_major_axis,
+            self.eccentricity,
+            math.radians(self.inclination),
+            math.radians(self.raan),
+            math.radians(self.argument_of_perigee),
+            math.radians(self.true_anomaly),
+            self.mu,
+            self.j2,
+            self.earth_radius,
+        )
+
 
 class WorldSpec(Section):
     """Frame, time steps and seed."""
@@ -934,27 +949,7 @@ class Scenario(Section):
         orbit = self.world.orbit
         if orbit.model == "cw":
             return FrameDynamics(FrameKind.CLOHESSY_WILTSHIRE, self.mean_motion)
-        inclination, raan, perigee, anomaly = (
-            math.radians(angle)
-            for angle in (
-                orbit.inclination,
-                orbit.raan,
-                orbit.argument_of_perigee,
-                orbit.true_anomaly,
-            )
-        )
-        chief = ChiefOrbit(
-            OrbitModel(orbit.model),
-            orbit.semi_major_axis,
-            orbit.eccentricity,
-            inclination,
-            raan,
-            perigee,
-            anomaly,
-            orbit.mu,
-            orbit.j2,
-            orbit.earth_radius,
-        )
+        chief = orbit.chief_orbit()
         return FrameDynamics(FrameKind.CLOHESSY_WILTSHIRE, self.mean_motion, chief)
 
 

@@ -522,7 +522,7 @@ class World:
         held = self._payload.held.items()
         parts = [(c, -1, self.field.objects[i].mass) for i, (c, _) in held]
         parts += [(self.robot_id, link, mass) for link, mass in self._robot.links]
-        self._exact_forces.begin_period(self.time, self.robot_id, (position, velocity), parts)
+        self._exact_forces.begin_period(self.time, (position, velocity), parts)
 
     def _set_body_mass(self, mass: float) -> None:
         """Give the robot's base ``mass``, kg (the orbital force on it uses it)."""

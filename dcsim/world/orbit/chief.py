@@ -36,14 +36,15 @@ def relative_dynamics(orbit: OrbitSpec) -> RelativeDynamics:
     """
     if orbit.model == "cw":
         raise ValueError("a cw orbit has no exact relative dynamics")
+    elements = orbit.chief_orbit()
     position, velocity = elements_to_state(
-        orbit.semi_major_axis,
-        orbit.eccentricity,
-        math.radians(orbit.inclination),
-        math.radians(orbit.raan),
-        math.radians(orbit.argument_of_perigee),
-        math.radians(orbit.true_anomaly),
-        orbit.mu,
+        elements.semi_major_axis,
+        elements.eccentricity,
+        elements.inclination,
+        elements.raan,
+        elements.argument_of_perigee,
+        elements.true_anomaly,
+        elements.mu,
     )
     if orbit.model == "two-body":
         return RelativeDynamics(KeplerOrbit(position, velocity, orbit.mu), point_mass(orbit.mu))

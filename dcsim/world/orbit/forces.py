@@ -74,9 +74,8 @@ class ExactOrbitalForces:
         PyBullet's semi-implicit Euler step, ``v ← v + a Δt`` then ``x ← x + v Δt``, is
         the leapfrog scheme with the velocity taken half a step late; started from
         ``v₀`` instead of ``v(−Δt/2)`` it carries a velocity error of ``a₀ Δt/2`` for
-        good, which a relative orbit turns into a position error growing with it (1.2 cm
-        after a tenth of an orbit at 1 km). Started staggered, positions are second-order
-        accurate.
+        good, which a relative orbit turns into a position error growing with it. Started
+        staggered, positions are second-order accurate.
         """
         position, velocity = self._state(body, -1)
         frame = self._frame(0)
@@ -91,7 +90,6 @@ class ExactOrbitalForces:
     def begin_period(
         self,
         t: float,
-        body: int,
         base_state: tuple[np.ndarray, np.ndarray],
         parts: Sequence[tuple[int, int, float]],
     ) -> None:
@@ -101,8 +99,6 @@ class ExactOrbitalForces:
         ----------
         t : float
             The period's start, s.
-        body : int
-            The robot's multibody id.
         base_state : (ndarray, ndarray)
             The base's position and velocity now, LVLH, m and m/s.
         parts : sequence of (int, int, float)
@@ -117,7 +113,6 @@ class ExactOrbitalForces:
         )
         self._base = fields[0]
         self._parts = [(b, link, m, f) for (b, link, m), f in zip(parts, fields[1:], strict=True)]
-        self._body = body
 
     def _state(self, body: int, link: int) -> tuple[tuple[float, ...], tuple[float, ...]]:
         """Position and velocity of a body's base (link -1) or a link's centre of mass."""
@@ -141,8 +136,7 @@ class ExactOrbitalForces:
 
         The last step's change is extrapolated by half a step:
         ``v(t) ≈ v_PyBullet + (v_PyBullet − v_previous)/2`` (second order). Without it
-        the Coriolis term would act on a velocity ``a Δt/2`` out (6.6 mm after a tenth
-        of an orbit at 1 km).
+        the Coriolis term would act on a velocity ``a Δt/2`` out, a first-order error.
         """
         u, v, w = self._previous.get(key, velocity)
         self._previous[key] = velocity

@@ -117,15 +117,13 @@ class ObjectOrbits:
 
     def _samples(self, k: np.ndarray, index: int) -> tuple[Vector, Vector]:
         """Object ``index``'s states at sample numbers ``k`` (any shape)."""
-        blocks = k // HERMITE_BLOCK
+        blocks, rows = np.divmod(k, HERMITE_BLOCK)
+        positions = np.empty((*k.shape, 3))
+        velocities = np.empty((*k.shape, 3))
         for block in np.unique(blocks).tolist():
             if block not in self._table:
                 times = (block * HERMITE_BLOCK + np.arange(HERMITE_BLOCK)) * HERMITE_STEP
                 self._table[block] = self._compute(times)
-        positions = np.empty((*k.shape, 3))
-        velocities = np.empty((*k.shape, 3))
-        rows = k % HERMITE_BLOCK
-        for block in np.unique(blocks).tolist():
             mask = blocks == block
             sampled_p, sampled_v = self._table[block]
             positions[mask] = sampled_p[rows[mask], index]

@@ -4,8 +4,8 @@ The neglected second-order terms of the relative gravity make a body at separati
 drift along track from where CW puts it by up to ``3 ρ² n t / a`` after time t (n the
 mean motion, a the orbit's radius). Against an inertial two-body propagation on a 400
 km orbit, after one orbit, bounded starts at 100 m, 1 km and 10 km along each LVLH axis
-are off by 0.014–0.028 m, 1.39–2.78 m and 139–278 m: the bound is the along-track
-case's error to 0.1 % (``dcsim bench dynamics``).
+are off by 0.014–0.028 m, 1.39–2.78 m and 138–278 m: the bound is the along-track
+case's error to 0.1 % (``dcsim bench dynamics --models cw``).
 """
 
 from __future__ import annotations
