@@ -5,10 +5,10 @@ telemetry (gzipped) and events of the first 130 s of ``dcsim run
 scenarios/default.yaml`` (a plan, a path, a grab, the controller's reset for the new
 mass), ``crowded_field-120s/`` those of the first 120 s of
 ``scenarios/crowded_field.yaml`` (the elastic controller dodges and brakes to within
-1.3 m of an obstacle). Their bytes are the ones this suite used to check by SHA-256
-(kept below): the default's events as recorded at commit c063456, its telemetry rows
-those of c063456 with ``wx wy wz est_sigma_x est_sigma_y est_sigma_z`` appended (and
-the header given its units); the crowded field's records as recorded at 8f80d82.
+1.3 m of an obstacle). Their bytes are pinned by SHA-256 (below): the default's as
+recorded when its targets and obstacles took ``bounded: true`` starts (the hand-rounded
+``-2 n x`` velocities before it differed from the drift-free ones by up to 4.7e-6 m/s),
+the crowded field's records as recorded at 8f80d82.
 
 Bytes are a property of one machine and library build, not of the code: numpy's
 OpenBLAS picks its kernels by CPU, and each kernel family rounds its sums in its own
@@ -199,13 +199,9 @@ def test_the_reference_is_the_recording_the_suite_hashed_before():
     default, crowded = reference("default"), reference("crowded_field")
     header, _, rows = read_bytes(default, "telemetry.csv").partition(b"\n")
     assert header.startswith(b"time_s,x_m,y_m,z_m,vx_mps,") and header.endswith(b",est_sigma_z_m")
-    assert sha256(rows) == "255db4a44caa31be595e91b9cdadf9d404a39cc1503ec0e94281116e181241d2"
-    recorded_at_c063456 = b"\n".join(b",".join(line.split(b",")[:27]) for line in rows.split(b"\n"))
-    assert sha256(recorded_at_c063456) == (
-        "97007c0936e73859b2cb32156f644d9aa9113313e732dad127ce4e3a2687beaf"
-    )
+    assert sha256(rows) == "7b1aa12b60c099bb89426b967ed2b9b9cf70cd8abf251eccb8d2ff81b86abde5"
     assert sha256(read_bytes(default, "events.jsonl")) == (
-        "002f4b6204e2c8c146bb05876a76b6856c584fdd38ef97a3c532f38b35ab8e14"
+        "79f290a2089ad32be7398df1b655411fde04b5e77933a10a3db4492312342909"
     )
     assert sha256(read_bytes(crowded, "telemetry.csv")) == (
         "93d069eb68b590ef7d4238134ecd4606909b4a704d1fcd577a8cad63daf2e959"
