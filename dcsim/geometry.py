@@ -255,3 +255,27 @@ def combined_inertia(
     for mass, offset in zip(masses, centres - centre, strict=True):
         inertia += mass * (offset @ offset * np.eye(3) - np.outer(offset, offset))
     return centre, inertia
+
+
+def attitude_error(
+    attitude: Sequence[float] | np.ndarray, reference: Sequence[float] | np.ndarray
+) -> float:
+    """Angle of the rotation from ``attitude`` to ``reference``, rad in ``[0, π]``.
+
+    The angle of ``reference ⊗ attitude⁻¹`` from its vector and scalar parts (with
+    ``atan2``, exact near zero), in scalar arithmetic: it is evaluated every tick.
+
+    Parameters
+    ----------
+    attitude, reference : sequence of float or ndarray (4,)
+        Unit quaternions ``[x, y, z, w]``.
+    """
+    x, y, z, w = (float(v) for v in attitude)
+    a, b, c, d = (float(v) for v in reference)
+    vector = (
+        w * a - d * x - (b * z - c * y),
+        w * b - d * y - (c * x - a * z),
+        w * c - d * z - (a * y - b * x),
+    )
+    scalar = d * w + a * x + b * y + c * z
+    return 2.0 * math.atan2(math.hypot(*vector), abs(scalar))

@@ -5,10 +5,11 @@ telemetry (gzipped) and events of the first 130 s of ``dcsim run
 scenarios/default.yaml`` (a plan, a path, a grab, the controller's reset for the new
 mass), ``crowded_field-120s/`` those of the first 120 s of
 ``scenarios/crowded_field.yaml`` (the elastic controller dodges and brakes to within
-1.3 m of an obstacle). Their bytes are pinned by SHA-256 (below): the default's as
-recorded when its targets and obstacles took ``bounded: true`` starts (the hand-rounded
-``-2 n x`` velocities before it differed from the drift-free ones by up to 4.7e-6 m/s),
-the crowded field's records as recorded at 8f80d82.
+1.3 m of an obstacle). Their bytes are pinned by SHA-256 (below), as recorded when the
+debris mission began to hold the collector's attitude (``mission.attitude: hold``) and
+every run to record ``attitude_error``; the events are those recorded before (the
+default's since its targets and obstacles took ``bounded: true`` starts, the crowded
+field's since 8f80d82).
 
 Bytes are a property of one machine and library build, not of the code: numpy's
 OpenBLAS picks its kernels by CPU, and each kernel family rounds its sums in its own
@@ -198,13 +199,15 @@ def flown(tmp_path_factory) -> dict[str, Path]:
 def test_the_reference_is_the_recording_the_suite_hashed_before():
     default, crowded = reference("default"), reference("crowded_field")
     header, _, rows = read_bytes(default, "telemetry.csv").partition(b"\n")
-    assert header.startswith(b"time_s,x_m,y_m,z_m,vx_mps,") and header.endswith(b",est_sigma_z_m")
-    assert sha256(rows) == "7b1aa12b60c099bb89426b967ed2b9b9cf70cd8abf251eccb8d2ff81b86abde5"
+    assert header.startswith(b"time_s,x_m,y_m,z_m,vx_mps,") and header.endswith(
+        b",est_sigma_z_m,attitude_error_rad"
+    )
+    assert sha256(rows) == "df27e1c373c0bdef73e95815c3f05f30a40f2635e5fc15206bc02ba606e2e356"
     assert sha256(read_bytes(default, "events.jsonl")) == (
         "79f290a2089ad32be7398df1b655411fde04b5e77933a10a3db4492312342909"
     )
     assert sha256(read_bytes(crowded, "telemetry.csv")) == (
-        "93d069eb68b590ef7d4238134ecd4606909b4a704d1fcd577a8cad63daf2e959"
+        "ad3c5419b55400af870fd6ede76a4b779e1c009b6764210ef8e4d3de3fbebc27"
     )
     assert sha256(read_bytes(crowded, "events.jsonl")) == (
         "126e2500f5196cdf74aaa83d2f856020a9fc9847e58d516b807454a361087721"

@@ -23,7 +23,7 @@ from dcsim.api import (
     Trajectory,
     quantity,
 )
-from dcsim.registry.answers import output_problem
+from dcsim.registry.answers import ActuatorCounts, output_problem
 from dcsim.run.loop import Runner
 from dcsim.run.setup import setup_run
 from tests.conftest import REPO
@@ -274,9 +274,11 @@ def test_debug_prints_the_plugin_s_traceback_and_keeps_exit_1(tmp_path):
 
 
 def test_the_output_check_passes_good_answers():
-    assert output_problem("controller", "command", Command(), joints=0) is None
-    assert output_problem("controller", "command", Command(joint_torques=[1, 2]), joints=2) is None
-    assert output_problem("controller", "command", Command(), joints=6) is None  # none given
+    assert output_problem("controller", "command", Command(), ActuatorCounts()) is None
+    two = Command(joint_torques=[1, 2])
+    assert output_problem("controller", "command", two, ActuatorCounts(joints=2)) is None
+    none_given = Command()
+    assert output_problem("controller", "command", none_given, ActuatorCounts(joints=6)) is None
     assert output_problem("path_planner", "plan", NoPath(reason="boxed in")) is None
     assert output_problem("localiser", "update", None) is None  # answers nothing
     trajectory = Trajectory(times=[0, 1], positions=np.zeros((2, 3)), velocities=np.zeros((2, 3)))

@@ -176,7 +176,11 @@ def test_help_and_the_listing_import_no_plugin_and_plugins_name_imports_only_it(
     assert {("controller", "hold", "dcsim-hold"), ("controller", "pd", "dcsim")} <= _names(listing)
     shown, imported = _imported_by(["plugins", "pd"], [dist])
     assert shown.stdout.startswith("controller pd: ")
-    assert imported == ["dcsim_plugins.controllers", "dcsim_plugins.controllers.pd"]
+    assert imported == [  # pd and the attitude loop it shares with elastic
+        "dcsim_plugins.controllers",
+        "dcsim_plugins.controllers.attitude",
+        "dcsim_plugins.controllers.pd",
+    ]
     held, imported = _imported_by(["plugins", "hold"], [dist])
     assert held.stdout.startswith("controller hold: Damps the velocity to zero")
     assert imported == ["dcsim_hold"]

@@ -186,7 +186,8 @@ def test_telemetry_records_the_world_frame_angular_rate_and_the_estimates_sigma(
     telemetry = runner.recorder.telemetry()
     rate = np.column_stack([telemetry[c] for c in ("wx", "wy", "wz")])
     attitude = np.column_stack([telemetry[c] for c in ("qx", "qy", "qz", "qw")])
-    assert np.abs(rate).max() > 0.05  # rad/s: the cargo turns the collector
+    # rad/s: grabs turn the collector, the attitude loop brings it back (below 0.5 deg/s)
+    assert 1e-3 < np.abs(rate).max() < np.radians(0.5)
     # q(t + dt) = exp(ω dt) ⊗ q(t) with ω in the world frame, rad/s.
     turned = rotation_vector(quaternion_multiply(attitude[1:], quaternion_conjugate(attitude[:-1])))
     observed = turned / np.diff(telemetry["time"])[:, None]

@@ -190,16 +190,27 @@ class Command(Message):
     Attributes
     ----------
     force : ndarray (3,)
-        Thrust on the base, world frame, N.
+        Thrust on the base, world frame, N (with thrusters, allocated to them).
     torque : ndarray (3,)
-        Torque on the base (reaction wheels), world frame, N·m.
+        Torque on the base, world frame, N·m (with reaction wheels or thrusters,
+        allocated to them).
     joint_torques : ndarray (n,)
         Joint torques (N·m) or forces (N); empty for a free flyer.
+    thruster_on_times : ndarray (N,)
+        Each thruster's firing time from the control period's start, s, in the order
+        of ``robot.actuators.thrusters``; given, it replaces the allocation of ``force``
+        (and of ``torque`` without wheels). Empty: allocate.
+    wheel_torques : ndarray (N,)
+        Each reaction wheel's torque about its spin axis, N·m (the base receives the
+        reaction), in the order of ``robot.actuators.reaction_wheels``; given, it
+        replaces the allocation of ``torque``. Empty: allocate.
     """
 
     force: Vector = array_field(default=(0.0, 0.0, 0.0))
     torque: Vector = array_field(default=(0.0, 0.0, 0.0))
     joint_torques: Vector = array_field(shape=(-1,), default=())
+    thruster_on_times: Vector = array_field(shape=(-1,), default=())
+    wheel_torques: Vector = array_field(shape=(-1,), default=())
 
 
 @message
@@ -220,9 +231,11 @@ class RobotSpec(Message):
         Largest thrust magnitude, N.
     max_torque : float
         Largest base torque magnitude, N·m. With reaction wheels
-        (``robot.actuators``), the largest delivered exactly in every direction: the
-        weakest direction of the wheels' minimum-norm allocation. Larger commands are
-        clipped wheel by wheel, and a wheel at its momentum limit gives less.
+        (``robot.actuators``), at most the largest they deliver exactly in every
+        direction (the weakest direction of their minimum-norm allocation); larger
+        commands are clipped wheel by wheel, and a wheel at its momentum limit gives
+        less. With thrusters and no wheels, at most their torque about the weakest body
+        axis.
     max_speed : float
         Speed the robot must not exceed, m/s.
     max_angular_rate : float
@@ -231,6 +244,14 @@ class RobotSpec(Message):
         Lower and upper limit of each joint, rad or m; no rows for a free flyer.
     joint_torque_limits : ndarray (n,)
         Largest torque (N·m) or force (N) of each joint.
+    thruster_forces, thruster_torques : ndarray (3, N)
+        Each thruster's force (N) and torque about the centre of mass (N·m) at full
+        thrust, body frame, as columns in the order of ``robot.actuators.thrusters``; no
+        columns without thrusters. A command's on-time ``t_i`` over a control period
+        ``T`` gives the mean force ``Σ (t_i / T) thruster_forces[:, i]``.
+    wheel_axes : ndarray (3, N)
+        Each reaction wheel's unit spin axis, body frame, as columns; no columns without
+        wheels. A wheel torque ``τ_i`` gives the base ``-τ_i wheel_axes[:, i]``.
     model : RobotModel or None
         The robot's model for model-based plugins (for a manipulator its
         :class:`~dcsim.robots.manipulator.ManipulatorModel`: kinematics, ``det(J Jᵀ)``,
@@ -251,6 +272,9 @@ class RobotSpec(Message):
     max_angular_rate: float = float("inf")
     joint_position_limits: Vector = array_field(shape=(-1, 2), default=np.zeros((0, 2)))
     joint_torque_limits: Vector = array_field(shape=(-1,), default=())
+    thruster_forces: Vector = array_field(shape=(3, -1), default=np.zeros((3, 0)))
+    thruster_torques: Vector = array_field(shape=(3, -1), default=np.zeros((3, 0)))
+    wheel_axes: Vector = array_field(shape=(3, -1), default=np.zeros((3, 0)))
     model: RobotModel | None = None
 
     def __post_init__(self) -> None:

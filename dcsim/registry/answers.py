@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator
 from dataclasses import dataclass, fields, is_dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -55,13 +55,25 @@ ANSWERS: dict[str, Answer] = {
     "controller": Answer(
         "command",
         (Command,),
-        "a Command with finite force, torque and joint torques (none, or one per joint)",
+        "a Command with finite numbers and joint torques, thruster on-times and wheel "
+        "torques each none or one per actuator",
     ),
 }
 """The answer each plugin kind owes, by kind."""
 
 
-def output_problem(kind: str, method: str, output: Any, joints: int | None = None) -> str | None:
+class ActuatorCounts(NamedTuple):
+    """How many joints, thrusters and reaction wheels a robot has: a command gives one
+    joint torque, thruster on-time or wheel torque per actuator of that kind, or none."""
+
+    joints: int = 0
+    thrusters: int = 0
+    wheels: int = 0
+
+
+def output_problem(
+    kind: str, method: str, output: Any, actuators: ActuatorCounts | None = None
+) -> str | None:
     """What is wrong with a plugin's answer, in words, or None when nothing is.
 
     Parameters
@@ -74,9 +86,9 @@ def output_problem(kind: str, method: str, output: Any, joints: int | None = Non
         (``reset``, ``predict``, ``update``) answers nothing that is checked.
     output : object
         What it returned.
-    joints : int, optional
-        The robot's number of joints, when known: a command gives one torque per joint,
-        or none (no joint torque).
+    actuators : ActuatorCounts, optional
+        The robot's joints, thrusters and wheels, when known: a command gives one value
+        per actuator of a kind, or none.
 
     Returns
     -------
@@ -94,14 +106,24 @@ def output_problem(kind: str, method: str, output: Any, joints: int | None = Non
         for name, value in _numbers(output):
             if not _finite(value):
                 return f"returned non-finite numbers: {name} {_show(value)}"
-    if isinstance(output, Command) and joints is not None:
-        given = len(output.joint_torques)
-        if given not in (0, joints):
-            return f"returned {given} joint torques for a robot with {joints} joints"
+    if isinstance(output, Command) and actuators is not None:
+        return _command_shape_problem(output, actuators)
     if isinstance(output, Trajectory) and (
         len(output.times) < 2 or np.any(np.diff(output.times) <= 0)
     ):
         return "returned a trajectory whose times do not increase strictly over two samples or more"
+    return None
+
+
+def _command_shape_problem(command: Command, actuators: ActuatorCounts) -> str | None:
+    """What a command gives for actuators the robot lacks, or None."""
+    for values, count, what, whose in (
+        (command.joint_torques, actuators.joints, "joint torques", "joints"),
+        (command.thruster_on_times, actuators.thrusters, "thruster on-times", "thrusters"),
+        (command.wheel_torques, actuators.wheels, "wheel torques", "reaction wheels"),
+    ):
+        if len(values) not in (0, count):
+            return f"returned {len(values)} {what} for a robot with {count} {whose}"
     return None
 
 

@@ -8,7 +8,7 @@ import traceback
 from collections.abc import Mapping
 from typing import Any
 
-from dcsim.registry.answers import ANSWERS, output_problem
+from dcsim.registry.answers import ANSWERS, ActuatorCounts, output_problem
 from dcsim.registry.interfaces import Plugin
 
 
@@ -63,7 +63,11 @@ class PluginFailure(Exception):
 
 
 def call_plugin(
-    plugins: Mapping[str, Plugin], role: str, method: str, *args: Any, joints: int | None = None
+    plugins: Mapping[str, Plugin],
+    role: str,
+    method: str,
+    *args: Any,
+    actuators: ActuatorCounts | None = None,
 ) -> Any:
     """Call ``plugins[role].method(*args)`` and check its answer.
 
@@ -75,8 +79,8 @@ def call_plugin(
         Whose method to call.
     *args
         Its arguments.
-    joints : int, optional
-        The robot's number of joints, which a controller's command must match.
+    actuators : ActuatorCounts, optional
+        The robot's joints, thrusters and wheels, which a controller's command must match.
 
     Raises
     ------
@@ -89,7 +93,7 @@ def call_plugin(
         answer = getattr(plugin, method)(*args)
     except Exception as error:  # a plugin's own bug ends the run, recorded
         raise PluginFailure(role, plugin.name, method, error) from error
-    problem = output_problem(plugin.kind, method, answer, joints)
+    problem = output_problem(plugin.kind, method, answer, actuators)
     if problem is not None:
         expected = ANSWERS[plugin.kind].expected
         raise PluginFailure(role, plugin.name, method, problem=f"{problem}; expected {expected}")

@@ -35,15 +35,17 @@ from typing import Any, TypedDict
 import numpy as np
 
 from dcsim.errors import CwValidityWarning, PlannerModelWarning
-from dcsim.geometry import Vector
-from dcsim.messages import Command, Observations, Prior, StateEstimate
+from dcsim.geometry import Vector, attitude_error
+from dcsim.messages import Command, Observations, Prior, Reference, StateEstimate
 from dcsim.missions import Mission, mission_class
+from dcsim.registry.answers import ActuatorCounts
 from dcsim.registry.calls import PluginFailure, call_plugin
 from dcsim.registry.hookspecs import RunInfo
 from dcsim.run.recording import (
     SIGMA_COLUMNS,
     Recorder,
     RecordingError,
+    duty_columns,
     telemetry_columns,
     telemetry_units,
     wheel_columns,
@@ -53,7 +55,6 @@ from dcsim.run.setup import RunSetup
 from dcsim.scenario import dump_scenario
 from dcsim.scenario.model import (
     ManipulatorSection,
-    ReactionWheelsSpec,
     RobotSection,
     point_to_cartesian,
 )
@@ -181,10 +182,14 @@ class Runner:
         self.scenario = setup.scenario
         self.plugins = setup.plugins
         self.mission_class = mission_class(self.scenario.mission.type)
-        self._wheel_columns = wheel_columns(_wheel_count(self.scenario.robot))
-        wheels = len(self._wheel_columns)
-        columns = telemetry_columns(self.mission_class.telemetry_columns(self.scenario), wheels)
-        units = telemetry_units(self.mission_class.telemetry_units(self.scenario), wheels)
+        self._actuator_counts = actuator_counts(self.scenario.robot)
+        self._wheel_columns = wheel_columns(self._actuator_counts.wheels)
+        self._duty_columns = duty_columns(self._actuator_counts.thrusters)
+        hardware = self._actuator_counts.thrusters, self._actuator_counts.wheels
+        mission_columns = self.mission_class.telemetry_columns(self.scenario)
+        columns = telemetry_columns(mission_columns, *hardware)
+        mission_units = self.mission_class.telemetry_units(self.scenario)
+        units = telemetry_units(mission_units, self._actuator_counts.wheels)
         self.recorder = Recorder(out_dir, columns, keep_rows, units)
         self.info = RunInfo(self.scenario, self.scenario.world.seed, out_dir)
         self.progress = progress
@@ -198,6 +203,7 @@ class Runner:
         self.laps = LapTimer()
         self.failure: PluginFailure | None = None
         self._command = Command()
+        self._reference: Reference | None = None
         self._robot_changes = 0
         self._started = 0.0
         self._squared_error_sum = 0.0
@@ -438,7 +444,7 @@ class Runner:
         laps.lap("sensors")
         estimate = self.estimate = _with_readings(self._localise(observations), observations)
         laps.lap("localiser")
-        reference = mission.tick(t, estimate, observations)
+        reference = self._reference = mission.tick(t, estimate, observations)
         laps.lap("mission")
         if world.robot_changes != self._robot_changes:  # a grab or a release
             self._robot_changes = world.robot_changes
@@ -452,7 +458,7 @@ class Runner:
             estimate,
             reference,
             surroundings,
-            joints=len(observations.joint_positions),
+            actuators=self._actuator_counts._replace(joints=len(observations.joint_positions)),
         )
         laps.lap("controller")
         self._record(t, estimate, mission.mode, self._command)
@@ -473,24 +479,24 @@ class Runner:
         return call_plugin(plugins, "localiser", "estimate")
 
     def _advance(self, disturbance_force: np.ndarray, disturbance_torque: np.ndarray) -> None:
+        command = self._command
         inputs = WorldInputs(
-            force=self._command.force,
-            torque=self._command.torque,
+            force=command.force,
+            torque=command.torque,
             disturbance_force=disturbance_force,
             disturbance_torque=disturbance_torque,
-            joint_torques=self._command.joint_torques,
+            joint_torques=command.joint_torques,
+            thruster_on_times=command.thruster_on_times,
+            wheel_torques=command.wheel_torques,
         )
         world = self._opened_world
-        saturated = len(world.wheel_saturations)
+        actuators = world.actuators
+        seen = 0 if actuators is None else len(actuators.events)
         collisions = world.step(inputs)
         self.laps.lap("world")
-        for saturation in world.wheel_saturations[saturated:]:
-            self._event(
-                "wheel_saturated",
-                at=saturation.time,
-                wheel=saturation.wheel,
-                momentum=saturation.momentum,
-            )
+        if actuators is not None:
+            for event in actuators.events[seen:]:
+                self._event(event.name, at=event.time, **event.data)
         for collision in collisions:
             self._event(
                 "collision",
@@ -553,9 +559,14 @@ class Runner:
         row.update(zip(("fx", "fy", "fz"), command.force.tolist(), strict=True))
         row.update(zip(("wx", "wy", "wz"), out["angular_velocity"].tolist(), strict=True))
         row.update(zip(SIGMA_COLUMNS, _position_sigmas(estimate.covariance), strict=True))
+        held = None if self._reference is None else self._reference.attitude
+        row["attitude_error"] = math.nan if held is None else attitude_error(out["attitude"], held)
         if self._wheel_columns:
             momenta = out["wheel_momentum"].tolist()
             row.update(zip(self._wheel_columns, momenta, strict=True))
+        if self._duty_columns:
+            duty = out["thruster_duty"].tolist()
+            row.update(zip(self._duty_columns, duty, strict=True))
         self._accumulate(out, estimate)
         self.recorder.row(row)
         if self._step_observed:
@@ -605,11 +616,18 @@ class Runner:
             "seed": self.scenario.world.seed,
         }
 
-    def _wheel_summary(self) -> dict[str, Any]:
+    def _hardware_summary(self) -> dict[str, Any]:
         """The reaction wheels' largest momentum as a fraction of their limit (each its
-        own), over the whole run; nothing without wheels."""
-        wheels = self._opened_world.wheels
-        return {} if wheels is None else {"peak_wheel_momentum_fraction": wheels.peak_fraction}
+        own) over the whole run, and the propellant burnt for attitude (kg, with
+        thrusters); nothing without the hardware."""
+        world = self._opened_world
+        fields: dict[str, Any] = {}
+        if world.wheels is not None:
+            fields["peak_wheel_momentum_fraction"] = world.wheels.peak_fraction
+        if world.actuators is not None and world.actuators.thrusters is not None:
+            fields["fuel_attitude_kg"] = world.attitude_fuel_used
+            fields["fuel_translation_kg"] = world.fuel_used - world.attitude_fuel_used
+        return fields
 
     def _summary(self, wall: float) -> dict[str, Any]:
         world, mission = self._opened_world, self._opened_mission
@@ -633,18 +651,22 @@ class Runner:
             "delta_v_mps": world.delta_v,
             "localisation_rmse_m": rmse,
             "min_obstacle_distance_m": self._min_gap if self.recorder.count else None,
-            **self._wheel_summary(),
+            **self._hardware_summary(),
             "plugins": self.setup.plugin_versions(),
             "localiser": self._localiser_note(),
             "wall_time_by_phase_s": dict(sorted(self.laps.totals.items())),
         }
 
 
-def _wheel_count(robot: RobotSection | ManipulatorSection) -> int:
-    """How many reaction wheels the robot has (0 for ideal torque)."""
-    if isinstance(robot, RobotSection) and isinstance(robot.actuators, ReactionWheelsSpec):
-        return len(robot.actuators.wheels)
-    return 0
+def actuator_counts(robot: RobotSection | ManipulatorSection) -> ActuatorCounts:
+    """How many thrusters and reaction wheels the robot has (its joints are counted
+    from its observations)."""
+    if not isinstance(robot, RobotSection):
+        return ActuatorCounts()
+    actuators = robot.actuators
+    return ActuatorCounts(
+        thrusters=len(actuators.thrusters or ()), wheels=len(actuators.reaction_wheels or ())
+    )
 
 
 def _position_sigmas(covariance: np.ndarray) -> list[float]:

@@ -44,7 +44,7 @@ diagonal of the estimate's covariance, position block."""
 
 _TRAILING_COLUMNS = (
     "fuel_used", "delta_v", "nearest_obstacle", "fx", "fy", "fz",
-    "wx", "wy", "wz", *SIGMA_COLUMNS,
+    "wx", "wy", "wz", *SIGMA_COLUMNS, "attitude_error",
 )  # fmt: skip
 _TEXT_COLUMNS = frozenset({"mode"})
 
@@ -71,6 +71,7 @@ COLUMN_UNITS = {
     **dict.fromkeys(("fx", "fy", "fz"), "N"),
     **dict.fromkeys(("wx", "wy", "wz"), "radps"),
     **dict.fromkeys(SIGMA_COLUMNS, "m"),
+    "attitude_error": "rad",
 }
 """Unit suffix of each column every run records (a column absent has no unit)."""
 
@@ -82,11 +83,20 @@ class RecordingError(DcsimError):
 def wheel_columns(wheels: int) -> tuple[str, ...]:
     """The telemetry columns of ``wheels`` reaction wheels' momenta: ``wheel_h_1``, ...
     (N·m·s, about each wheel's spin axis, numbered in the order of
-    ``robot.actuators.wheels``)."""
+    ``robot.actuators.reaction_wheels``)."""
     return tuple(f"wheel_h_{i}" for i in range(1, wheels + 1))
 
 
-def telemetry_columns(mission_columns: Sequence[str], wheels: int = 0) -> tuple[str, ...]:
+def duty_columns(thrusters: int) -> tuple[str, ...]:
+    """The telemetry columns of ``thrusters`` thrusters' duty cycles: ``duty_1``, ... (the
+    fraction of the control period each fired, numbered in the order of
+    ``robot.actuators.thrusters``)."""
+    return tuple(f"duty_{i}" for i in range(1, thrusters + 1))
+
+
+def telemetry_columns(
+    mission_columns: Sequence[str], thrusters: int = 0, wheels: int = 0
+) -> tuple[str, ...]:
     """Columns of ``telemetry.csv`` for a mission with its own ``mission_columns``.
 
     Every run records time (s); true and estimated position (m) and velocity (m/s);
@@ -95,15 +105,19 @@ def telemetry_columns(mission_columns: Sequence[str], wheels: int = 0) -> tuple[
     propellant used (kg), delta-v (m/s), the surface gap to the nearest obstacle (m),
     the commanded thrust (N), the true angular velocity (world frame, rad/s) and the
     standard deviations of the estimated position (:data:`SIGMA_COLUMNS`, m; 0 when
-    the mission flies on the true state); last, with ``wheels`` reaction wheels, each
-    wheel's momentum (:func:`wheel_columns`, N·m·s).
+    the mission flies on the true state), the angle from the true attitude to the
+    reference's (rad; nan when the reference leaves the attitude free); last, with
+    ``wheels`` reaction wheels, each
+    wheel's momentum (:func:`wheel_columns`, N·m·s), and with ``thrusters`` thrusters,
+    each one's duty cycle (:func:`duty_columns`).
     """
-    return (*_LEADING_COLUMNS, *mission_columns, *_TRAILING_COLUMNS, *wheel_columns(wheels))
+    hardware = (*wheel_columns(wheels), *duty_columns(thrusters))
+    return (*_LEADING_COLUMNS, *mission_columns, *_TRAILING_COLUMNS, *hardware)
 
 
 def telemetry_units(mission_units: Mapping[str, str], wheels: int = 0) -> dict[str, str]:
     """Unit suffix of each telemetry column: :data:`COLUMN_UNITS`, the mission's own and
-    those of ``wheels`` reaction wheels' momenta."""
+    those of ``wheels`` reaction wheels' momenta (thrusters' duty cycles have none)."""
     return {**COLUMN_UNITS, **mission_units, **dict.fromkeys(wheel_columns(wheels), "Nms")}
 
 

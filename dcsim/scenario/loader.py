@@ -35,9 +35,9 @@ from dcsim.scenario.model import (
     MAX_PHYSICS_STEPS,
     MAX_STEPS_PER_CONTROL_PERIOD,
     MEAN_MOTION_RANGE,
+    ActuatorsSpec,
     MissionSettings,
     OrbitSpec,
-    ReactionWheelsSpec,
     Scenario,
     scenario_model,
 )
@@ -409,21 +409,35 @@ def _propellant_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
     return [(("robot", "propellant_mass"), message)]
 
 
-def _wheel_torque_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
-    """With reaction wheels, a ``robot.max_torque`` given must be theirs."""
-    if get("robot", "type") != "free-flyer" or not get.given("robot", "max_torque"):
+def _actuator_limit_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
+    """With thrusters or reaction wheels, a ``robot.max_force`` or ``robot.max_torque``
+    given must be within what they give along every body axis."""
+    if get("robot", "type") != "free-flyer":
         return []
-    wheels = get("robot", "actuators")
-    if not isinstance(wheels, ReactionWheelsSpec):
+    actuators = get("robot", "actuators")
+    if not isinstance(actuators, ActuatorsSpec):
         return []
-    given, limit = get("robot", "max_torque"), wheels.torque_limit()
-    if math.isclose(given, limit, rel_tol=1e-9):
-        return []
-    message = (
-        f"{given:g} N*m disagrees with the reaction wheels' torque limit ({limit:.6g} N*m, the "
-        "largest delivered in every direction); leave max_torque out when giving wheels"
-    )
-    return [(("robot", "max_torque"), message)]
+    found: list[tuple[KeyPath, str]] = []
+    for key, limit, unit, what in (
+        ("max_force", actuators.force_limit(), "N", "thrusters' force"),
+        ("max_torque", actuators.torque_limit(), "N*m", f"{_torquers(actuators)} torque"),
+    ):
+        if limit is None or not get.given("robot", key):
+            continue
+        given = get("robot", key)
+        if given <= limit * (1.0 + 1e-9):
+            continue
+        message = (
+            f"{given:g} {unit} exceeds the {what} along the weakest body axis "
+            f"({limit:.6g} {unit}); leave {key} out to use it"
+        )
+        found.append((("robot", key), message))
+    return found
+
+
+def _torquers(actuators: ActuatorsSpec) -> str:
+    """Who gives the torque: the reaction wheels, or else the thrusters."""
+    return "reaction wheels'" if actuators.reaction_wheels is not None else "thrusters'"
 
 
 def _joint_count_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
@@ -501,7 +515,7 @@ _RULES: list[Rule] = [
     _duration_rule,
     _orbit_rule,
     _propellant_rule,
-    _wheel_torque_rule,
+    _actuator_limit_rule,
     _joint_count_rule,
     _attitude_rule,
     _object_rules,
@@ -593,6 +607,8 @@ def _field_adapter(model: type[BaseModel], name: str) -> TypeAdapter[Any]:
     """A validator of field ``name`` of ``model`` on its own: type, bounds and config."""
     info = model.model_fields[name]
     assert info.annotation is not None  # pydantic gives every field of a model its type
+    if isinstance(info.annotation, type) and issubclass(info.annotation, BaseModel):
+        return TypeAdapter(info.annotation)  # a section has its own config
     annotation = Annotated[info.annotation, *info.metadata] if info.metadata else info.annotation
     # mypy types an Annotated built at run time as a special form, which pydantic accepts
     return TypeAdapter(annotation, config=model.model_config)  # type: ignore[arg-type]

@@ -389,16 +389,6 @@ def _no_tensor(value: Any) -> Any:
     return value
 
 
-class IdealActuatorsSpec(Section):
-    """Ideal attitude actuators: the commanded torque, clipped to `robot.max_torque`."""
-
-    type: Literal["ideal"] = Field(
-        "ideal",
-        description="`ideal`: the base receives the commanded torque (world frame), its "
-        "magnitude clipped to `robot.max_torque`.",
-    )
-
-
 def _nonzero_axis(axis: Vec3) -> Vec3:
     if sum(a * a for a in axis) < 1e-12:
         raise ValueError("the axis must not be zero")
@@ -440,51 +430,188 @@ def wheel_axes(wheels: list[WheelSpec]) -> Vector:
     return axes / np.linalg.norm(axes, axis=0)
 
 
-class ReactionWheelsSpec(Section):
-    """Reaction wheels: the base's torque is the reaction of three or more wheels.
+class ThrusterSpec(Section):
+    """One thruster: where it sits on the base, which way it pushes, its limits."""
 
-    The commanded torque is turned into body axes and shared among the wheels by the
-    minimum-norm solution; each wheel's torque is clipped to its `max_torque` and
-    to what keeps its momentum within `max_momentum` (docs/architecture.md, World).
+    position: Vec3 = quantity(
+        unit="m",
+        description="Position [x, y, z] in the body frame, from the base's centre of mass.",
+    )
+    direction: Annotated[Vec3, AfterValidator(_nonzero_axis)] = quantity(
+        description="Direction [x, y, z] of the force on the base, body frame (normalised; "
+        "the plume leaves the other way)."
+    )
+    max_thrust: float = quantity(unit="N", gt=0, description="Thrust when on.")
+    min_impulse_bit: float = quantity(
+        0.0,
+        unit="N*s",
+        ge=0,
+        description="Smallest impulse of one firing: shorter on-times are rounded to 0 or to "
+        "it (docs/architecture.md, World).",
+    )
+    specific_impulse: float | None = quantity(
+        None, unit="s", gt=0, description="Specific impulse; null: `robot.specific_impulse`."
+    )
+
+
+class UnloadingSpec(Section):
+    """Momentum unloading: thrusters take the reaction wheels' momentum out.
+
+    Unloading starts when a wheel's momentum passes ``start_fraction`` of its limit and
+    stops when every wheel is below ``stop_fraction``; meanwhile the thrusters give the
+    torque ``-H / time_constant`` (``H`` the wheels' momentum, body frame) and the wheels
+    the rest of the commanded torque, so the base feels what was commanded while the
+    wheels' momentum decays.
     """
 
-    type: Literal["reaction_wheels"] = Field(
-        description="`reaction_wheels`: three or more wheels whose axes span 3-D."
+    start_fraction: float = quantity(
+        0.8, gt=0, le=1, description="Momentum fraction of any wheel that starts unloading."
     )
-    wheels: Annotated[list[WheelSpec], Field(min_length=3), AfterValidator(_spanning)] = Field(
-        description="The wheels, at least three, their axes spanning three dimensions."
+    stop_fraction: float = quantity(
+        0.1, ge=0, lt=1, description="Momentum fraction every wheel is below when it stops."
+    )
+    time_constant: float = quantity(
+        30.0, unit="s", gt=0, description="Time constant of the wheels' momentum decay."
     )
 
-    def torque_limit(self) -> float:
-        """The largest torque magnitude, N·m, delivered exactly in every direction.
+    @model_validator(mode="after")
+    def _ordered(self) -> UnloadingSpec:
+        if self.stop_fraction >= self.start_fraction:
+            raise ValueError("stop_fraction must be below start_fraction")
+        return self
 
-        The minimum-norm allocation gives wheel ``i`` the torque ``(A⁺ t)_i`` for a body
-        torque ``t``; it stays within ``max_torque_i`` for every direction of ``t`` while
-        ``|t| ≤ max_torque_i / |row i of A⁺|``. The smallest of these bounds the weakest axis.
+
+_AXIS_NAMES = ("+x", "-x", "+y", "-y", "+z", "-z")
+
+
+def thruster_matrices(thrusters: list[ThrusterSpec]) -> tuple[Vector, Vector]:
+    """Force (N) and torque (N·m) of each thruster at full thrust, body frame: the
+    columns of two (3, N) matrices."""
+    positions = np.array([t.position for t in thrusters], dtype=float)
+    directions = np.array([t.direction for t in thrusters], dtype=float)
+    directions /= np.linalg.norm(directions, axis=1)[:, None]
+    thrust = np.array([t.max_thrust for t in thrusters])
+    return (directions * thrust[:, None]).T, (np.cross(positions, directions) * thrust[:, None]).T
+
+
+def axis_capacities(produced: Vector, held: Vector) -> Vector:
+    """The largest output along each body axis, +x, -x, +y, -y, +z, -z, that thrusts
+    between zero and full give while the other output stays zero (a linear programme
+    per axis; 0 where none).
+
+    Parameters
+    ----------
+    produced : ndarray (3, N)
+        What each thruster gives at full thrust of the output asked for (force or torque).
+    held : ndarray (3, N)
+        What each gives of the output held at zero.
+    """
+    from scipy.optimize import linprog  # imported here: only validation needs it
+
+    n = produced.shape[1]
+    capacities = []
+    for axis in np.vstack([np.eye(3), -np.eye(3)])[[0, 3, 1, 4, 2, 5]]:
+        # variables: duty cycles u (N) and the magnitude s; maximise s
+        equality = np.block([[produced, -axis[:, None]], [held, np.zeros((3, 1))]])
+        result = linprog(
+            np.r_[np.zeros(n), -1.0],
+            A_eq=equality,
+            b_eq=np.zeros(6),
+            bounds=[(0.0, 1.0)] * n + [(0.0, None)],
+            method="highs",
+        )
+        capacities.append(float(result.x[-1]) if result.status == 0 else 0.0)
+    return np.array(capacities)
+
+
+def _thrusters_push_every_way(thrusters: list[ThrusterSpec]) -> list[ThrusterSpec]:
+    forces, torques = thruster_matrices(thrusters)
+    missing = []
+    for what, produced, held in (("force", forces, torques), ("torque", torques, forces)):
+        capacities = axis_capacities(produced, held)
+        weak = [name for name, c in zip(_AXIS_NAMES, capacities, strict=True) if c <= 1e-9]
+        if weak:
+            missing.append(f"no {what} along {', '.join(weak)}")
+    if missing:
+        raise ValueError(
+            "the thrusters must give a force along every body axis without a torque, and "
+            f"a torque about every axis without a force; they give {'; '.join(missing)}"
+        )
+    return thrusters
+
+
+class ActuatorsSpec(Section):
+    """The free flyer's actuators: thrusters, reaction wheels, both or neither (ideal).
+
+    Without ``thrusters`` the commanded force is applied as it is (world frame, clipped
+    to ``robot.max_force``); without ``reaction_wheels`` the commanded torque likewise,
+    or by the thrusters when there are thrusters. With both, the thrusters give the
+    force and unload the wheels, and the wheels the torque (docs/architecture.md, World).
+    """
+
+    thrusters: (
+        Annotated[
+            list[ThrusterSpec], Field(min_length=1), AfterValidator(_thrusters_push_every_way)
+        ]
+        | None
+    ) = Field(
+        None,
+        description="Thrusters fixed to the base, giving a force along and a torque about "
+        "every body axis; null: ideal thrust.",
+    )
+    reaction_wheels: (
+        Annotated[list[WheelSpec], Field(min_length=3), AfterValidator(_spanning)] | None
+    ) = Field(
+        None,
+        description="Reaction wheels, at least three, their axes spanning three dimensions; "
+        "null: ideal torque (or the thrusters').",
+    )
+    unloading: UnloadingSpec = Field(
+        default_factory=UnloadingSpec,
+        description="When thrusters unload the wheels (used when both are given).",
+    )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_type(cls, data: Any) -> Any:
+        if isinstance(data, dict) and "type" in data:
+            raise ValueError(
+                "robot.actuators takes no `type`: list `reaction_wheels: [...]` and/or "
+                "`thrusters: [...]` (neither: ideal force and torque)"
+            )
+        return data
+
+    @property
+    def ideal(self) -> bool:
+        """Whether both force and torque are ideal (no thrusters, no wheels)."""
+        return self.thrusters is None and self.reaction_wheels is None
+
+    def torque_limit(self) -> float | None:
+        """The largest torque magnitude, N·m, the attitude actuators deliver exactly about
+        every body axis (the wheels' in every direction); None when torque is ideal.
+
+        The wheels' minimum-norm allocation gives wheel ``i`` the torque ``(A⁺ t)_i`` for a
+        body torque ``t``; it stays within ``max_torque_i`` for every direction of ``t``
+        while ``|t| ≤ max_torque_i / |row i of A⁺|``. The smallest of these bounds the
+        weakest direction. Thrusters alone: the smallest of their torques along the six
+        body axis directions with zero force.
         """
-        rows = np.linalg.norm(np.linalg.pinv(wheel_axes(self.wheels)), axis=1)
-        limits = np.array([wheel.max_torque for wheel in self.wheels]) / rows
-        return float(limits.min())
+        if self.reaction_wheels is not None:
+            rows = np.linalg.norm(np.linalg.pinv(wheel_axes(self.reaction_wheels)), axis=1)
+            limits = np.array([wheel.max_torque for wheel in self.reaction_wheels]) / rows
+            return float(limits.min())
+        if self.thrusters is not None:
+            forces, torques = thruster_matrices(self.thrusters)
+            return float(axis_capacities(torques, forces).min())
+        return None
 
-
-def _actuator_type(data: Any) -> str | None:
-    """The tag of an actuator section: its ``type`` (``ideal`` when absent)."""
-    if isinstance(data, dict):
-        value = data.get("type", "ideal")
-        return value if isinstance(value, str) else None
-    return getattr(data, "type", "ideal")
-
-
-ActuatorsSpec = Annotated[
-    Annotated[IdealActuatorsSpec, Tag("ideal")]
-    | Annotated[ReactionWheelsSpec, Tag("reaction_wheels")],
-    Discriminator(
-        _actuator_type,
-        custom_error_type="actuator_type",
-        custom_error_message="robot.actuators.type must be `ideal` or `reaction_wheels`",
-    ),
-]
-"""The free flyer's attitude actuators, chosen by their ``type`` (``ideal`` when absent)."""
+    def force_limit(self) -> float | None:
+        """The largest force, N, the thrusters give along every body axis with zero torque
+        (the smallest of the six axis directions' linear programmes); None when ideal."""
+        if self.thrusters is None:
+            return None
+        forces, torques = thruster_matrices(self.thrusters)
+        return float(axis_capacities(forces, torques).min())
 
 
 class RobotSection(RobotBaseSection):
@@ -512,11 +639,10 @@ class RobotSection(RobotBaseSection):
         "null: a uniform sphere's of `radius`, 2/5 m r^2.",
     )
     actuators: ActuatorsSpec = Field(
-        default_factory=IdealActuatorsSpec,
-        description="Attitude actuators: `{type: ideal}` (the default) or `{type: "
-        "reaction_wheels, wheels: [...]}`. With wheels, `max_torque` is theirs: the largest "
-        "torque delivered exactly in every direction (filled in when left out; given, it "
-        "must agree). Thrust stays ideal.",
+        default_factory=ActuatorsSpec,
+        description="Thrusters and reaction wheels; absent, ideal force and torque. With "
+        "them, `max_force` and `max_torque` are theirs when left out (the largest given "
+        "along every body axis); given, they must not exceed them.",
     )
     initial: InitialStateSpec = Field(
         default_factory=InitialStateSpec, description="State at t = 0."
@@ -524,13 +650,19 @@ class RobotSection(RobotBaseSection):
 
     @model_validator(mode="wrap")
     @classmethod
-    def _wheel_torque(cls, data: Any, handler: ModelWrapValidatorHandler[Any]) -> Any:
-        """Fill in ``max_torque`` from the reaction wheels when it is not given."""
+    def _actuator_limits(cls, data: Any, handler: ModelWrapValidatorHandler[Any]) -> Any:
+        """Fill in ``max_force`` and ``max_torque`` from the actuators when not given."""
         robot = handler(data)
-        wheels = robot.actuators
-        if isinstance(wheels, ReactionWheelsSpec) and "max_torque" not in robot.model_fields_set:
-            return robot.model_copy(update={"max_torque": wheels.torque_limit()})
-        return robot
+        limits = {
+            "max_force": robot.actuators.force_limit(),
+            "max_torque": robot.actuators.torque_limit(),
+        }
+        update = {
+            key: limit
+            for key, limit in limits.items()
+            if limit is not None and key not in robot.model_fields_set
+        }
+        return robot.model_copy(update=update) if update else robot
 
 
 def _ordered(limits: tuple[float, float]) -> tuple[float, float]:

@@ -26,7 +26,7 @@ from dcsim.messages import (
     Surroundings,
     Trajectory,
 )
-from dcsim.registry.answers import ANSWERS, output_problem
+from dcsim.registry.answers import ANSWERS, ActuatorCounts, output_problem
 from dcsim.registry.discovery import check_plugin_class
 from dcsim.registry.interfaces import PLUGIN_KINDS, Controller, Localiser, Plugin
 from dcsim.testing import problems
@@ -286,12 +286,14 @@ def run_plugin(plugin_class: type[Plugin], inputs: list, what: str) -> list:
     return outputs
 
 
-def checked_answer(kind: str, output: Any, what: str, joints: int | None = None) -> Any:
+def checked_answer(
+    kind: str, output: Any, what: str, actuators: ActuatorCounts | None = None
+) -> Any:
     """``output`` when it is an answer a plugin of ``kind`` may give (the check a run makes
     at the plugin boundary, :func:`dcsim.registry.answers.output_problem`); otherwise a
     violation saying what was wrong on ``what`` and what was expected."""
     answer = ANSWERS[kind]
-    problem = output_problem(kind, answer.method, output, joints)
+    problem = output_problem(kind, answer.method, output, actuators)
     if problem is not None:
         fail(f"{problem} on {what}; expected {answer.expected}")
     return output

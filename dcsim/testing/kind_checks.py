@@ -24,6 +24,7 @@ from dcsim.messages import (
     Surroundings,
     Trajectory,
 )
+from dcsim.registry.answers import ActuatorCounts
 from dcsim.registry.interfaces import Controller, PathPlanner, Plugin, TaskPlanner
 from dcsim.testing import problems
 from dcsim.testing.contracts import (
@@ -705,7 +706,10 @@ def check_manipulator_convergence(plugin_class: type[Plugin]) -> None:
         fail(f"raised {type(error).__name__}: {error} on a manipulator near its reference")
     for t, command in zip(loop.times, loop.commands, strict=False):
         checked_answer(
-            "controller", command, f"a manipulator near its reference at t = {t:g} s", joints.size
+            "controller",
+            command,
+            f"a manipulator near its reference at t = {t:g} s",
+            ActuatorCounts(joints=joints.size),
         )
     joint_error = np.abs(loop.q[:, 7:] - joints).max(axis=1) / np.abs(offset).max()
     attitude_error = np.linalg.norm(rotation_vector(loop.q[:, 3:7]), axis=1) / 0.03

@@ -45,7 +45,8 @@ from dcsim.messages import (
     RobotSpec,
     RobotState,
 )
-from dcsim.scenario.model import ManipulatorSection, ReactionWheelsSpec, RobotSection, Scenario
+from dcsim.scenario.model import ManipulatorSection, RobotSection, Scenario
+from dcsim.world.actuators import Actuators, ThrustProfile
 from dcsim.world.bodies import ObjectBodies, surface_gap
 from dcsim.world.environment import (
     Propellant,
@@ -62,7 +63,6 @@ from dcsim.world.payload import Payload
 from dcsim.world.pybullet_client import connect_direct, pb
 from dcsim.world.robot_body import RobotBody
 from dcsim.world.sensors import Sensors
-from dcsim.world.wheels import ReactionWheels
 
 _BROAD_PHASE_SLACK = 1e-3  # m added to the swept reach of each control period
 
@@ -92,6 +92,11 @@ class WorldInputs:
     joint_torques : ndarray (n,)
         Commanded joint torques of a manipulator, N·m (clipped to the limits); empty
         for none (and for a free flyer, which has no joints).
+    thruster_on_times : ndarray (N,)
+        Each thruster's on-time from the period's start, s; empty: allocate ``force``
+        (:class:`~dcsim.messages.Command`).
+    wheel_torques : ndarray (N,)
+        Each reaction wheel's torque, N·m; empty: allocate ``torque``.
     """
 
     force: np.ndarray = field(default_factory=lambda: np.zeros(3))
@@ -99,6 +104,8 @@ class WorldInputs:
     disturbance_force: np.ndarray = field(default_factory=lambda: np.zeros(3))
     disturbance_torque: np.ndarray = field(default_factory=lambda: np.zeros(3))
     joint_torques: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    thruster_on_times: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    wheel_torques: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 @dataclass(frozen=True)
@@ -123,30 +130,13 @@ class CollisionEvent:
     penetration: float
 
 
-@dataclass(frozen=True)
-class WheelSaturation:
-    """A reaction wheel reaching its momentum limit (once per episode at the limit).
-
-    Attributes
-    ----------
-    time : float
-        s.
-    wheel : int
-        The wheel's number, from 1 in the order of ``robot.actuators.wheels``.
-    momentum : float
-        Its angular momentum about its spin axis, N·m·s (``±max_momentum``).
-    """
-
-    time: float
-    wheel: int
-    momentum: float
-
-
-def _build_wheels(robot: RobotSection | ManipulatorSection) -> ReactionWheels | None:
-    """The free flyer's reaction wheels, or None for ideal torque."""
-    if isinstance(robot, RobotSection) and isinstance(robot.actuators, ReactionWheelsSpec):
-        return ReactionWheels(robot.actuators)
-    return None
+def _build_actuators(
+    robot: RobotSection | ManipulatorSection, control_period: float, physics_step: float
+) -> Actuators | None:
+    """The free flyer's thrusters and reaction wheels, or None when both are ideal."""
+    if not isinstance(robot, RobotSection) or robot.actuators.ideal:
+        return None
+    return Actuators(robot.actuators, robot.specific_impulse, control_period, physics_step)
 
 
 class World:
@@ -176,10 +166,11 @@ class World:
         Every collision so far.
     robot_id : int
         The robot's PyBullet body id (its base is link -1).
+    actuators : Actuators or None
+        The free flyer's thrusters and reaction wheels (``robot.actuators``); None when
+        force and torque are ideal.
     wheels : ReactionWheels or None
-        The free flyer's reaction wheels (``robot.actuators``); None for ideal torque.
-    wheel_saturations : list of WheelSaturation
-        Every wheel saturation so far.
+        The free flyer's reaction wheels; None for ideal (or thrusters') torque.
     """
 
     def __init__(self, scenario: Scenario, rng: np.random.Generator) -> None:
@@ -209,8 +200,8 @@ class World:
         ) = None
         pb.setTimeStep(self.physics_step, physicsClientId=self._client)
         self._robot = _build_robot_body(self._client, robot)
-        self.wheels = _build_wheels(robot)
-        self.wheel_saturations: list[WheelSaturation] = []
+        self.actuators = _build_actuators(robot, self.control_period, self.physics_step)
+        self.wheels = None if self.actuators is None else self.actuators.wheels
         self._links_mass = sum(mass for _, mass in self._robot.links)
         self.robot_id = self._robot.body
         self._joint_torques = np.zeros(0)
@@ -335,6 +326,8 @@ class World:
         solid of its shape, by the parallel-axis theorem.
         """
         spec = self._robot.spec(self.assembly_mass(), self.base_mass(), self.cargo_protrusion())
+        if self.actuators is not None:
+            spec = self._with_actuators(spec)
         if not self._payload.held:
             return spec
         position, _, attitude, _ = self.base_state()
@@ -342,6 +335,18 @@ class World:
         base = (self.base_mass(), position, rotation @ spec.inertia @ rotation.T)
         _, inertia = combined_inertia([base, *self._payload.parts()])
         return dataclasses.replace(spec, inertia=rotation.T @ inertia @ rotation)
+
+    def _with_actuators(self, spec: RobotSpec) -> RobotSpec:
+        """``spec`` with the thrusters' and wheels' geometry."""
+        assert self.actuators is not None
+        thrusters, wheels = self.actuators.thrusters, self.wheels
+        if thrusters is not None:
+            spec = dataclasses.replace(
+                spec, thruster_forces=thrusters.forces, thruster_torques=thrusters.torques
+            )
+        if wheels is not None:
+            spec = dataclasses.replace(spec, wheel_axes=wheels.axes)
+        return spec
 
     def carried_ids(self) -> list[int]:
         """Ids of the targets on board."""
@@ -466,14 +471,25 @@ class World:
 
     def _wheel_outputs(self) -> dict[str, Any]:
         """The reaction wheels' momenta (N·m·s), spin rates (rad/s) and the torque they
-        gave the base over the last physics step (body frame, N·m); none without wheels."""
-        if self.wheels is None:
-            return {}
-        return {
-            "wheel_momentum": self.wheels.momentum.copy(),
-            "wheel_speed": self.wheels.speeds,
-            "wheel_torque": self.wheels.delivered(),
-        }
+        gave the base over the last physics step (body frame, N·m); each thruster's duty
+        cycle over the last control period (a fraction) and whether the thrusters are
+        unloading the wheels; none of these without the hardware."""
+        outputs: dict[str, Any] = {}
+        if self.wheels is not None:
+            outputs["wheel_momentum"] = self.wheels.momentum.copy()
+            outputs["wheel_speed"] = self.wheels.speeds
+            outputs["wheel_torque"] = self.wheels.delivered()
+        if self.actuators is not None and self.actuators.thrusters is not None:
+            outputs["thruster_duty"] = self.actuators.duty.copy()
+            outputs["unloading"] = self.actuators.unloading
+        return outputs
+
+    @property
+    def attitude_fuel_used(self) -> float:
+        """Propellant burnt for attitude so far, kg: with thrusters, what each period's
+        firing burnt beyond the allocation of its mean force alone
+        (:mod:`~dcsim.world.actuators`); 0 with ideal thrust."""
+        return 0.0 if self.actuators is None else self.actuators.attitude_propellant
 
     # ------------------------------------------------------------------ stepping
     def step(self, inputs: WorldInputs | None = None) -> list[CollisionEvent]:
@@ -487,32 +503,73 @@ class World:
         if inputs is not None:
             self.inputs = inputs
         force = clip_norm(self.inputs.force, self.robot.max_force)
-        torque = self._ideal_torque()
         self._period_mass = self.assembly_mass()
         self._joint_torques = self._robot.clip_joint_torques(self.inputs.joint_torques)
         if self._exact_forces is not None:
             self._linearise_orbital_forces()
         self._update_broad_phase(force)
         disturbance = tuple(float(f) for f in self.inputs.disturbance_force)
-        total_torque = tuple(
-            float(q) for q in torque + np.asarray(self.inputs.disturbance_torque, dtype=float)
-        )
-        thrusts = self._propellant.burn(force, self._period_mass)
-        started = self._fly_period(thrusts, disturbance, total_torque)
+        if self.actuators is not None and self.actuators.thrusters is not None:
+            profile = self._fire_thrusters(force)
+            torque = tuple(float(q) for q in self.inputs.disturbance_torque)
+            started = self._fly_period(None, disturbance, torque, profile)
+        else:
+            commanded = self._ideal_torque()
+            torque = tuple(
+                float(q)
+                for q in commanded + np.asarray(self.inputs.disturbance_torque, dtype=float)
+            )
+            thrusts = self._propellant.burn(force, self._period_mass)
+            started = self._fly_period(thrusts, disturbance, torque)
         self._set_body_mass(self.base_mass())
         self.collisions += started
         return started
 
+    def _rotation(self) -> np.ndarray:
+        """The base's body-to-world rotation matrix now."""
+        return np.reshape(pb.getMatrixFromQuaternion(self.base_state()[2].tolist()), (3, 3))
+
     def _ideal_torque(self) -> np.ndarray:
         """The commanded torque clipped to ``max_torque``, world frame, N·m; with reaction
-        wheels, zero: the wheels take the command (in body axes) and the base gets their
-        reaction step by step."""
-        if self.wheels is None:
+        wheels, zero: the wheels take the command (in body axes, each wheel clipped to its
+        limits) and the base gets their reaction step by step."""
+        if self.actuators is None:
             return clip_norm(self.inputs.torque, self.robot.max_torque)
-        attitude = self.base_state()[2]
-        rotation = np.reshape(pb.getMatrixFromQuaternion(attitude.tolist()), (3, 3))
-        self.wheels.command(rotation.T @ np.asarray(self.inputs.torque, dtype=float))
+        torque = np.asarray(self.inputs.torque, dtype=float)
+        wheel_torques = np.asarray(self.inputs.wheel_torques, dtype=float)
+        self.actuators.command_wheels(self.time, self._rotation(), torque, wheel_torques, None)
         return np.zeros(3)
+
+    def _fire_thrusters(self, force: np.ndarray) -> ThrustProfile:
+        """The thrusters' firing over the coming period (and the wheels' command, with
+        wheels), propellant booked."""
+        assert self.actuators is not None
+        rotation = self._rotation()
+        torque = np.asarray(self.inputs.torque, dtype=float)
+        if self.wheels is None:  # the thrusters give it
+            torque = clip_norm(torque, self.robot.max_torque)
+        profile = self.actuators.fire(
+            self.time,
+            rotation,
+            force,
+            torque,
+            np.asarray(self.inputs.thruster_on_times, dtype=float),
+            self._propellant,
+            self._period_mass,
+            rotation.T @ self._centre_offset(),
+        )
+        if self.wheels is not None:
+            wheel_torques = np.asarray(self.inputs.wheel_torques, dtype=float)
+            self.actuators.command_wheels(self.time, rotation, torque, wheel_torques, profile)
+        return profile
+
+    def _centre_offset(self) -> np.ndarray:
+        """The centre of mass of the base and its cargo less the base's, world frame, m."""
+        if not self._payload.held:
+            return np.zeros(3)
+        position = self.base_state()[0]
+        parts = [(self.base_mass(), position, np.zeros((3, 3))), *self._payload.parts()]
+        return combined_inertia(parts)[0] - position
 
     def _linearise_orbital_forces(self) -> None:
         """Expand the exact orbital acceleration of every body of the robot (base, cargo,
@@ -531,13 +588,19 @@ class World:
 
     def _fly_period(
         self,
-        thrusts: list[tuple[float, float, float]],
+        thrusts: list[tuple[float, float, float]] | None,
         disturbance: tuple[float, ...],
         torque: tuple[float, ...],
+        profile: ThrustProfile | None = None,
     ) -> list[CollisionEvent]:
         """The control period's physics steps: thrust, disturbance and orbital forces on
         the assembly (and the arm's joint torques), the broad phase's candidates checked
-        for contact after each step. What cannot change within the period is read once."""
+        for contact after each step. What cannot change within the period is read once.
+
+        ``thrusts`` gives each step's ideal thrust (world frame, N); with thrusters it is
+        None and ``profile`` gives each step's body force and torque instead, turned by
+        that step's attitude. ``torque`` is the torque on the base besides the
+        thrusters' and the wheels' (world frame, N·m)."""
         client, body, mass, n = self._client, self.robot_id, self._body_mass, self._mean_motion
         get_pose, get_velocity = pb.getBasePositionAndOrientation, pb.getBaseVelocity
         apply_force, step = pb.applyExternalForce, pb.stepSimulation
@@ -545,12 +608,21 @@ class World:
         robot, links = self._robot, self._robot.links
         exact, dt = self._exact_forces, self.physics_step
         parts = exact is not None and exact.has_parts
-        apply_torque = torque != (0.0, 0.0, 0.0)
+        wheels, actuators = self.wheels, self.actuators
+        apply_torque = torque != (0.0, 0.0, 0.0) or profile is not None
         check_contacts = len(self._candidates) > 0
         dx, dy, dz = disturbance
         started: list[CollisionEvent] = []
-        for k, (tx, ty, tz) in enumerate(thrusts):
-            position = get_pose(body, client)[0]
+        for k in range(self.steps_per_control):
+            position, attitude = get_pose(body, client)
+            if profile is None:
+                assert thrusts is not None
+                tx, ty, tz = thrusts[k]
+                step_torque = torque
+            else:
+                rotation = np.reshape(pb.getMatrixFromQuaternion(attitude), (3, 3))
+                tx, ty, tz = (rotation @ profile.forces[k]).tolist()
+                step_torque = tuple((rotation @ profile.torques[k] + torque).tolist())
             fx, fy, fz = tx + dx, ty + dy, tz + dz
             if n is not None:
                 ax, ay, az = cw_acceleration(n, position, get_velocity(body, client)[0])
@@ -567,14 +639,14 @@ class World:
                     exact.apply_to_parts(k * dt)
             robot.apply_joint_torques(self._joint_torques)
             apply_force(body, -1, (fx, fy, fz), position, pb.WORLD_FRAME, client)
-            if self.wheels is not None:
-                self._apply_wheel_torque(torque)
+            if wheels is not None:
+                self._apply_wheel_torque(step_torque)
             elif apply_torque:
-                pb.applyExternalTorque(body, -1, torque, pb.WORLD_FRAME, client)
+                pb.applyExternalTorque(body, -1, step_torque, pb.WORLD_FRAME, client)
             step(client)
             self._steps += 1
-            if self.wheels is not None:
-                self._note_saturations()
+            if actuators is not None and wheels is not None:
+                actuators.note_saturations(self.time)
             if check_contacts:
                 started += self._detect_collisions()
         return started
@@ -592,13 +664,6 @@ class World:
         reaction = self.wheels.step(rotation, angular, moments, external, self.physics_step)
         torque = (reaction + external).tolist()
         pb.applyExternalTorque(body, -1, torque, pb.WORLD_FRAME, client)
-
-    def _note_saturations(self) -> None:
-        """Record the wheels that reached their momentum limit in the last physics step."""
-        assert self.wheels is not None
-        for index in self.wheels.newly_saturated():
-            momentum = float(self.wheels.momentum[index])
-            self.wheel_saturations.append(WheelSaturation(self.time, index + 1, momentum))
 
     def _update_broad_phase(self, force: np.ndarray) -> None:
         """Find the free objects that could touch the assembly in the coming period."""

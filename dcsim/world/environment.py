@@ -148,3 +148,43 @@ class Propellant:
         self.delta_v += magnitude * dt * burnt / mass
         self.last_acceleration = force * (mean / mass)
         return thrusts
+
+    def draw(self, needed: np.ndarray) -> np.ndarray:
+        """Take the propellant that each physics step of the coming period needs, in turn,
+        until none is left.
+
+        Parameters
+        ----------
+        needed : ndarray (steps,)
+            Propellant each step's firing burns, kg.
+
+        Returns
+        -------
+        ndarray (steps,)
+            The fraction of each step's firing the propellant allowed: 1 until it runs
+            out, then the part left, then 0.
+        """
+        before = np.cumsum(needed) - needed
+        room = np.maximum(self.remaining - before, 0.0)
+        fractions = np.where(
+            needed > 0, np.minimum(room / np.where(needed > 0, needed, 1.0), 1.0), 1.0
+        )
+        used = float(needed @ fractions)
+        self.remaining = max(self.remaining - used, 0.0)
+        self.used += used
+        return fractions
+
+    def book_thrust(self, magnitudes: np.ndarray, mean_force: np.ndarray, mass: float) -> None:
+        """Book a period of thrust that :meth:`draw` paid for.
+
+        Parameters
+        ----------
+        magnitudes : ndarray (steps,)
+            The net thrust's magnitude in each physics step, N.
+        mean_force : ndarray (3,)
+            The mean net thrust over the period, world frame, N.
+        mass : float
+            Mass accelerated over the period, kg.
+        """
+        self.delta_v += float(magnitudes.sum()) * self._dt / mass
+        self.last_acceleration = mean_force / mass

@@ -1,4 +1,4 @@
-"""Reaction wheels: a free flyer's attitude actuators when ``robot.actuators`` is
+"""Reaction wheels: a free flyer's attitude actuators when ``robot.actuators`` lists
 ``reaction_wheels``.
 
 The wheels' spin is bookkept here; PyBullet sees only the base. Each control period
@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from dcsim.scenario.model import ReactionWheelsSpec, wheel_axes
+from dcsim.scenario.model import WheelSpec, wheel_axes
 
 _AT_LIMIT = 1.0 - 1e-12
 """Fraction of ``max_momentum`` from which a wheel counts as saturated (rounding)."""
@@ -68,7 +68,7 @@ class ReactionWheels:
 
     Parameters
     ----------
-    spec : ReactionWheelsSpec
+    wheels : list of WheelSpec
         The scenario's wheels: spin axes (body frame), inertias, torque and momentum
         limits.
 
@@ -84,16 +84,16 @@ class ReactionWheels:
         Largest ``|h_i| / max_momentum_i`` reached so far.
     """
 
-    def __init__(self, spec: ReactionWheelsSpec) -> None:
-        self.axes = wheel_axes(spec.wheels)
+    def __init__(self, wheels: list[WheelSpec]) -> None:
+        self.axes = wheel_axes(wheels)
         self._allocation = np.linalg.pinv(self.axes)
-        self._inertia = np.array([wheel.inertia for wheel in spec.wheels])
-        self._max_torque = np.array([wheel.max_torque for wheel in spec.wheels])
-        self._max_momentum = np.array([wheel.max_momentum for wheel in spec.wheels])
-        self.momentum = np.zeros(len(spec.wheels))
-        self.torque = np.zeros(len(spec.wheels))
-        self._command = np.zeros(len(spec.wheels))
-        self._saturated = np.zeros(len(spec.wheels), dtype=bool)
+        self._inertia = np.array([wheel.inertia for wheel in wheels])
+        self._max_torque = np.array([wheel.max_torque for wheel in wheels])
+        self._max_momentum = np.array([wheel.max_momentum for wheel in wheels])
+        self.momentum = np.zeros(len(wheels))
+        self.torque = np.zeros(len(wheels))
+        self._command = np.zeros(len(wheels))
+        self._saturated = np.zeros(len(wheels), dtype=bool)
         self.peak_fraction = 0.0
 
     @property
@@ -116,9 +116,32 @@ class ReactionWheels:
             clipped to its ``max_torque`` (momentum limits apply step by step,
             :meth:`step`).
         """
-        allocated = -(self._allocation @ np.asarray(body_torque, dtype=float))
-        self._command = np.clip(allocated, -self._max_torque, self._max_torque)
+        return self.command_wheels(-(self._allocation @ np.asarray(body_torque, dtype=float)))
+
+    def command_wheels(self, torques: np.ndarray) -> np.ndarray:
+        """Set each wheel's torque for the coming control period.
+
+        Parameters
+        ----------
+        torques : ndarray (N,)
+            Torque on each wheel about its spin axis, N·m (the base receives ``-A τ``).
+
+        Returns
+        -------
+        ndarray (N,)
+            The torques commanded, each clipped to its ``max_torque``, N·m.
+        """
+        torques = np.asarray(torques, dtype=float)
+        self._command = np.clip(torques, -self._max_torque, self._max_torque)
         return self._command
+
+    def momentum_fraction(self) -> float:
+        """The largest ``|h_i| / max_momentum_i`` of the wheels now."""
+        return float((np.abs(self.momentum) / self._max_momentum).max())
+
+    def body_momentum(self) -> np.ndarray:
+        """The wheels' angular momentum ``A h``, body frame, N·m·s (3,)."""
+        return self.axes @ self.momentum
 
     def step(
         self,

@@ -85,6 +85,10 @@ Every obstacle is taken as its bounding sphere (``ObjectTrack.radius``), as in t
 thesis: for a box or a cylinder (``ObjectTrack.shape``) this is conservative, the
 collector keeps clear of the sphere that holds the shape.
 
+When the reference gives an attitude, the shared attitude loop
+(:mod:`dcsim_plugins.controllers.attitude`) turns the base towards it; the translation
+law above does not depend on it.
+
 The gains are softer than a tracking loop's would be (``gain`` 0.03/s, ``response_time``
 4 s): every dodge is followed by a return to the reference, and the velocity loop feeds
 the navigation noise into thrust, both at a delta-v cost proportional to them.
@@ -95,6 +99,7 @@ the figures in docs/benchmarks.md.
 from __future__ import annotations
 
 import numpy as np
+from dcsim_plugins.controllers.attitude import AttitudeLoop, attitude_bandwidth, attitude_damping
 
 from dcsim.api import (
     Command,
@@ -238,6 +243,8 @@ class ElasticParams(PluginParams):
     escape_gain: float = quantity(
         0.2, unit="1/s", ge=0, description="Escape speed per metre inside the braking margin."
     )
+    attitude_bandwidth: float = attitude_bandwidth()
+    attitude_damping: float = attitude_damping()
 
 
 def perpendicular_repulsion(
@@ -460,6 +467,9 @@ class ElasticController(Controller):
     def reset(self, robot: RobotSpec) -> None:
         """Remember the robot's limits, mass and size (called again after a grab or release)."""
         self.robot = robot
+        self.attitude_loop = AttitudeLoop(
+            self.params.attitude_bandwidth, self.params.attitude_damping
+        )
 
     def move(
         self,
@@ -478,15 +488,20 @@ class ElasticController(Controller):
         reference: Reference,
         surroundings: Surroundings,
     ) -> Command:
-        """Force that flies the Move message's velocity; no torque."""
+        """Force that flies the Move message's velocity; torque towards the reference's
+        attitude, if it gives one."""
         move, heading = self._move(time, estimate, reference, surroundings)
-        return move.to_command(
+        command = move.to_command(
             heading,
             estimate.velocity,
             self.robot.mass,
             self.robot.max_force,
             self.params.response_time,
         )
+        if reference.attitude is None:
+            return command
+        torque = self.attitude_loop.torque(self.robot, estimate, reference)
+        return Command(force=command.force, torque=torque)
 
     def _move(
         self,

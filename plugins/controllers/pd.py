@@ -10,20 +10,19 @@ natural frequency ``bandwidth`` and damping ratio ``damping``, giving ``kp = ω�
 
 which equals ``F = m (kp e + kd ė + a_ref)`` while no limit is active.
 
-When the reference gives an attitude, an attitude loop of the same form acts on the
-rotation-vector error ``e_q = rotvec(q_ref ⊗ q⁻¹)`` (world frame), with its own
-pole-placed gains:
-
-    ω_cmd = ω_ref + (kp_q / kd_q) e_q,                   |ω_cmd| ≤ max_angular_rate
-    τ = I_w (kd_q (ω_cmd − ω) + α_ref) + ω × I_w ω,      |τ| ≤ max_torque
-
-with ``I_w = R I Rᵀ`` the inertia in the world frame. A reference without attitude
-leaves the attitude free: no torque is commanded.
+When the reference gives an attitude, the shared attitude loop
+(:mod:`dcsim_plugins.controllers.attitude`) turns the base towards it with its own
+pole-placed gains; a reference without attitude leaves the attitude free.
 """
 
 from __future__ import annotations
 
-import numpy as np
+from dcsim_plugins.controllers.attitude import (
+    AttitudeLoop,
+    attitude_bandwidth,
+    attitude_damping,
+    design_gains,
+)
 
 from dcsim.api import (
     Command,
@@ -34,13 +33,8 @@ from dcsim.api import (
     StateEstimate,
     Surroundings,
     clip_norm,
-    cross,
     hookimpl,
     quantity,
-    quaternion_conjugate,
-    quaternion_multiply,
-    rotate,
-    rotation_vector,
 )
 
 
@@ -51,36 +45,8 @@ class PDParams(PluginParams):
         0.2, unit="rad/s", gt=0, description="Natural frequency ω of the closed position loop."
     )
     damping: float = quantity(0.9, gt=0, le=5, description="Damping ratio ζ of the closed loop.")
-    attitude_bandwidth: float = quantity(
-        0.5, unit="rad/s", gt=0, description="Natural frequency of the closed attitude loop."
-    )
-    attitude_damping: float = quantity(
-        0.9, gt=0, le=5, description="Damping ratio of the closed attitude loop."
-    )
-
-
-def design_gains(bandwidth: float, damping: float) -> tuple[float, float]:
-    """Place the double integrator's poles at those of ``s² + 2ζω s + ω²``.
-
-    Parameters
-    ----------
-    bandwidth : float
-        Natural frequency ω, rad/s.
-    damping : float
-        Damping ratio ζ.
-
-    Returns
-    -------
-    kp, kd : float
-        Position gain (1/s²) and velocity gain (1/s), per unit mass.
-    """
-    import control  # imported here: it is slow to import and only needed at reset
-
-    a = np.array([[0.0, 1.0], [0.0, 0.0]])
-    b = np.array([[0.0], [1.0]])
-    poles = np.roots([1.0, 2.0 * damping * bandwidth, bandwidth**2])
-    gains = np.asarray(control.acker(a, b, poles)).ravel()
-    return float(gains[0]), float(gains[1])
+    attitude_bandwidth: float = attitude_bandwidth()
+    attitude_damping: float = attitude_damping()
 
 
 class PDController(Controller):
@@ -95,7 +61,7 @@ class PDController(Controller):
         """Design the gains and remember the robot's limits."""
         self.robot = robot
         self.kp, self.kd = design_gains(self.params.bandwidth, self.params.damping)
-        self.kp_attitude, self.kd_attitude = design_gains(
+        self.attitude_loop = AttitudeLoop(
             self.params.attitude_bandwidth, self.params.attitude_damping
         )
 
@@ -114,33 +80,9 @@ class PDController(Controller):
         force = clip_norm(self.robot.mass * acceleration, self.robot.max_force)
         if reference.attitude is None:
             return Command(force=force)
-        return Command(force=force, torque=self._torque(estimate, reference, reference.attitude))
-
-    def _torque(
-        self, estimate: StateEstimate, reference: Reference, attitude: np.ndarray
-    ) -> np.ndarray:
-        """The attitude loop's torque towards ``attitude`` (the reference's), world frame, N·m."""
-        error = rotation_vector(
-            quaternion_multiply(attitude, quaternion_conjugate(estimate.attitude))
+        return Command(
+            force=force, torque=self.attitude_loop.torque(self.robot, estimate, reference)
         )
-        limit = min(self.robot.max_angular_rate, reference.max_angular_rate)
-        rate = clip_norm(
-            reference.angular_velocity + (self.kp_attitude / self.kd_attitude) * error, limit
-        )
-        inertia = _world_inertia(self.robot.inertia, estimate.attitude)
-        omega = estimate.angular_velocity
-        wanted = self.kd_attitude * (rate - omega) + reference.angular_acceleration
-        torque = inertia @ wanted + cross(omega, inertia @ omega)
-        return clip_norm(torque, self.robot.max_torque)
-
-
-def _world_inertia(inertia: np.ndarray, attitude: np.ndarray) -> np.ndarray:
-    """``R I Rᵀ``: a body-frame inertia tensor expressed in the world frame, kg·m²."""
-    rotation = np.array([rotate(attitude, axis) for axis in _AXES]).T
-    return rotation @ inertia @ rotation.T
-
-
-_AXES = np.eye(3)
 
 
 @hookimpl

@@ -12,7 +12,6 @@ from dcsim.registry.discovery import PluginRegistry
 from dcsim.run.loop import Runner
 from dcsim.run.setup import setup_run
 from dcsim.testing import checks_for
-from tests.conftest import SHARES_DEFAULT_RUN
 
 TOLERANCE = 1e-9  # m, m/s: the FMU computes pd's gains in closed form, pd with acker
 
@@ -46,11 +45,11 @@ def test_keeps_the_controller_contracts(example_controller, check):
     check.run(example_controller)
 
 
-@SHARES_DEFAULT_RUN
-def test_example_pd_fmu_flies_the_default_mission_like_pd(pd_fmu, default_run):
-    runner, pd_summary, _ = default_run
-    pd_run = runner.recorder.telemetry()
-    fmu_summary, fmu_run = fly(with_fmu(pd_fmu))
+def test_example_pd_fmu_flies_the_default_mission_like_pd(pd_fmu):
+    # the example FMU is pd's translation loop alone: both fly with the attitude free
+    free = ["mission.attitude=free"]
+    pd_summary, pd_run = fly(free)
+    fmu_summary, fmu_run = fly([*free, *with_fmu(pd_fmu)])
     assert fmu_summary["status"] == "completed"
     assert fmu_summary["delivered"] == pd_summary["delivered"] == 4
     assert list(fmu_run["mode"]) == list(pd_run["mode"])

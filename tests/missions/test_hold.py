@@ -9,13 +9,13 @@ import pytest
 
 from dcsim.api import ScenarioError
 from dcsim.geometry import (
+    attitude_error,
     quaternion_conjugate,
     quaternion_from_rotation_vector,
     quaternion_multiply,
     rotation_vector,
 )
 from dcsim.missions.hold import HoldMission
-from dcsim.missions.hold.mission import attitude_error
 from dcsim.registry.discovery import PluginRegistry
 from dcsim.run.loop import Runner
 from dcsim.run.setup import setup_run

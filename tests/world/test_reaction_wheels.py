@@ -1,4 +1,4 @@
-"""Reaction wheels (``robot.actuators: {type: reaction_wheels}``): the scenario key, the
+"""Reaction wheels (``robot.actuators: {reaction_wheels: [...]}``): the scenario key, the
 allocation of the commanded torque, saturation, and the angular momentum of base plus
 wheels over a slew flown by the wheels alone."""
 
@@ -13,7 +13,7 @@ from dcsim.missions import mission_class
 from dcsim.run.recording import telemetry_columns
 from dcsim.run.scripting import run
 from dcsim.scenario.loader import dump_scenario, read_scenario
-from dcsim.scenario.model import IdealActuatorsSpec, wheel_axes
+from dcsim.scenario.model import ActuatorsSpec, wheel_axes
 from dcsim.world import World, WorldInputs
 from dcsim.world.pybullet_client import pb
 
@@ -34,7 +34,7 @@ def scenario(wheels=PYRAMID, duration=600.0, **robot):
         "name": "wheel slew",
         "world": {"frame": "geocentric", "duration": duration},
         "robot": {
-            "actuators": {"type": "reaction_wheels", "wheels": wheels},
+            "actuators": {"reaction_wheels": wheels},
             "initial": {
                 "attitude": [0.5, 0.5, 0.5, 0.5],
                 "angular_velocity": [0.01, -0.005, 0.008],
@@ -54,7 +54,8 @@ def problems(data):
 # ------------------------------------------------------------------ scenario
 def test_the_default_is_ideal_and_records_no_wheel_columns():
     robot = read_scenario(None).robot
-    assert robot.actuators == IdealActuatorsSpec() and robot.max_torque == 0.5
+    assert robot.actuators == ActuatorsSpec() and robot.actuators.ideal
+    assert robot.max_torque == 0.5
     default = read_scenario(None)
     mission = mission_class(default.mission.type).telemetry_columns(default)
     assert not [c for c in telemetry_columns(mission) if c.startswith("wheel")]
@@ -64,7 +65,9 @@ def test_wheels_fill_in_max_torque_and_survive_a_dump():
     loaded = read_scenario(scenario())
     # minimum-norm allocation: the skewed wheel takes a quarter of the load on the x axis
     # and the weakest direction is limited by the orthogonal wheels' rows of A⁺
-    rows = np.linalg.norm(np.linalg.pinv(wheel_axes(loaded.robot.actuators.wheels)), axis=1)
+    rows = np.linalg.norm(
+        np.linalg.pinv(wheel_axes(loaded.robot.actuators.reaction_wheels)), axis=1
+    )
     assert loaded.robot.max_torque == pytest.approx(0.05 / rows.max(), rel=1e-12)
     assert loaded.robot.max_torque > 0.05  # four wheels give more than one alone
     assert read_scenario(yaml.safe_load(dump_scenario(loaded))) == loaded
@@ -73,12 +76,12 @@ def test_wheels_fill_in_max_torque_and_survive_a_dump():
 @pytest.mark.parametrize(
     ("wheels", "robot", "path", "words"),
     [
-        (PYRAMID[:2], {}, "robot.actuators.wheels", "at least 3"),
-        ([wheel([1, 0, 0]), wheel([0, 1, 0]), wheel([1, 1, 0])], {}, "robot.actuators.wheels",
+        (PYRAMID[:2], {}, "robot.actuators.reaction_wheels", "at least 3"),
+        ([wheel([1, 0, 0]), wheel([0, 1, 0]), wheel([1, 1, 0])], {}, "robot.actuators.reaction_wheels",
          "span three dimensions"),
-        ([wheel([0, 0, 0]), *PYRAMID[1:]], {}, "robot.actuators.wheels[0].axis", "not be zero"),
+        ([wheel([0, 0, 0]), *PYRAMID[1:]], {}, "robot.actuators.reaction_wheels[0].axis", "not be zero"),
         ([*PYRAMID[:3], wheel([1, 1, 1], max_momentum=0)], {},
-         "robot.actuators.wheels[3].max_momentum", "greater than 0"),
+         "robot.actuators.reaction_wheels[3].max_momentum", "greater than 0"),
         (PYRAMID, {"max_torque": 1.0}, "robot.max_torque", "leave max_torque out"),
     ],
 )  # fmt: skip
@@ -88,11 +91,15 @@ def test_invalid_wheels_are_named_by_their_key(wheels, robot, path, words):
     assert found[0][0] == path and words in found[0][1], found
 
 
-def test_an_unknown_actuator_type_is_named():
+def test_a_max_torque_below_the_wheels_limit_is_kept():
+    assert read_scenario(scenario(max_torque=0.01)).robot.max_torque == 0.01
+
+
+def test_the_old_actuator_type_key_says_where_the_wheels_went():
     data = scenario()
-    data["robot"]["actuators"] = {"type": "thrusters"}
+    data["robot"]["actuators"] = {"type": "reaction_wheels", "wheels": PYRAMID}
     [(path, message)] = problems(data)
-    assert path == "robot.actuators" and "`ideal` or `reaction_wheels`" in message
+    assert path == "robot.actuators" and "`reaction_wheels: [...]`" in message
 
 
 # ------------------------------------------------------------------ allocation
@@ -154,8 +161,10 @@ def test_a_saturated_wheel_gives_no_more_torque_that_way_and_says_so_once():
         for _ in range(20):  # 2 s: the fourth wheel fills in about 0.35 s
             world.step(WorldInputs(torque=torque))
         assert wheels.momentum[3] == 0.004 and wheels.torque[3] == 0.0
-        assert [s.wheel for s in world.wheel_saturations] == [4]
-        assert world.wheel_saturations[0].momentum == 0.004
+        assert world.actuators is not None
+        saturations = [e for e in world.actuators.events if e.name == "wheel_saturated"]
+        assert [e.data["wheel"] for e in saturations] == [4]
+        assert saturations[0].data["momentum"] == 0.004
         # the other way it turns again and leaves the limit
         world.step(WorldInputs(torque=-torque))
         assert wheels.torque[3] < 0 and wheels.momentum[3] < 0.004

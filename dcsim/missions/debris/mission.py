@@ -15,6 +15,9 @@ enters sensor range, a grab fails, or a pickup can no longer be met. After
 ``max_plan_attempts`` "no path" answers of the path planner in a row the executer gives
 up and the run ends ``stopped`` with the planner's reason. Every mode change, plan,
 grab, release and path failure is reported through the ``emit`` callback as an event.
+
+Every reference holds the collector's initial attitude, fixed in the world frame
+(``mission.attitude: hold``, the default), or leaves it free (``free``).
 """
 
 from __future__ import annotations
@@ -89,6 +92,8 @@ class DebrisMission(Mission):
     ----------
     drop_point : DropPoint
         Where cargo is delivered (the section's ``drop_point``).
+    attitude : ndarray (4,) or None
+        The attitude every reference holds ``[x, y, z, w]``; None leaves it free.
     """
 
     type = "debris"
@@ -121,6 +126,7 @@ class DebrisMission(Mission):
         self.refusals = 0
         self.refusal = ""
         self.time = 0.0
+        self.attitude = _held_attitude(scenario, self.settings.attitude)
         self._handlers: dict[Mode, Callable[[], Reference]] = {
             Mode.LOCALIZE: self._localize,
             Mode.IDLE: self._idle,
@@ -152,8 +158,10 @@ class DebrisMission(Mission):
             before = self.state
             reference = self._step()
             if self.state is before or self.state not in _INSTANT:
-                return reference
-        return reference
+                break
+        if self.attitude is None:
+            return reference
+        return dataclasses.replace(reference, attitude=self.attitude)
 
     def telemetry(self, outputs: Mapping[str, Any]) -> dict[str, Any]:
         """Targets carried and delivered now."""
@@ -449,6 +457,15 @@ class DebrisMission(Mission):
                 self.emit("release", delivered=[], reason=result.reason)
                 self.release_refused = True
         return reference
+
+
+def _held_attitude(scenario: Scenario, attitude: str) -> np.ndarray | None:
+    """The attitude the collector holds ``[x, y, z, w]`` (its initial one, unit length),
+    or None when the mission leaves it free."""
+    if attitude == "free":
+        return None
+    initial = np.asarray(scenario.robot.initial.attitude, dtype=float)
+    return initial / np.linalg.norm(initial)
 
 
 def _ordered_steps(plan: Plan) -> list[PlanTask | DropVisit]:

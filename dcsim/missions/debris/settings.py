@@ -85,6 +85,13 @@ class DebrisMissionSection(MissionSettings):
         ge=0,
         description="Speed limit on the way to the drop point (DROP_SPEED); 0 for robot.max_speed.",
     )
+    attitude: Literal["hold", "free"] = Field(
+        "hold",
+        description="The collector's attitude reference: `hold` keeps the attitude it "
+        "starts with (robot.initial.attitude), fixed in the world frame (LVLH-fixed in an "
+        "`lvlh` world), through grabs and releases; `free` leaves it free (no torque is "
+        "asked for).",
+    )
     pickup_slack: float = quantity(
         30.0, unit="s", ge=0, description="How late a pickup may be before the plan is remade."
     )

@@ -11,13 +11,12 @@ is fed).
 
 from __future__ import annotations
 
-import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
-from dcsim.geometry import length
+from dcsim.geometry import attitude_error, length
 from dcsim.messages import Observations, Reference, StateEstimate
 from dcsim.missions.base import Emit, Mission, MissionWorld
 from dcsim.missions.hold.settings import HoldMissionSection
@@ -52,8 +51,8 @@ class HoldMission(Mission):
     Settings = HoldMissionSection
     roles = ("controller",)
     modes = ("HOLD",)
-    columns = ("position_error", "attitude_error", "tx", "ty", "tz")
-    units = {"position_error": "m", "attitude_error": "rad", "tx": "Nm", "ty": "Nm", "tz": "Nm"}
+    columns = ("position_error", "tx", "ty", "tz")
+    units = {"position_error": "m", "tx": "Nm", "ty": "Nm", "tz": "Nm"}
     summary_names = (
         "final_position_error_m",
         "final_attitude_error_deg",
@@ -95,15 +94,14 @@ class HoldMission(Mission):
         )
 
     def telemetry(self, outputs: Mapping[str, Any]) -> dict[str, Any]:
-        """True distance to the held position (m), angle to the held attitude (rad) and
-        the commanded torque (world frame, N·m)."""
+        """True distance to the held position (m) and the commanded torque (world frame,
+        N·m); every run records the angle to the held attitude (``attitude_error``)."""
         self.position_error = length(outputs["position"] - self.position)
         self.attitude_error = attitude_error(outputs["attitude"], self.attitude)
         self.max_position_error = max(self.max_position_error, self.position_error)
         tx, ty, tz = (float(v) for v in outputs["command"].torque)
         return {
             "position_error": self.position_error,
-            "attitude_error": self.attitude_error,
             "tx": tx,
             "ty": ty,
             "tz": tz,
@@ -123,27 +121,3 @@ class HoldMission(Mission):
             "final_attitude_error_deg": float(np.degrees(self.attitude_error)),
             "max_position_error_m": self.max_position_error,
         }
-
-
-def attitude_error(
-    attitude: Sequence[float] | np.ndarray, reference: Sequence[float] | np.ndarray
-) -> float:
-    """Angle of the rotation from ``attitude`` to ``reference``, rad in ``[0, π]``.
-
-    The angle of ``reference ⊗ attitude⁻¹`` from its vector and scalar parts (with
-    ``atan2``, exact near zero), in scalar arithmetic: it is evaluated every tick.
-
-    Parameters
-    ----------
-    attitude, reference : sequence of float or ndarray (4,)
-        Unit quaternions ``[x, y, z, w]``.
-    """
-    x, y, z, w = (float(v) for v in attitude)
-    a, b, c, d = (float(v) for v in reference)
-    vector = (
-        w * a - d * x - (b * z - c * y),
-        w * b - d * y - (c * x - a * z),
-        w * c - d * z - (a * y - b * x),
-    )
-    scalar = d * w + a * x + b * y + c * z
-    return 2.0 * math.atan2(math.hypot(*vector), abs(scalar))
