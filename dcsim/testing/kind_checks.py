@@ -662,6 +662,65 @@ def check_double_integrator(plugin_class: type[Plugin]) -> None:
         fail(f"after 1000 s it is {error:.3f} m from the reference moving at {speed:.4f} m/s")
 
 
+HARDWARE_TIME = 300.0
+"""Time the check on thrusters and wheels gives a controller, s."""
+
+
+@contract(
+    "flies_on_thrusters_and_wheels",
+    "a free flyer with 12 thrusters (minimum impulse bits) and 4 reaction wheels, 5 m off "
+    f"its reference and 20 deg off its attitude, flown in a real world for {HARDWARE_TIME:g} s: "
+    "every command gives none or one value per thruster and per wheel (body force and "
+    "torque are allocated to them, on-times and wheel torques are flown as given), and the "
+    "robot ends within 0.1 m of the reference (free-flyer controllers)",
+    kinds=("controller",),
+    robots=("free-flyer",),
+)
+def check_hardware(plugin_class: type[Plugin]) -> None:
+    from dcsim.scenario import read_scenario  # imported here: the world is heavy
+    from dcsim.world import World, WorldInputs
+
+    if not issubclass(plugin_class, Controller):
+        not_derived(plugin_class, Controller)
+    tilt = quaternion_from_rotation_vector(np.radians([20.0, 0.0, 0.0]))
+    scenario = read_scenario(
+        problems.hardware_scenario(HARDWARE_TIME, (4.0, -3.0, 0.0), tilt.tolist())
+    )
+    reference = Reference(time=0.0, position=np.zeros(3), attitude=np.array([0.0, 0.0, 0.0, 1.0]))
+    actuators = ActuatorCounts(thrusters=12, wheels=4)
+    with World(scenario, np.random.default_rng(0)) as world:
+        plugin = make(plugin_class)
+        plugin.reset(world.robot_spec())
+        while world.time < HARDWARE_TIME - 1e-9:
+            position, velocity, attitude, rate = world.base_state()
+            estimate = StateEstimate(
+                time=world.time,
+                position=position,
+                attitude=attitude,
+                velocity=velocity,
+                angular_velocity=rate,
+                converged=True,
+            )
+            what = f"thrusters and wheels at t = {world.time:g} s"
+            command = checked_answer(
+                "controller",
+                plugin.command(world.time, estimate, reference, Surroundings()),
+                what,
+                actuators,
+            )
+            world.step(
+                WorldInputs(
+                    force=command.force,
+                    torque=command.torque,
+                    thruster_on_times=command.thruster_on_times,
+                    wheel_torques=command.wheel_torques,
+                )
+            )
+        error = float(np.linalg.norm(world.base_state()[0]))
+    if error > 0.1:
+        fail(f"after {HARDWARE_TIME:g} s on thrusters and wheels it is {error:.3f} m off")
+
+
 CONVERGENCE_TIME = 15.0
 """Time the manipulator convergence check gives a controller, s."""
 

@@ -7,7 +7,9 @@ inputs. They are small enough to run in well under a second per check.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -399,3 +401,23 @@ def manipulator_ticks(empty: bool = False) -> list:
         )
         ticks.append((t, estimate, reference, Surroundings(obstacles)))
     return [manipulator_robot(), ticks]
+
+
+def hardware_scenario(
+    duration: float, position: Sequence[float], attitude: Sequence[float]
+) -> dict[str, Any]:
+    """A free flyer with the packaged ``default_hardware`` scenario's robot (12 thrusters in
+    six opposed couples, 4 wheels in a pyramid), alone in a frame without orbital forces,
+    starting at rest at ``position`` (m) with ``attitude`` ``[x, y, z, w]``, under a
+    ``hold`` mission of ``duration`` seconds."""
+    import yaml  # imported here: only this problem reads a scenario file
+
+    packaged = yaml.safe_load(packaged_scenario_path("default_hardware.yaml").read_text())
+    robot = packaged["robot"]
+    robot["initial"] = {"position": list(position), "attitude": list(attitude)}
+    return {
+        "name": "hardware",
+        "world": {"frame": "geocentric", "duration": duration},
+        "robot": robot,
+        "mission": {"type": "hold"},
+    }

@@ -7,8 +7,9 @@ with the controller's command:
   body axes with the attitude at the period's start, and, without reaction wheels, the
   commanded torque, both about the centre of mass of the robot and its cargo (the
   thrusters' positions are from the base's, so a force through a centre moved by cargo
-  needs a torque about the base's); a command's own ``thruster_on_times`` replace the
-  allocation. The
+  needs a torque about the base's), and modulated with the minimum impulse bit; a
+  command's own ``thruster_on_times`` replace the allocation (rounded to the minimum
+  impulse bit, with nothing carried over). The
   firing profile is cut where the propellant runs out. The world applies each physics
   step's body force and torque rotated by the attitude of that step.
 - **Reaction wheels** (:mod:`~dcsim.world.wheels`) take the commanded torque (a
@@ -210,7 +211,7 @@ class Actuators:
         else:
             firing = thrusters.allocate(body_force, body_torque)
             self._note_shortfall(time, firing.shortfall, body_force, body_torque)
-            on_times = firing.on_times
+            on_times = thrusters.modulate(firing.on_times)
         fractions = thrusters.step_fractions(on_times)
         needed = thrusters.propellant(fractions)
         fractions = fractions * propellant.draw(needed)[:, None]

@@ -17,9 +17,12 @@ give (the residual) and what the scaling took off are reported as a shortfall.
 
 **Pulse-width modulation.** Thruster ``i`` fires for ``t_i = T f_i / F_i`` from the
 period's start. An on-time shorter than the minimum impulse bit's ``t_min = MIB_i / F_i``
-is rounded to 0 below ``t_min / 2`` and to ``t_min`` from there. A physics step of
-length ``Δt`` only partly covered by a firing receives the covered fraction of the
-thrust, so the impulse over the period is exactly ``F_i t_i``.
+is rounded to 0 below ``t_min / 2`` and to ``t_min`` from there. What the rounding took
+off or added is carried into the thruster's next period (error feedback, at most
+``t_min`` either way), so a steady command too small for one pulse is met on average by
+pulses every few periods instead of never. A physics step of length ``Δt`` only partly
+covered by a firing receives the covered fraction of the thrust, so the impulse over
+the period is exactly ``F_i t_i``.
 
 **Propellant.** Thruster ``i`` burns ``F_i / (Isp_i g₀)`` kilograms per second of firing.
 """
@@ -42,7 +45,8 @@ class Firing:
     Attributes
     ----------
     on_times : ndarray (N,)
-        Each thruster's firing time from the period's start, s.
+        Each thruster's firing time from the period's start, s, before the minimum
+        impulse bit's rounding (:meth:`Thrusters.modulate`).
     shortfall : float
         Size of the part of the commanded wrench the thrusters cannot give (before the
         minimum impulse bit's rounding): ``|w − B f|`` with torque divided by the mean arm,
@@ -100,6 +104,7 @@ class Thrusters:
         steps = round(control_period / physics_step)
         self._step_starts = np.arange(steps) * physics_step
         self._dt = physics_step
+        self._carried = np.zeros(len(specs))
 
     @property
     def count(self) -> int:
@@ -119,7 +124,7 @@ class Thrusters:
         Returns
         -------
         Firing
-            On-times after the minimum impulse bit's rounding, and the shortfall.
+            On-times (not yet rounded to the minimum impulse bit) and the shortfall.
         """
         wanted = np.concatenate([force, np.asarray(torque, dtype=float) / self.arm])
         if not wanted.any():
@@ -130,7 +135,16 @@ class Thrusters:
             thrust = thrust / scale
         given = self._unit_wrench @ thrust
         shortfall = float(np.linalg.norm(wanted - given))
-        return Firing(self.round_on_times(self.period * thrust / self.max_thrust), shortfall)
+        return Firing(self.period * thrust / self.max_thrust, shortfall)
+
+    def modulate(self, on_times: np.ndarray) -> np.ndarray:
+        """The on-times fired this period: ``on_times`` plus what earlier periods' rounding
+        left over, rounded to the minimum impulse bit (:meth:`round_on_times`), s; the new
+        remainder, within ``±t_min``, is kept for the next period."""
+        wanted = np.clip(on_times + self._carried, 0.0, self.period)
+        fired = self.round_on_times(wanted)
+        self._carried = np.clip(wanted - fired, -self._min_on_time, self._min_on_time)
+        return fired
 
     def round_on_times(self, on_times: np.ndarray) -> np.ndarray:
         """On-times within ``[0, T]`` and rounded to the minimum impulse bit, s.

@@ -7,12 +7,22 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.optimize import nnls
 
+from dcsim.api import (
+    Command,
+    Controller,
+    RobotSpec,
+    quaternion_conjugate,
+    quaternion_multiply,
+    rotate,
+    rotation_vector,
+)
 from dcsim.errors import ScenarioError
-from dcsim.messages import Command
 from dcsim.registry.answers import ActuatorCounts, output_problem
 from dcsim.run.scripting import run
 from dcsim.scenario.loader import read_scenario
+from dcsim.testing import ContractViolation, checks_for
 from dcsim.world import World, WorldInputs
 from dcsim.world.environment import STANDARD_GRAVITY
 from dcsim.world.pybullet_client import pb
@@ -249,3 +259,52 @@ def test_the_default_mission_on_hardware_delivers_and_holds_its_attitude():
     assert summary["fuel_attitude_kg"] + summary["fuel_translation_kg"] == pytest.approx(
         summary["fuel_used_kg"]
     )
+
+
+# ------------------------------------------------------------------ conformance
+class DirectHardware(Controller):
+    """Commands each thruster's on-time and each wheel's torque itself: a PD law on the
+    position and the attitude, the body force shared among the thrusters by non-negative
+    least squares over the thrusters' geometry in the robot's spec, the body torque among
+    the wheels by their axes' pseudo-inverse."""
+
+    name = "direct-hardware"
+    summary = "PD on thruster on-times and wheel torques"
+
+    def reset(self, robot: RobotSpec) -> None:
+        self.robot, self.last = robot, None
+
+    def command(self, time, estimate, reference, surroundings) -> Command:
+        period = 0.1 if self.last is None else time - self.last
+        self.last = time
+        rotation = np.column_stack([rotate(estimate.attitude, axis) for axis in np.eye(3)])
+        error = reference.position - estimate.position
+        force = self.robot.mass * (0.04 * error - 0.4 * estimate.velocity)
+        duty = nnls(self.robot.thruster_forces, rotation.T @ force)[0]
+        angle = rotation_vector(
+            quaternion_multiply(reference.attitude, quaternion_conjugate(estimate.attitude))
+        )
+        torque = self.robot.inertia @ (
+            rotation.T @ (0.25 * angle - 0.9 * estimate.angular_velocity)
+        )
+        return Command(
+            thruster_on_times=np.clip(duty, 0.0, 1.0) * period,
+            wheel_torques=-np.linalg.pinv(self.robot.wheel_axes) @ torque,
+        )
+
+
+def hardware_check():
+    return next(c for c in checks_for("controller") if c.name == "flies_on_thrusters_and_wheels")
+
+
+def test_the_conformance_suite_flies_a_controller_that_commands_the_hardware_itself():
+    hardware_check().run(DirectHardware)
+
+
+def test_the_conformance_suite_refuses_on_times_for_thrusters_the_robot_lacks():
+    class TooFew(DirectHardware):
+        def command(self, time, estimate, reference, surroundings) -> Command:
+            return Command(thruster_on_times=np.zeros(5))
+
+    with pytest.raises(ContractViolation, match="returned 5 thruster on-times for a robot with 12"):
+        hardware_check().run(TooFew)
