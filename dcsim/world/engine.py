@@ -609,6 +609,9 @@ class World:
         exact, dt = self._exact_forces, self.physics_step
         parts = exact is not None and exact.has_parts
         wheels, actuators = self.wheels, self.actuators
+        if wheels is not None:  # the base's mass, and so its inertia, is set per period
+            ix, iy, iz = pb.getDynamicsInfo(body, -1, physicsClientId=client)[2]
+            moments = (ix, iy, iz)
         apply_torque = torque != (0.0, 0.0, 0.0) or profile is not None
         check_contacts = len(self._candidates) > 0
         dx, dy, dz = disturbance
@@ -640,7 +643,7 @@ class World:
             robot.apply_joint_torques(self._joint_torques)
             apply_force(body, -1, (fx, fy, fz), position, pb.WORLD_FRAME, client)
             if wheels is not None:
-                self._apply_wheel_torque(step_torque)
+                self._apply_wheel_torque(attitude, moments, step_torque)
             elif apply_torque:
                 pb.applyExternalTorque(body, -1, step_torque, pb.WORLD_FRAME, client)
             step(client)
@@ -651,19 +654,24 @@ class World:
                 started += self._detect_collisions()
         return started
 
-    def _apply_wheel_torque(self, disturbance: tuple[float, ...]) -> None:
+    def _apply_wheel_torque(
+        self,
+        attitude: tuple[float, ...],
+        moments: tuple[float, float, float],
+        disturbance: tuple[float, ...],
+    ) -> None:
         """Step the reaction wheels and put their reaction, with ``disturbance`` (world
-        frame, N·m), on the base for the coming physics step."""
+        frame, N·m), on the base for the coming physics step; ``attitude`` is the base's
+        now ``[x, y, z, w]``, ``moments`` its principal moments of inertia (kg·m²)."""
         assert self.wheels is not None
         client, body = self._client, self.robot_id
-        attitude = pb.getBasePositionAndOrientation(body, client)[1]
-        rotation = np.reshape(pb.getMatrixFromQuaternion(attitude), (3, 3))
-        angular = np.array(pb.getBaseVelocity(body, client)[1])
-        moments = np.array(pb.getDynamicsInfo(body, -1, physicsClientId=client)[2])
-        external = np.array(disturbance)
-        reaction = self.wheels.step(rotation, angular, moments, external, self.physics_step)
-        torque = (reaction + external).tolist()
-        pb.applyExternalTorque(body, -1, torque, pb.WORLD_FRAME, client)
+        rotation = pb.getMatrixFromQuaternion(attitude)
+        wx, wy, wz = pb.getBaseVelocity(body, client)[1]
+        dx, dy, dz = disturbance
+        rx, ry, rz = self.wheels.step(
+            rotation, (wx, wy, wz), moments, (dx, dy, dz), self.physics_step
+        )
+        pb.applyExternalTorque(body, -1, (rx + dx, ry + dy, rz + dz), pb.WORLD_FRAME, client)
 
     def _update_broad_phase(self, force: np.ndarray) -> None:
         """Find the free objects that could touch the assembly in the coming period."""

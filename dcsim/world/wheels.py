@@ -38,29 +38,57 @@ _AT_LIMIT = 1.0 - 1e-12
 _ITERATIONS = 3
 """Fixed-point iterations of the base's reaction per physics step."""
 
+Vec = tuple[float, float, float]
+"""A 3-vector in plain floats: each physics step's arithmetic on 3-vectors is done in
+floats, which at this size costs a tenth of numpy's."""
 
-def _rotation_matrix(rotation_vector: np.ndarray) -> np.ndarray:
-    """The rotation matrix of a rotation vector (axis times angle, rad), by Rodrigues."""
-    x, y, z = rotation_vector.tolist()
-    angle = math.sqrt(x * x + y * y + z * z)
-    if angle == 0.0:
-        return np.eye(3)
-    x, y, z = x / angle, y / angle, z / angle
-    s, c = math.sin(angle), 1.0 - math.cos(angle)
-    return np.array(
-        [
-            [1.0 - c * (y * y + z * z), c * x * y - s * z, c * x * z + s * y],
-            [c * x * y + s * z, 1.0 - c * (x * x + z * z), c * y * z - s * x],
-            [c * x * z - s * y, c * y * z + s * x, 1.0 - c * (x * x + y * y)],
-        ]
+Matrix = tuple[float, ...]
+"""A 3×3 rotation matrix as nine floats, row by row (PyBullet's
+``getMatrixFromQuaternion``)."""
+
+
+def _turn(m: Matrix, v: Vec) -> Vec:
+    """``M v``."""
+    x, y, z = v
+    return (
+        m[0] * x + m[1] * y + m[2] * z,
+        m[3] * x + m[4] * y + m[5] * z,
+        m[6] * x + m[7] * y + m[8] * z,
     )
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a × b`` of two 3-vectors (np.cross costs ten times more at this size)."""
-    ax, ay, az = a.tolist()
-    bx, by, bz = b.tolist()
-    return np.array([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx])
+def _turn_back(m: Matrix, v: Vec) -> Vec:
+    """``Mᵀ v``."""
+    x, y, z = v
+    return (
+        m[0] * x + m[3] * y + m[6] * z,
+        m[1] * x + m[4] * y + m[7] * z,
+        m[2] * x + m[5] * y + m[8] * z,
+    )
+
+
+def _cross(a: Vec, b: Vec) -> Vec:
+    """``a × b``."""
+    ax, ay, az = a
+    bx, by, bz = b
+    return (ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx)
+
+
+def _rotated(rotation_vector: Vec, v: Vec) -> Vec:
+    """``v`` turned by a rotation vector (axis times angle, rad), by Rodrigues' formula."""
+    x, y, z = rotation_vector
+    angle = math.sqrt(x * x + y * y + z * z)
+    if angle == 0.0:
+        return v
+    k = (x / angle, y / angle, z / angle)
+    c, s = math.cos(angle), math.sin(angle)
+    across = _cross(k, v)
+    along = (k[0] * v[0] + k[1] * v[1] + k[2] * v[2]) * (1.0 - c)
+    return (
+        v[0] * c + across[0] * s + k[0] * along,
+        v[1] * c + across[1] * s + k[1] * along,
+        v[2] * c + across[2] * s + k[2] * along,
+    )
 
 
 class ReactionWheels:
@@ -76,25 +104,34 @@ class ReactionWheels:
     ----------
     axes : ndarray (3, N)
         Unit spin axes as columns, body frame.
-    momentum : ndarray (N,)
-        Each wheel's angular momentum about its spin axis, N·m·s.
-    torque : ndarray (N,)
-        Each wheel's torque over the last physics step, N·m (what the base reacts to).
     peak_fraction : float
         Largest ``|h_i| / max_momentum_i`` reached so far.
     """
 
     def __init__(self, wheels: list[WheelSpec]) -> None:
         self.axes = wheel_axes(wheels)
+        self._axis_list = [tuple(axis) for axis in self.axes.T.tolist()]
         self._allocation = np.linalg.pinv(self.axes)
         self._inertia = np.array([wheel.inertia for wheel in wheels])
         self._max_torque = np.array([wheel.max_torque for wheel in wheels])
         self._max_momentum = np.array([wheel.max_momentum for wheel in wheels])
-        self.momentum = np.zeros(len(wheels))
-        self.torque = np.zeros(len(wheels))
-        self._command = np.zeros(len(wheels))
-        self._saturated = np.zeros(len(wheels), dtype=bool)
+        self._limits = self._max_momentum.tolist()
+        self._h = [0.0] * len(wheels)
+        self._tau = [0.0] * len(wheels)
+        self._command_list = [0.0] * len(wheels)
+        self._saturated = [False] * len(wheels)
         self.peak_fraction = 0.0
+
+    @property
+    def momentum(self) -> np.ndarray:
+        """Each wheel's angular momentum about its spin axis, N·m·s (N,)."""
+        return np.array(self._h)
+
+    @property
+    def torque(self) -> np.ndarray:
+        """Each wheel's torque over the last physics step, N·m (N,): what the base reacts
+        to."""
+        return np.array(self._tau)
 
     @property
     def speeds(self) -> np.ndarray:
@@ -132,68 +169,102 @@ class ReactionWheels:
             The torques commanded, each clipped to its ``max_torque``, N·m.
         """
         torques = np.asarray(torques, dtype=float)
-        self._command = np.clip(torques, -self._max_torque, self._max_torque)
-        return self._command
+        command = np.clip(torques, -self._max_torque, self._max_torque)
+        self._command_list = command.tolist()
+        return command
 
     def momentum_fraction(self) -> float:
         """The largest ``|h_i| / max_momentum_i`` of the wheels now."""
-        return float((np.abs(self.momentum) / self._max_momentum).max())
+        return max(abs(h) / limit for h, limit in zip(self._h, self._limits, strict=True))
 
     def body_momentum(self) -> np.ndarray:
         """The wheels' angular momentum ``A h``, body frame, N·m·s (3,)."""
-        return self.axes @ self.momentum
+        return np.array(self._body(self._h))
 
     def step(
         self,
-        rotation: np.ndarray,
-        angular_velocity: np.ndarray,
-        moments: np.ndarray,
-        torque: np.ndarray,
+        rotation: Matrix,
+        angular_velocity: Vec,
+        moments: Vec,
+        torque: Vec,
         dt: float,
-    ) -> np.ndarray:
+    ) -> Vec:
         """One physics step: the wheels' torques, their momenta, the base's reaction.
 
         Parameters
         ----------
-        rotation : ndarray (3, 3)
-            The base's body-to-world rotation at the step's start.
-        angular_velocity : ndarray (3,)
+        rotation : tuple of 9 float
+            The base's body-to-world rotation at the step's start, row by row.
+        angular_velocity : tuple of 3 float
             The base's angular velocity at the step's start, world frame, rad/s.
-        moments : ndarray (3,)
+        moments : tuple of 3 float
             The base's principal moments of inertia about its centre of mass, along
             the body axes, kg·m².
-        torque : ndarray (3,)
+        torque : tuple of 3 float
             Any other torque on the base over the step, world frame, N·m.
         dt : float
             The physics step, s.
 
         Returns
         -------
-        ndarray (3,)
+        tuple of 3 float
             The wheels' torque on the base over the step, world frame, N·m.
         """
-        low = (-self._max_momentum - self.momentum) / dt
-        high = (self._max_momentum - self.momentum) / dt
-        self.torque = np.clip(self._command, np.minimum(low, 0.0), np.maximum(high, 0.0))
-        before = rotation @ (self.axes @ self.momentum)
-        self.momentum = np.clip(
-            self.momentum + self.torque * dt, -self._max_momentum, self._max_momentum
-        )
-        fraction = np.abs(self.momentum) / self._max_momentum
-        self.peak_fraction = max(self.peak_fraction, float(fraction.max()))
-        body_after = self.axes @ self.momentum
-        spin = rotation @ (moments * (angular_velocity @ rotation))  # I ω, world frame
+        torques, momenta, peak = [], [], self.peak_fraction
+        for command, h, limit in zip(self._command_list, self._h, self._limits, strict=True):
+            low, high = min((-limit - h) / dt, 0.0), max((limit - h) / dt, 0.0)
+            tau = low if command < low else high if command > high else command
+            h_next = h + tau * dt
+            h_next = -limit if h_next < -limit else limit if h_next > limit else h_next
+            torques.append(tau)
+            momenta.append(h_next)
+            peak = max(peak, abs(h_next) / limit)
+        before = _turn(rotation, self._body(self._h))
+        body_after = self._body(momenta)
+        self._tau, self._h, self.peak_fraction = torques, momenta, peak
+        ix, iy, iz = moments
 
-        def rate_change(applied: np.ndarray) -> np.ndarray:
+        def rate_change(applied: Vec) -> Vec:
             """I⁻¹ applied Δt, world frame, rad/s."""
-            return rotation @ ((applied @ rotation) / moments) * dt
+            bx, by, bz = _turn_back(rotation, applied)
+            return _turn(rotation, (bx / ix * dt, by / iy * dt, bz / iz * dt))
 
-        free_rate = angular_velocity + rate_change(torque - _cross(angular_velocity, spin))
-        reaction = -(rotation @ (self.axes @ self.torque)) - _cross(angular_velocity, before)
+        wx, wy, wz = _turn_back(rotation, angular_velocity)
+        spin = _turn(rotation, (ix * wx, iy * wy, iz * wz))  # I ω, world frame
+        gyroscopic = _cross(angular_velocity, spin)
+        free = rate_change(
+            (torque[0] - gyroscopic[0], torque[1] - gyroscopic[1], torque[2] - gyroscopic[2])
+        )
+        free_rate = (
+            angular_velocity[0] + free[0],
+            angular_velocity[1] + free[1],
+            angular_velocity[2] + free[2],
+        )
+        wheel = _turn(rotation, self._body(torques))
+        carried = _cross(angular_velocity, before)
+        reaction = (-wheel[0] - carried[0], -wheel[1] - carried[1], -wheel[2] - carried[2])
+        after = _turn(rotation, body_after)
         for _ in range(_ITERATIONS):
-            turned = _rotation_matrix((free_rate + rate_change(reaction)) * dt) @ rotation
-            reaction = (before - turned @ body_after) / dt
+            change = rate_change(reaction)
+            turn = (
+                (free_rate[0] + change[0]) * dt,
+                (free_rate[1] + change[1]) * dt,
+                (free_rate[2] + change[2]) * dt,
+            )
+            turned = _rotated(turn, after)
+            reaction = (
+                (before[0] - turned[0]) / dt,
+                (before[1] - turned[1]) / dt,
+                (before[2] - turned[2]) / dt,
+            )
         return reaction
+
+    def _body(self, values: list[float]) -> Vec:
+        """``A v`` for per-wheel values ``v`` (momenta or torques), body frame."""
+        x = y = z = 0.0
+        for (ax, ay, az), value in zip(self._axis_list, values, strict=True):
+            x, y, z = x + ax * value, y + ay * value, z + az * value
+        return (x, y, z)
 
     def newly_saturated(self) -> list[int]:
         """Indices of the wheels that reached their momentum limit since the last call.
@@ -201,12 +272,18 @@ class ReactionWheels:
         A wheel is saturated while ``|h_i|`` is at ``max_momentum``; it is reported once
         per such episode.
         """
-        at_limit = np.abs(self.momentum) >= _AT_LIMIT * self._max_momentum
-        started = np.flatnonzero(at_limit & ~self._saturated)
+        at_limit = [
+            abs(h) >= _AT_LIMIT * limit for h, limit in zip(self._h, self._limits, strict=True)
+        ]
+        started = [
+            i
+            for i, (now, was) in enumerate(zip(at_limit, self._saturated, strict=True))
+            if now and not was
+        ]
         self._saturated = at_limit
-        return started.tolist()
+        return started
 
     def delivered(self) -> np.ndarray:
         """The torque the wheels gave the base over the last physics step, ``-A τ``,
         body frame, N·m (3,): the commanded torque where no limit cut it."""
-        return -(self.axes @ self.torque)
+        return -np.array(self._body(self._tau))
