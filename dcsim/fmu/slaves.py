@@ -41,8 +41,15 @@ from dcsim.fmu.variables import (
     JOINT_RATE,
     JOINT_TORQUE,
     QUATERNION,
+    THRUSTER_DUTY,
+    THRUSTER_ON_TIME,
+    THRUSTERS_DIRECT,
+    WHEEL_MOMENTUM,
+    WHEEL_TORQUE,
+    WHEELS_DIRECT,
     FmuVariable,
     closed_loop_variables,
+    hardware,
     joint_count,
     plant_variables,
 )
@@ -201,10 +208,10 @@ class _ScenarioSlave(Fmi2Slave):
         return cls(
             name,
             causality=Fmi2Causality.input,
-            variability=Fmi2Variability.continuous,
+            variability=Fmi2Variability.continuous if cls is Real else Fmi2Variability.discrete,
             description=description,
             getter=getter,
-            setter=lambda value: self._set_input(name, value),
+            setter=lambda value: self._set_input(variable, value),
         )
 
     def _set_parameter(self, name: str, value: Any) -> None:
@@ -213,13 +220,14 @@ class _ScenarioSlave(Fmi2Slave):
             return
         self.values[name] = value
 
-    def _set_input(self, name: str, value: float) -> None:
+    def _set_input(self, variable: FmuVariable, value: float | bool) -> None:
+        name = variable.name
         if not math.isfinite(value):
             self._refused[name] = value
             self.log(f"input {name} = {value} refused: inputs must be finite", Fmi2Status.error)
             return
         self._refused.pop(name, None)
-        self.values[name] = float(value)
+        self.values[name] = variable.type(value)
 
     def _overrides(self) -> list[str]:
         """The parameters as scenario overrides (each parameter name is a scenario key)."""
@@ -309,6 +317,12 @@ class _ScenarioSlave(Fmi2Slave):
         values["collisions"] = int(out["collisions"])
         values["fuel_used"] = float(out["fuel_used"])
         values["delta_v"] = float(out["delta_v"])
+        for i, momentum in enumerate(out.get("wheel_momentum", ()), 1):
+            values[WHEEL_MOMENTUM.format(i)] = float(momentum)
+        for i, duty in enumerate(out.get("thruster_duty", ()), 1):
+            values[THRUSTER_DUTY.format(i)] = float(duty)
+        if "attitude_fuel_used" in values:  # a robot with thrusters
+            values["attitude_fuel_used"] = world.attitude_fuel_used
         self._publish_more(out)
 
     def _publish_more(self, out: dict[str, Any]) -> None:
@@ -338,6 +352,8 @@ class ClosedLoopSlave(_ScenarioSlave):
 
     Each control period is one :meth:`Runner.advance` with the disturbance inputs; the
     outputs at a period boundary equal the telemetry row ``dcsim run`` records there.
+    The runner keeps its rows in memory only until they are published: the attitude
+    error is read from the last one.
     """
 
     def _declare(self) -> list[FmuVariable]:
@@ -345,7 +361,7 @@ class ClosedLoopSlave(_ScenarioSlave):
 
     def _open(self) -> None:
         setup = setup_run(self.scenario_path, self._overrides(), seed=self.values["seed"])
-        self.runner = Runner(setup, keep_rows=False)
+        self.runner = Runner(setup, keep_rows=True)
         self.runner.open()
 
     def _advance(self) -> None:
@@ -369,6 +385,10 @@ class ClosedLoopSlave(_ScenarioSlave):
         assert estimate is not None  # every decided control period makes one
         values["localisation_error"] = float(np.linalg.norm(out["position"] - estimate.position))
         values["run_status"] = _RUN_STATUS[runner.status]
+        rows = runner.recorder.rows  # none since the last publication once the run has ended
+        if rows and "attitude_error" in values:  # a robot with the hardware
+            values["attitude_error"] = float(rows[-1]["attitude_error"])
+        rows.clear()
 
     def _healthy(self) -> None:
         if self.runner.status == "failed":
@@ -380,8 +400,13 @@ class ClosedLoopSlave(_ScenarioSlave):
 
 
 class PlantSlave(_ScenarioSlave):
-    """The world alone as an FMU: force and torque (and a manipulator's joint torques) in,
-    true state and sensors out.
+    """The world alone as an FMU: force and torque (and a manipulator's joint torques, a
+    free flyer's thruster on-times and wheel torques) in, true state and sensors out.
+
+    The on-times replace the allocation of force (and of torque without wheels) while
+    ``thrusters_direct`` is true, the wheel torques that of torque while
+    ``wheels_direct`` is; otherwise they are not used, and a non-zero one is warned of
+    once.
 
     Attributes
     ----------
@@ -409,14 +434,34 @@ class PlantSlave(_ScenarioSlave):
         )
         self.world = World(scenario, component_rng(scenario.world.seed, "world"))
         self._collided = False
+        self._ignored: set[str] = set()
+        thrusters, wheels = hardware(scenario.robot)
+        self._thrusters, self._wheels = len(thrusters), len(wheels)
 
     def _advance(self) -> None:
         inputs = WorldInputs(
             force=self._vector("force"),
             torque=self._vector("torque"),
             joint_torques=self._joint_torques(),
+            thruster_on_times=self._direct(THRUSTERS_DIRECT, THRUSTER_ON_TIME, self._thrusters),
+            wheel_torques=self._direct(WHEELS_DIRECT, WHEEL_TORQUE, self._wheels),
         )
         self._collided |= bool(self.world.step(inputs))
+
+    def _direct(self, switch: str, name: str, count: int) -> np.ndarray:
+        """The ``count`` inputs ``name.format(i)`` while the Boolean input ``switch`` is
+        true, else none (the world allocates); non-zero ones unused are warned of once."""
+        given = np.array([self.values[name.format(i)] for i in range(1, count + 1)])
+        if count and self.values[switch]:
+            return given
+        if given.any() and switch not in self._ignored:
+            self._ignored.add(switch)
+            self.log(
+                f"{name.format('i')} inputs are not used while {switch} is false: set "
+                f"{switch} to true to fly them",
+                Fmi2Status.warning,
+            )
+        return np.zeros(0)
 
     def _world(self) -> World:
         return self.world

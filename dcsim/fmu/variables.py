@@ -11,6 +11,13 @@ A manipulator's FMUs have, besides its base's state, its joints' angles and rate
 end effector's position; its plant FMU takes the joint torques (``joint_torque[i]``).
 Only a robot that carries targets (a free flyer) has the ``captured`` and ``delivered``
 counts.
+
+A free flyer with ``robot.actuators`` hardware has, in both FMUs, each reaction wheel's
+momentum (``wheel_momentum[i]``) and each thruster's duty cycle (``thruster_duty[i]``),
+and with thrusters the propellant burnt for attitude; its closed-loop FMU also outputs
+the attitude error, its plant FMU takes per-thruster on-times and per-wheel torques,
+used while ``thrusters_direct`` and ``wheels_direct`` are true. Without the hardware
+none of these exist.
 """
 
 from __future__ import annotations
@@ -18,7 +25,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from dcsim.missions import mission_class
-from dcsim.scenario.model import ManipulatorSection, RobotSection, Scenario
+from dcsim.scenario.model import (
+    ManipulatorSection,
+    RobotSection,
+    Scenario,
+    ThrusterSpec,
+    WheelSpec,
+)
 
 AXES = ("x", "y", "z")
 QUATERNION = ("x", "y", "z", "w")
@@ -29,6 +42,20 @@ JOINT_RATE = "joint[{}].rate"
 """FMI name of joint i's rate, rad/s."""
 JOINT_TORQUE = "joint_torque[{}]"
 """FMI name of joint i's commanded torque (a plant input), N·m."""
+THRUSTER_ON_TIME = "thruster_on_time[{}]"
+"""FMI name of thruster i's on-time from the control period's start (a plant input), s;
+i from 1 in the order of ``robot.actuators.thrusters``."""
+WHEEL_TORQUE = "wheel_torque[{}]"
+"""FMI name of reaction wheel i's torque about its spin axis (a plant input), N·m; i
+from 1 in the order of ``robot.actuators.reaction_wheels``."""
+THRUSTERS_DIRECT = "thrusters_direct"
+"""FMI name of the plant input that makes the on-time inputs fire the thrusters."""
+WHEELS_DIRECT = "wheels_direct"
+"""FMI name of the plant input that makes the wheel torque inputs drive the wheels."""
+WHEEL_MOMENTUM = "wheel_momentum[{}]"
+"""FMI name of reaction wheel i's angular momentum about its spin axis, N·m·s."""
+THRUSTER_DUTY = "thruster_duty[{}]"
+"""FMI name of the fraction of the last control period thruster i fired."""
 
 
 @dataclass(frozen=True)
@@ -137,6 +164,128 @@ def joint_torque_inputs(robot: RobotSection | ManipulatorSection) -> list[FmuVar
     ]
 
 
+def hardware(
+    robot: RobotSection | ManipulatorSection,
+) -> tuple[list[ThrusterSpec], list[WheelSpec]]:
+    """The thrusters and the reaction wheels of a scenario's robot, in the scenario's
+    order (none for ideal force and torque, and for a manipulator)."""
+    if not isinstance(robot, RobotSection):
+        return [], []
+    return list(robot.actuators.thrusters or ()), list(robot.actuators.reaction_wheels or ())
+
+
+def hardware_inputs(scenario: Scenario) -> list[FmuVariable]:
+    """The plant's per-thruster on-times (s) and per-wheel torques (N·m), each set with
+    the Boolean that makes them replace the allocation of ``force`` and ``torque``."""
+    thrusters, wheels = hardware(scenario.robot)
+    period = scenario.world.control_period
+    inputs = [
+        FmuVariable(
+            THRUSTER_ON_TIME.format(i),
+            "input",
+            float,
+            "s",
+            f"Firing time of thruster {i} from the control period's start, flown while "
+            f"{THRUSTERS_DIRECT} is true (clipped to [0, {period:g}] s; below "
+            f"{spec.min_impulse_bit / spec.max_thrust:g} s rounded to 0 or to that, "
+            "the minimum impulse bit).",
+        )
+        for i, spec in enumerate(thrusters, 1)
+    ]
+    if thrusters:
+        inputs.append(
+            FmuVariable(
+                THRUSTERS_DIRECT,
+                "input",
+                bool,
+                "",
+                f"True: the {THRUSTER_ON_TIME.format('i')} inputs fire the thrusters; false "
+                "(the default): "
+                f"{'force (and unloading) is' if wheels else 'force and torque are'} "
+                "allocated to them.",
+            )
+        )
+    inputs += [
+        FmuVariable(
+            WHEEL_TORQUE.format(i),
+            "input",
+            float,
+            "N.m",
+            f"Torque of reaction wheel {i} about its spin axis, flown while {WHEELS_DIRECT} "
+            f"is true; the base receives the reaction (clipped to ±{spec.max_torque:g} N.m).",
+        )
+        for i, spec in enumerate(wheels, 1)
+    ]
+    if wheels:
+        inputs.append(
+            FmuVariable(
+                WHEELS_DIRECT,
+                "input",
+                bool,
+                "",
+                f"True: the {WHEEL_TORQUE.format('i')} inputs drive the wheels; false (the "
+                "default): torque is allocated to them.",
+            )
+        )
+    return inputs
+
+
+def hardware_outputs(robot: RobotSection | ManipulatorSection) -> list[FmuVariable]:
+    """Both FMUs' outputs of the hardware: each wheel's momentum (N·m·s), each thruster's
+    duty cycle over the last control period, and with thrusters the propellant burnt for
+    attitude (kg)."""
+    thrusters, wheels = hardware(robot)
+    outputs = [
+        FmuVariable(
+            WHEEL_MOMENTUM.format(i),
+            "output",
+            float,
+            "N.m.s",
+            f"Angular momentum of reaction wheel {i} about its spin axis "
+            f"(limit ±{spec.max_momentum:g} N.m.s).",
+        )
+        for i, spec in enumerate(wheels, 1)
+    ]
+    outputs += [
+        FmuVariable(
+            THRUSTER_DUTY.format(i),
+            "output",
+            float,
+            "",
+            f"Fraction of the last control period thruster {i} fired.",
+        )
+        for i in range(1, len(thrusters) + 1)
+    ]
+    if thrusters:
+        outputs.append(
+            FmuVariable(
+                "attitude_fuel_used",
+                "output",
+                float,
+                "kg",
+                "Propellant burnt for attitude: what each period's firing burnt beyond what "
+                "its mean force alone needs (part of fuel_used).",
+            )
+        )
+    return outputs
+
+
+def _attitude_error(robot: RobotSection | ManipulatorSection) -> list[FmuVariable]:
+    """The closed loop's attitude error, with the hardware only."""
+    if not any(hardware(robot)):
+        return []
+    return [
+        FmuVariable(
+            "attitude_error",
+            "output",
+            float,
+            "rad",
+            "Angle from the attitude to the mission reference's (the telemetry's "
+            "attitude_error); NaN while the reference leaves the attitude free.",
+        )
+    ]
+
+
 def _torque_clipping(limit: float | None) -> str:
     return "unlimited" if limit is None else f"clipped to ±{limit:g} N.m, the link's torque_limit"
 
@@ -170,6 +319,8 @@ def closed_loop_variables(scenario: Scenario) -> list[FmuVariable]:
         FmuVariable("collisions", "output", int, "", "Collisions so far."),
         FmuVariable("fuel_used", "output", float, "kg", "Propellant used."),
         FmuVariable("delta_v", "output", float, "m/s", "Delta-v spent."),
+        *hardware_outputs(robot),
+        *_attitude_error(robot),
         FmuVariable(
             "localisation_error", "output", float, "m", "Distance from the estimate to the truth."
         ),
@@ -228,6 +379,7 @@ def plant_variables(scenario: Scenario, beacons: int) -> list[FmuVariable]:
         *_vector("force", "input", "N", "Commanded thrust (clipped to robot.max_force)."),
         *_vector("torque", "input", "N.m", "Commanded torque (clipped to robot.max_torque)."),
         *joint_torque_inputs(robot),
+        *hardware_inputs(scenario),
         *_state(robot),
         FmuVariable("mass", "output", float, "kg", mass),
         *ranges,
@@ -239,6 +391,7 @@ def plant_variables(scenario: Scenario, beacons: int) -> list[FmuVariable]:
         FmuVariable("collisions", "output", int, "", "Collisions so far."),
         FmuVariable("fuel_used", "output", float, "kg", "Propellant used."),
         FmuVariable("delta_v", "output", float, "m/s", "Delta-v spent."),
+        *hardware_outputs(robot),
     ]
 
 

@@ -13,7 +13,12 @@ from fmpy.validation import validate_fmu
 from dcsim.errors import ScenarioError
 from dcsim.fmu.export import export_fmu
 from dcsim.fmu.instance import FmuCallError, FmuError, FmuInstance
-from dcsim.fmu.variables import closed_loop_variables, plant_variables
+from dcsim.fmu.variables import (
+    closed_loop_variables,
+    hardware_inputs,
+    hardware_outputs,
+    plant_variables,
+)
 from dcsim.missions.debris import DebrisMission
 from dcsim.run.loop import Runner
 from dcsim.run.seeding import component_rng
@@ -133,17 +138,30 @@ def test_docs_list_the_variables():
 
 
 def test_every_free_flyer_scenario_has_the_default_scenarios_variables():
-    def signature(variables):
-        return [(v.name, v.causality, v.type) for v in variables]
+    """A free flyer with thrusters or wheels has their variables besides
+    (scenarios/default_hardware.yaml)."""
+
+    def signature(variables, hardware):
+        return [(v.name, v.causality, v.type) for v in variables if v.name not in hardware]
 
     default = read_scenario()
-    expected = signature(closed_loop_variables(default)), signature(plant_variables(default, 4))
+    expected = (
+        signature(closed_loop_variables(default), ()),
+        signature(plant_variables(default, 4), ()),
+    )
     scenarios = sorted((Path(__file__).resolve().parents[2] / "scenarios").glob("*.yaml"))
     free_flyers = [s for s in map(read_scenario, scenarios) if s.robot.type == "free-flyer"]
     assert {s.mission.type for s in free_flyers} == {"debris", "transfer"}
+    with_hardware = []
     for scenario in free_flyers:
-        got = signature(closed_loop_variables(scenario)), signature(plant_variables(scenario, 4))
+        added = [*hardware_inputs(scenario), *hardware_outputs(scenario.robot)]
+        hardware = {v.name for v in added} | ({"attitude_error"} if added else set())
+        closed, plant = closed_loop_variables(scenario), plant_variables(scenario, 4)
+        got = signature(closed, hardware), signature(plant, hardware)
         assert got == expected, scenario.name
+        assert {v.name for v in [*closed, *plant]} >= hardware, scenario.name
+        with_hardware += [scenario.name] if added else []
+    assert "default_hardware" in with_hardware
 
 
 @SHARES_DEFAULT_RUN
