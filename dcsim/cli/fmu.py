@@ -27,8 +27,8 @@ def fmu_group() -> None:
 @click.option(
     "--plant-only",
     is_flag=True,
-    help="Export the world alone: force and torque (and a manipulator's joint torques) in, "
-    "true state and sensors out.",
+    help="Export the world alone: force and torque (and a manipulator's joint torques, a "
+    "free flyer's thruster on-times and wheel torques) in, true state and sensors out.",
 )
 @click.option(
     "--beacons",
@@ -48,8 +48,11 @@ def fmu_export_command(
     The closed-loop FMU runs the whole scenario (world, localiser, planners, controller,
     mission) with disturbance force and torque as inputs; --plant-only exports the world
     alone. A manipulator's FMUs also output its joint angles and rates and its end
-    effector, and its plant FMU takes the joint torques. The resolved scenario travels
-    inside the FMU; importing it needs Python with dcsim installed.
+    effector, and its plant FMU takes the joint torques. A free flyer's thrusters and
+    reaction wheels add their duty cycles and momenta (and the attitude error to the
+    closed loop), and the plant takes their on-times and torques one by one. The
+    resolved scenario travels inside the FMU; importing it needs Python with dcsim
+    installed.
     """
     from dcsim.fmu.export import export_fmu
     from dcsim.fmu.variables import DEFAULT_BEACONS

@@ -43,8 +43,9 @@ def export_fmu(
     out : str or Path
         FMU file to write (``.fmu``).
     plant_only : bool
-        Export the world alone (force/torque, and a manipulator's joint torques, in; state
-        and sensors out) instead of the closed loop.
+        Export the world alone (force/torque, and a manipulator's joint torques or a free
+        flyer's thruster on-times and wheel torques, in; state and sensors out) instead of
+        the closed loop.
     overrides : sequence of str
         ``key.path=value`` overrides applied before the scenario is resolved.
     beacons : int

@@ -2,7 +2,8 @@
 
 The free flyer's tables are those of the packaged default scenario; the manipulator's
 table is generated from the repository's reach scenario
-(``scenarios/space_manipulator_reach.yaml``, six joints).
+(``scenarios/space_manipulator_reach.yaml``, six joints), the thrusters' and the
+wheels' table from ``scenarios/default_hardware.yaml`` (twelve thrusters, four wheels).
 """
 
 from __future__ import annotations
@@ -14,17 +15,21 @@ from dcsim.fmu.variables import (
     DEFAULT_BEACONS,
     FmuVariable,
     arm_outputs,
+    attitude_error_output,
     closed_loop_variables,
+    hardware_inputs,
+    hardware_outputs,
     joint_torque_inputs,
     plant_variables,
 )
 from dcsim.report.docgen import update_block
 from dcsim.scenario import read_scenario
 
-MANIPULATOR_SCENARIO = (
-    Path(__file__).resolve().parents[2] / "scenarios" / "space_manipulator_reach.yaml"
-)
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+MANIPULATOR_SCENARIO = SCENARIOS / "space_manipulator_reach.yaml"
 """The scenario the manipulator's table is generated from."""
+HARDWARE_SCENARIO = SCENARIOS / "default_hardware.yaml"
+"""The scenario the table of the thrusters' and the wheels' variables is generated from."""
 
 
 def variables_table(variables: list[FmuVariable]) -> str:
@@ -44,6 +49,8 @@ BEGIN_PLANT = "<!-- begin: plant variables (make docs) -->"
 END_PLANT = "<!-- end: plant variables -->"
 BEGIN_MANIPULATOR = "<!-- begin: manipulator variables (make docs) -->"
 END_MANIPULATOR = "<!-- end: manipulator variables -->"
+BEGIN_HARDWARE = "<!-- begin: hardware variables (make docs) -->"
+END_HARDWARE = "<!-- end: hardware variables -->"
 
 
 def generated_blocks() -> list[tuple[str, str, str]]:
@@ -52,10 +59,13 @@ def generated_blocks() -> list[tuple[str, str, str]]:
     The closed-loop and plant tables of the default scenario (the plant with K =
     :data:`DEFAULT_BEACONS`), and the variables a manipulator's FMUs add (the plant's
     joint torque inputs, then the joint and end-effector outputs of both variants) for
-    :data:`MANIPULATOR_SCENARIO`.
+    :data:`MANIPULATOR_SCENARIO`, and those thrusters and wheels add (the plant's inputs,
+    the outputs of both variants, the closed loop's attitude error) for
+    :data:`HARDWARE_SCENARIO`.
     """
     default = read_scenario()
     robot = read_scenario(MANIPULATOR_SCENARIO).robot
+    hardware = read_scenario(HARDWARE_SCENARIO)
     return [
         (BEGIN_CLOSED, END_CLOSED, variables_table(closed_loop_variables(default))),
         (BEGIN_PLANT, END_PLANT, variables_table(plant_variables(default, DEFAULT_BEACONS))),
@@ -63,6 +73,17 @@ def generated_blocks() -> list[tuple[str, str, str]]:
             BEGIN_MANIPULATOR,
             END_MANIPULATOR,
             variables_table([*joint_torque_inputs(robot), *arm_outputs(robot)]),
+        ),
+        (
+            BEGIN_HARDWARE,
+            END_HARDWARE,
+            variables_table(
+                [
+                    *hardware_inputs(hardware),
+                    *hardware_outputs(hardware.robot),
+                    *attitude_error_output(hardware.robot),
+                ]
+            ),
         ),
     ]
 

@@ -186,9 +186,7 @@ def hardware_inputs(scenario: Scenario) -> list[FmuVariable]:
             float,
             "s",
             f"Firing time of thruster {i} from the control period's start, flown while "
-            f"{THRUSTERS_DIRECT} is true (clipped to [0, {period:g}] s; below "
-            f"{spec.min_impulse_bit / spec.max_thrust:g} s rounded to 0 or to that, "
-            "the minimum impulse bit).",
+            f"{THRUSTERS_DIRECT} is true ({_on_time_rounding(spec, period)}).",
         )
         for i, spec in enumerate(thrusters, 1)
     ]
@@ -212,7 +210,8 @@ def hardware_inputs(scenario: Scenario) -> list[FmuVariable]:
             float,
             "N.m",
             f"Torque of reaction wheel {i} about its spin axis, flown while {WHEELS_DIRECT} "
-            f"is true; the base receives the reaction (clipped to ±{spec.max_torque:g} N.m).",
+            f"is true; the base receives the reaction (clipped to ±{spec.max_torque:g} N.m "
+            "and to the momentum limit).",
         )
         for i, spec in enumerate(wheels, 1)
     ]
@@ -228,6 +227,19 @@ def hardware_inputs(scenario: Scenario) -> list[FmuVariable]:
             )
         )
     return inputs
+
+
+def _on_time_rounding(spec: ThrusterSpec, period: float) -> str:
+    """What the world does with an on-time of the thruster ``spec`` (s): clips it to the
+    control period and rounds one shorter than the minimum impulse bit's."""
+    clipped = f"clipped to [0, {period:g}] s"
+    shortest = spec.min_impulse_bit / spec.max_thrust
+    if shortest == 0.0:
+        return clipped
+    return (
+        f"{clipped}; shorter than the minimum impulse bit's {shortest:g} s: flown as 0 "
+        f"below {shortest / 2:g} s, else as {shortest:g} s"
+    )
 
 
 def hardware_outputs(robot: RobotSection | ManipulatorSection) -> list[FmuVariable]:
@@ -270,8 +282,9 @@ def hardware_outputs(robot: RobotSection | ManipulatorSection) -> list[FmuVariab
     return outputs
 
 
-def _attitude_error(robot: RobotSection | ManipulatorSection) -> list[FmuVariable]:
-    """The closed loop's attitude error, with the hardware only."""
+def attitude_error_output(robot: RobotSection | ManipulatorSection) -> list[FmuVariable]:
+    """The closed loop's attitude error (rad), for a robot with thrusters or reaction
+    wheels only."""
     if not any(hardware(robot)):
         return []
     return [
@@ -320,7 +333,7 @@ def closed_loop_variables(scenario: Scenario) -> list[FmuVariable]:
         FmuVariable("fuel_used", "output", float, "kg", "Propellant used."),
         FmuVariable("delta_v", "output", float, "m/s", "Delta-v spent."),
         *hardware_outputs(robot),
-        *_attitude_error(robot),
+        *attitude_error_output(robot),
         FmuVariable(
             "localisation_error", "output", float, "m", "Distance from the estimate to the truth."
         ),
