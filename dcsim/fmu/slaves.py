@@ -352,8 +352,6 @@ class ClosedLoopSlave(_ScenarioSlave):
 
     Each control period is one :meth:`Runner.advance` with the disturbance inputs; the
     outputs at a period boundary equal the telemetry row ``dcsim run`` records there.
-    The runner keeps its rows in memory only until they are published: the attitude
-    error is read from the last one.
     """
 
     def _declare(self) -> list[FmuVariable]:
@@ -361,7 +359,7 @@ class ClosedLoopSlave(_ScenarioSlave):
 
     def _open(self) -> None:
         setup = setup_run(self.scenario_path, self._overrides(), seed=self.values["seed"])
-        self.runner = Runner(setup, keep_rows=True)
+        self.runner = Runner(setup, keep_rows=False)
         self.runner.open()
 
     def _advance(self) -> None:
@@ -385,10 +383,8 @@ class ClosedLoopSlave(_ScenarioSlave):
         assert estimate is not None  # every decided control period makes one
         values["localisation_error"] = float(np.linalg.norm(out["position"] - estimate.position))
         values["run_status"] = _RUN_STATUS[runner.status]
-        rows = runner.recorder.rows  # none since the last publication once the run has ended
-        if rows and "attitude_error" in values:  # a robot with the hardware
-            values["attitude_error"] = float(rows[-1]["attitude_error"])
-        rows.clear()
+        if "attitude_error" in values and "attitude_error" in out:  # hardware, run going on
+            values["attitude_error"] = float(out["attitude_error"])
 
     def _healthy(self) -> None:
         if self.runner.status == "failed":

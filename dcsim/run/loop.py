@@ -166,7 +166,8 @@ class Runner:
     mode : str or None
         The mission mode decided for the current control period.
     outputs : dict of str to object
-        The world's outputs (:meth:`World.outputs`) at the current time.
+        The world's outputs (:meth:`World.outputs`) at the current time; while the run
+        goes on, also the last ``command`` and ``attitude_error`` (rad, as recorded).
     """
 
     def __init__(
@@ -561,6 +562,7 @@ class Runner:
         row.update(zip(SIGMA_COLUMNS, _position_sigmas(estimate.covariance), strict=True))
         held = None if self._reference is None else self._reference.attitude
         row["attitude_error"] = math.nan if held is None else attitude_error(out["attitude"], held)
+        out["attitude_error"] = row["attitude_error"]
         if self._wheel_columns:
             momenta = out["wheel_momentum"].tolist()
             row.update(zip(self._wheel_columns, momenta, strict=True))

@@ -191,7 +191,8 @@ class Actuators:
             The commanded force (N) and torque (N·m), world frame, within the limits;
             the torque goes to the thrusters only without wheels.
         on_times : ndarray (N,) or empty
-            The command's own on-times, s; empty: allocate.
+            The command's own on-times, s; empty: allocate (and, with wheels, unload them
+            when their momentum says so; given on-times leave unloading to the command).
         propellant : Propellant
             The propellant, which this firing spends.
         mass : float
@@ -204,11 +205,13 @@ class Actuators:
         thrusters = self.thrusters
         assert thrusters is not None
         body_force = rotation.T @ force
-        body_torque = rotation.T @ torque if self.wheels is None else self._unloading_torque(time)
-        body_torque = body_torque + np.cross(centre, body_force)
         if len(on_times):
             on_times = thrusters.round_on_times(on_times)
         else:
+            body_torque = (
+                rotation.T @ torque if self.wheels is None else self._unloading_torque(time)
+            )
+            body_torque = body_torque + np.cross(centre, body_force)
             firing = thrusters.allocate(body_force, body_torque)
             self._note_shortfall(time, firing.shortfall, body_force, body_torque)
             on_times = thrusters.modulate(firing.on_times)
