@@ -72,6 +72,14 @@ def stacked(telemetry: Mapping[str, np.ndarray], names: Sequence[str]) -> np.nda
     return np.column_stack([np.asarray(telemetry[name], dtype=float) for name in names])
 
 
+def numbered_columns(telemetry: Mapping[str, np.ndarray], prefix: str) -> list[str]:
+    """The telemetry columns ``prefix1``, ``prefix2``, … in the order of their numbers."""
+    names = [
+        name for name in telemetry if name.startswith(prefix) and name[len(prefix) :].isdigit()
+    ]
+    return sorted(names, key=lambda name: int(name[len(prefix) :]))
+
+
 def save(figure: Figure, path: Path) -> None:
     """Write ``figure`` to ``path`` (PNG) and free it."""
     try:
@@ -115,6 +123,13 @@ def stack_layout(
         top=1.0 - top / height,
         hspace=gap / panel,
     )
+
+
+def label_time(axes: Sequence[Any]) -> None:
+    """Name the time axis (s) under the bottom panel of stacked ``axes`` only."""
+    for axis in axes[:-1]:
+        axis.set_xlabel("")
+    axes[-1].set_xlabel("time [s]")
 
 
 def kilometre_ticks() -> FuncFormatter:

@@ -30,7 +30,13 @@ import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first
 import numpy as np  # noqa: E402
 
 from dcsim.missions.reach.settings import ReachMissionSection  # noqa: E402
-from dcsim.report.plots import FrameAxes, plots_folder, save, stacked  # noqa: E402
+from dcsim.report.plots import (  # noqa: E402
+    FrameAxes,
+    numbered_columns,
+    plots_folder,
+    save,
+    stacked,
+)
 from dcsim.scenario.model import Scenario  # noqa: E402
 
 SIGHT_LIMIT_DEG = 60.0
@@ -176,7 +182,7 @@ def _torques(axis, telemetry: Mapping[str, np.ndarray]) -> None:
     times = telemetry["time"]
     base = np.linalg.norm(stacked(telemetry, ("tx", "ty", "tz")), axis=1)
     axis.plot(times, base, color="k", lw=1.4, label="base |τ|")
-    for i, name in enumerate(_numbered(telemetry, "joint_torque_"), 1):
+    for i, name in enumerate(numbered_columns(telemetry, "joint_torque_"), 1):
         axis.plot(times, telemetry[name], lw=0.9, label=f"joint {i}")
     thrust = np.linalg.norm(stacked(telemetry, ("fx", "fy", "fz")), axis=1)
     axis.plot(times, thrust, color="0.5", ls="--", lw=1.0, label="base thrust |F| [N]")
@@ -196,19 +202,11 @@ def _momentum(linear_axis, angular_axis, telemetry: Mapping[str, np.ndarray]) ->
         axis.set(ylabel=f"change [{unit}]", title=f"Total {what} momentum: change from the start")
 
 
-def _numbered(telemetry: Mapping[str, np.ndarray], prefix: str) -> list[str]:
-    """The columns ``prefix1``, ``prefix2``, … in order."""
-    names = [
-        name for name in telemetry if name.startswith(prefix) and name[len(prefix) :].isdigit()
-    ]
-    return sorted(names, key=lambda name: int(name[len(prefix) :]))
-
-
 def _joints_figure(
     path: Path, telemetry: Mapping[str, np.ndarray], path_end: float | None, title: str
 ) -> None:
     times = telemetry["time"]
-    joints = _numbered(telemetry, "joint_")
+    joints = numbered_columns(telemetry, "joint_")
     figure, axes = plt.subplots(2, 1, figsize=(11, 9), sharex=True)
     colours = plt.get_cmap("tab10")
     for i, name in enumerate(joints):
