@@ -88,6 +88,12 @@ def save(figure: Figure, path: Path) -> None:
         plt.close(figure)
 
 
+def top_title(figure: Figure, text: str) -> None:
+    """Title ``figure`` with ``text`` 0.2 in under its top edge, however tall it is (the
+    legend :func:`top_legend` draws under it keeps clear)."""
+    figure.suptitle(text, y=1.0 - 0.2 / figure.get_figheight())
+
+
 def top_legend(figure: Figure, handles: Sequence[Any]) -> float:
     """Draw a legend of ``handles`` in one row under ``figure``'s title (nothing without
     handles); return the height the title and the legend take at the top, in."""

@@ -45,6 +45,7 @@ from dcsim.report.plots import (  # noqa: E402
     stack_layout,
     stacked,
     top_legend,
+    top_title,
     write_plots,
 )
 from dcsim.scenario.model import Scenario  # noqa: E402
@@ -267,7 +268,7 @@ def timeline_figure(
     label_time(axes)
     for axis in axes:
         axis.grid(alpha=0.3)
-    figure.suptitle(f"{scenario.name}: timeline")
+    top_title(figure, f"{scenario.name}: timeline")
     stack_layout(figure, len(axes), top_legend(figure, handles), left=1.3, right=max(right, 0.3))
     return figure
 

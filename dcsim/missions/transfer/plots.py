@@ -53,6 +53,7 @@ from dcsim.report.plots import (  # noqa: E402
     stack_layout,
     stacked,
     thrust_panel,
+    top_title,
 )
 from dcsim.scenario.model import Scenario  # noqa: E402
 from dcsim.world.objects import build_objects  # noqa: E402
@@ -442,7 +443,7 @@ def timeline_figure(
         title="mode (shaded; a dash-dot line marks each change) and the planner's answers",
         bbox_to_anchor=(0.5, 1.0 - TITLE_ROOM / figure.get_figheight()),
     )
-    figure.suptitle(f"{scenario.name}: timeline")
+    top_title(figure, f"{scenario.name}: timeline")
     stack_layout(figure, len(axes), top=TITLE_ROOM + 2 * LEGEND_ROW, right=max(right, 1.3))
     return figure
 
