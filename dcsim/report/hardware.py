@@ -32,6 +32,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first)
 import numpy as np  # noqa: E402
+from matplotlib.colors import ListedColormap  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
 from dcsim.report.plots import TRUE_COLOUR, numbered_columns  # noqa: E402
@@ -43,8 +44,9 @@ PANEL_HEIGHT = 2.2
 LEGEND_RIGHT = 1.6
 """Room kept right of the panels for the wheels' legend and the duty cycles' colour bar, in."""
 
-DUTY_COLOURS = "Oranges"
-"""Matplotlib colour map of the duty cycles, 0 to 1."""
+DUTY_COLOURS = ListedColormap(plt.get_cmap("Oranges")(np.linspace(0.3, 1.0, 256)))
+"""Colours of the duty cycles, 0 to 1: matplotlib's Oranges from its 30 % on, so that a
+short firing still shows against the blank of an idle thruster."""
 
 Panel = Callable[[Any], None]
 """Draws one panel on the matplotlib Axes it is given."""
