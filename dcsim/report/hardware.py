@@ -140,7 +140,10 @@ def attitude_error_panel(axis, telemetry: Mapping[str, np.ndarray]) -> None:
     error = np.degrees(np.asarray(telemetry["attitude_error"], dtype=float))
     axis.plot(telemetry["time"], error, color=TRUE_COLOUR, lw=1.0)
     axis.set(ylabel="error [deg]", title="Attitude error: angle to the reference's attitude")
-    axis.set_ylim(bottom=0.0, top=max(1.2 * float(np.nanmax(error)), 1e-3))
+    peak = float(np.nanmax(error))
+    axis.set_ylim(
+        bottom=0.0, top=1.2 * peak if peak > 0.0 else 1e-3
+    )  # the tick labels say how small
 
 
 def wheel_panel(axis, telemetry: Mapping[str, np.ndarray], actuators: ActuatorsSpec | None) -> None:
