@@ -131,7 +131,7 @@ def stack_layout(
     )
 
 
-def label_time(axes: Sequence[Any]) -> None:
+def label_time(axes: Sequence[Any] | np.ndarray) -> None:
     """Name the time axis (s) under the bottom panel of stacked ``axes`` only."""
     for axis in axes[:-1]:
         axis.set_xlabel("")
