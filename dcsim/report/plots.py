@@ -72,12 +72,26 @@ def stacked(telemetry: Mapping[str, np.ndarray], names: Sequence[str]) -> np.nda
     return np.column_stack([np.asarray(telemetry[name], dtype=float) for name in names])
 
 
+def numbered_columns(telemetry: Mapping[str, np.ndarray], prefix: str) -> list[str]:
+    """The telemetry columns ``prefix1``, ``prefix2``, … in the order of their numbers."""
+    names = [
+        name for name in telemetry if name.startswith(prefix) and name[len(prefix) :].isdigit()
+    ]
+    return sorted(names, key=lambda name: int(name[len(prefix) :]))
+
+
 def save(figure: Figure, path: Path) -> None:
     """Write ``figure`` to ``path`` (PNG) and free it."""
     try:
         figure.savefig(path, dpi=DPI)
     finally:
         plt.close(figure)
+
+
+def top_title(figure: Figure, text: str) -> None:
+    """Title ``figure`` with ``text`` 0.2 in under its top edge, however tall it is (the
+    legend :func:`top_legend` draws under it keeps clear)."""
+    figure.suptitle(text, y=1.0 - 0.2 / figure.get_figheight())
 
 
 def top_legend(figure: Figure, handles: Sequence[Any]) -> float:
@@ -115,6 +129,13 @@ def stack_layout(
         top=1.0 - top / height,
         hspace=gap / panel,
     )
+
+
+def label_time(axes: Sequence[Any] | np.ndarray) -> None:
+    """Name the time axis (s) under the bottom panel of stacked ``axes`` only."""
+    for axis in axes[:-1]:
+        axis.set_xlabel("")
+    axes[-1].set_xlabel("time [s]")
 
 
 def kilometre_ticks() -> FuncFormatter:
@@ -243,14 +264,12 @@ def thrust_panel(
     magnitude, with ±``max_force`` (N) marked."""
     times = telemetry["time"]
     force = stacked(telemetry, ("fx", "fy", "fz"))
-    _components(axis, times, force, names)
-    axis.plot(times, np.linalg.norm(force, axis=1), color="k", lw=1.2, label="|F|")
+    vector_lines(axis, times, force, names, "|F|")
     _limit_line(axis, max_force, "max_force")
     axis.axhline(-max_force, color="k", ls="--", lw=0.8)
     bound = 1.2 * max(max_force, float(np.max(np.abs(force))))
     axis.set_ylim(-bound, bound)
     axis.set(ylabel="thrust [N]", title="Commanded thrust")
-    axis.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.0, 0.5))
 
 
 def attitude_change(telemetry: Mapping[str, np.ndarray]) -> np.ndarray:
@@ -275,15 +294,33 @@ def rate_panel(axis, telemetry: Mapping[str, np.ndarray], names: Sequence[str]) 
     magnitude, deg/s."""
     times = telemetry["time"]
     rate = np.degrees(stacked(telemetry, ("wx", "wy", "wz")))
-    _components(axis, times, rate, names)
-    axis.plot(times, np.linalg.norm(rate, axis=1), color="k", lw=1.2, label="|ω|")
+    vector_lines(axis, times, rate, names, "|ω|")
     axis.set(ylabel="rate [deg/s]", title="Angular rate (world frame)")
-    axis.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.0, 0.5))
 
 
-def _components(axis, times: np.ndarray, values: np.ndarray, names: Sequence[str]) -> None:
+def vector_lines(
+    axis, times: np.ndarray, values: np.ndarray, names: Sequence[str], magnitude: str
+) -> None:
+    """Vectors over time on ``axis``: their components along the world axes ``names``
+    and their magnitude (labelled ``magnitude``), named in a legend right of the panel.
+
+    Parameters
+    ----------
+    axis : matplotlib Axes
+        The panel.
+    times : ndarray (N,)
+        Times, s.
+    values : ndarray (N, 3)
+        The vectors, world frame, in the panel's unit.
+    names : sequence of str
+        The world axes' names.
+    magnitude : str
+        The magnitude's label, e.g. ``|F|``.
+    """
     for column, name, colour in zip(values.T, names, _COMPONENTS, strict=True):
         axis.plot(times, column, color=colour, lw=0.8, label=name)
+    axis.plot(times, np.linalg.norm(values, axis=1), color="k", lw=1.2, label=magnitude)
+    axis.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.0, 0.5))
 
 
 # ---------------------------------------------------------------------- debris pictures

@@ -113,9 +113,12 @@ def test_attitude_error_is_the_rotation_angle_for_either_sign():
     assert attitude_error(tiny, [0.0, 0.0, 0.0, 1.0]) == pytest.approx(1e-10, rel=1e-6)
 
 
-def test_a_hold_run_draws_the_pictures_every_run_has_and_no_debris_ones(tmp_path, registry):
+def test_a_hold_run_draws_its_timeline_the_pictures_every_run_has_and_no_debris_ones(
+    tmp_path, registry
+):
     path = tmp_path / "slew.yaml"
     path.write_text(textwrap.dedent(SLEW.format(duration=2.0, goal=GOAL, hold="true")))
     out = tmp_path / "run"
     Runner(setup_run(path, registry=registry), out).run()
-    assert sorted(p.name for p in (out / "plots").iterdir()) == ["estimation.png", "motion.png"]
+    names = sorted(p.name for p in (out / "plots").iterdir())
+    assert names == ["estimation.png", "motion.png", "timeline.png"]

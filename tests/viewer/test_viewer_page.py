@@ -28,6 +28,7 @@ CHROMIUM_ARGS = [
     "--disable-component-update",
     "--disable-sync",
 ]
+EIGHTH_TURN_Z = [0.0, 0.0, float(np.sin(np.pi / 8)), float(np.cos(np.pi / 8))]
 LOAD_TIMEOUT_MS = 120_000  # plotly.js alone takes seconds to start on a loaded two-core machine
 
 
@@ -269,3 +270,82 @@ def test_without_plotly_the_page_is_refused_saying_how_to_install_it(monkeypatch
     monkeypatch.setitem(sys.modules, "plotly.offline", None)  # import fails
     with pytest.raises(ViewError, match="needs the plotly package: pip install plotly"):
         write_view(run_dir)
+
+
+@pytest.fixture(scope="module")
+def hardware_visit(browser, tmp_path_factory):
+    """default_hardware's first 30 s, the base turned 45° about z from the start (so the
+    plumes turn with it), run with ``dcsim run --view`` and open in a tab."""
+    import subprocess
+
+    from tests.conftest import DCSIM, REPO
+
+    out = tmp_path_factory.mktemp("viewed") / "hardware"
+    scenario = REPO / "scenarios" / "default_hardware.yaml"
+    done = subprocess.run(
+        [str(DCSIM), "run", str(scenario), "--out", str(out), "--set", "world.duration=30"]
+        + ["--set", f"robot.initial.attitude={EIGHTH_TURN_Z}", "--view"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    visit = Visit(browser, out / PAGE_NAME)
+    yield visit
+    visit.tab.close()
+
+
+def plume_pixels(visit) -> int:
+    """Pixels of the plumes' amber with every other trace hidden."""
+    visit.tab.evaluate(
+        """() => {
+            const plot = document.getElementById('plot');
+            const others = plot.data.map((_, i) => i)
+                .filter(i => plot.data[i].name !== 'thruster plumes');
+            return Plotly.restyle(plot, {visible: false}, others);
+        }"""
+    )
+    pixels = visit.plot_pixels()
+    red, green, blue = pixels[..., 0], pixels[..., 1], pixels[..., 2]
+    return int(np.sum((red > 200) & (np.abs(green - 166) < 40) & (blue < 80)))
+
+
+def test_firing_thrusters_draw_plumes_against_their_force_turning_with_the_base(hardware_visit):
+    from scipy.spatial.transform import Rotation
+
+    tab = hardware_visit.tab
+    scene = tab.evaluate("JSON.parse(document.getElementById('dcsim-scene').textContent)")
+    thrusters = scene["thrusters"]
+    duty = np.array(thrusters["duty"])
+    frames = len(scene["times"])
+    busiest = int(np.argmax((duty > 0).sum(axis=1)))
+    hardware_visit.show(busiest / (frames - 1))
+    plumes = tab.evaluate(
+        "(() => { const t = document.getElementById('plot').data"
+        ".find(t => t.name === 'thruster plumes'); return [t.x, t.y, t.z]; })()"
+    )
+    points = np.array(plumes, dtype=float).T.reshape(-1, 3, 3)  # start, tip, gap
+    firing = np.flatnonzero(duty[busiest] > 0)
+    assert len(firing) >= 2 and len(points) == len(firing)
+    assert np.isnan(points[:, 2]).all()
+    robot = next(g for g in scene["bodies"] if g["trace"]["name"] == "robot")["members"][0]
+    base = Rotation.from_quat(robot["turns"][busiest])
+    assert base.magnitude() == pytest.approx(np.pi / 4, abs=0.01)  # the plumes turn with it
+    centre = np.array(robot["positions"][busiest])
+    at = np.array(thrusters["positions"])[firing]
+    direction = np.array(thrusters["directions"])[firing]
+    length = thrusters["length"][0] + thrusters["length"][1] * duty[busiest, firing]
+    np.testing.assert_allclose(points[:, 0], centre + base.apply(at), atol=1e-4)
+    tip = centre + base.apply(at - length[:, None] * direction)
+    np.testing.assert_allclose(points[:, 1], tip, atol=1e-4)  # the scene keeps 0.1 mm
+    assert plume_pixels(hardware_visit) > 50
+    hardware_visit.show(0.0)  # nothing fired before the first frame
+    assert (
+        tab.evaluate(
+            "document.getElementById('plot').data.find(t => t.name === 'thruster plumes').x.length"
+        )
+        == 0
+    )
+    assert plume_pixels(hardware_visit) == 0
+    assert hardware_visit.readout("thrusters firing") == "none"
+    assert hardware_visit.errors == []

@@ -246,3 +246,49 @@ def test_a_transfer_shows_its_planned_trajectory_goal_and_shaped_obstacles(trans
     assert len(obstacles["members"]) == len(transfer_records.scenario.obstacles)
     assert {"distance to goal", "tracking error"} <= {r["label"] for r in scene["readouts"]}
     assert not scene["stages"]
+
+
+# ---------------------------------------------------------------- a free flyer on hardware
+
+
+@pytest.fixture(scope="module")
+def hardware_records(tmp_path_factory):
+    """default_hardware's first 30 s: twelve thrusters fire, four wheels spin."""
+    out = tmp_path_factory.mktemp("hardware")
+    return run_into(out, REPO / "scenarios" / "default_hardware.yaml", "world.duration=30")
+
+
+def test_the_scene_carries_the_thrusters_geometry_and_every_firing_between_frames(
+    hardware_records,
+):
+    scene = build_scene(hardware_records, max_frames=40)
+    thrusters = scene["thrusters"]
+    specs = hardware_records.scenario.robot.actuators.thrusters
+    assert len(specs) == 12
+    np.testing.assert_array_equal(thrusters["positions"], [t.position for t in specs])
+    directions = np.array([t.direction for t in specs], dtype=float)
+    np.testing.assert_allclose(thrusters["directions"], directions)  # unit already
+    telemetry = hardware_records.telemetry
+    duty = np.column_stack([telemetry[f"duty_{i}"] for i in range(1, 13)])
+    rows = frame_rows(len(telemetry["time"]), 40)
+    assert thrusters["duty"].shape == (len(rows), 12)
+    previous = -1
+    for frame, row in enumerate(rows):  # the mean over the rows since the previous frame
+        np.testing.assert_allclose(thrusters["duty"][frame], duty[previous + 1 : row + 1].mean(0))
+        previous = row
+    counts = np.diff(np.concatenate([[-1], rows]))
+    np.testing.assert_allclose((thrusters["duty"] * counts[:, None]).sum(0), duty.sum(0))
+    assert duty.max() > 0.3 and thrusters["duty"][0].max() == 0.0  # none fired before t = 0
+    firing = readout(scene, "thrusters firing")
+    for frame in range(len(rows)):
+        fired = [str(n + 1) for n in np.flatnonzero(thrusters["duty"][frame] > 0)]
+        assert firing[frame] == (", ".join(fired) or "none")
+    error = readout(scene, "attitude error")
+    assert error[-1] == f"{np.degrees(telemetry['attitude_error'][rows[-1]]):.3f} deg"
+
+
+@SHARES_DEFAULT_RUN
+def test_a_free_flyer_without_thrusters_has_no_plumes(default_scene):
+    _, scene = default_scene
+    assert scene["thrusters"] is None
+    assert "thrusters firing" not in {r["label"] for r in scene["readouts"]}

@@ -10,7 +10,9 @@
 ``timeline.png``
     The mission mode with every grab (GRAB is decided and done within one tick, so no
     row of the telemetry shows it) and every release marked, propellant used, delta-v
-    used and the surface gap to the nearest obstacle.
+    used and the surface gap to the nearest obstacle; below them the attitude error, the
+    reaction wheels' momenta and the thrusters' duty cycles when the telemetry has them
+    (:mod:`dcsim.report.hardware`).
 """
 
 from __future__ import annotations
@@ -31,16 +33,19 @@ from matplotlib.lines import Line2D  # noqa: E402
 from dcsim.messages import ObjectKind, Shape  # noqa: E402
 from dcsim.missions.debris.settings import DebrisMissionSection  # noqa: E402
 from dcsim.motion import MotionSet  # noqa: E402
+from dcsim.report.hardware import timeline_axes  # noqa: E402
 from dcsim.report.outlines import outline  # noqa: E402
 from dcsim.report.plots import (  # noqa: E402
     ESTIMATED_COLOUR,
     OBSTACLE_COLOUR,
     TRUE_COLOUR,
     FrameAxes,
+    label_time,
     obstacle_panel,
     stack_layout,
     stacked,
     top_legend,
+    top_title,
     write_plots,
 )
 from dcsim.scenario.model import Scenario  # noqa: E402
@@ -232,7 +237,8 @@ def timeline_figure(
     modes: tuple[str, ...],
     safety_distance: float,
 ) -> Figure:
-    """Mode (grabs and releases marked), propellant, delta-v and obstacle gap over time.
+    """Mode (grabs and releases marked), propellant, delta-v and obstacle gap over time,
+    then the hardware panels the telemetry has data for (:mod:`dcsim.report.hardware`).
 
     Parameters
     ----------
@@ -248,7 +254,7 @@ def timeline_figure(
         Gap marked on the obstacle-distance panel, m.
     """
     times = telemetry["time"]
-    figure, axes = plt.subplots(4, 1, figsize=(11, 10), sharex=True)
+    figure, axes, right = timeline_axes(scenario, telemetry, 4, 10.0)
     axes[0].step(times, _mode_levels(telemetry["mode"], modes), where="post", color="tab:purple")
     axes[0].set_yticks(range(len(modes)), modes, fontsize=7)
     axes[0].set_ylim(-0.5, len(modes) - 0.3)
@@ -259,10 +265,11 @@ def timeline_figure(
     axes[2].set(ylabel="delta-v [m/s]", title="Delta-v used")
     obstacle_panel(axes[3], times, telemetry["nearest_obstacle"], safety_distance)
     handles = _mark_captures(axes, events, modes)
+    label_time(axes)
     for axis in axes:
         axis.grid(alpha=0.3)
-    figure.suptitle(f"{scenario.name}: timeline")
-    stack_layout(figure, len(axes), top_legend(figure, handles), left=1.3)
+    top_title(figure, f"{scenario.name}: timeline")
+    stack_layout(figure, len(axes), top_legend(figure, handles), left=1.3, right=max(right, 0.3))
     return figure
 
 

@@ -11,7 +11,8 @@ is fed).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -106,6 +107,19 @@ class HoldMission(Mission):
             "ty": ty,
             "tz": tz,
         }
+
+    def plot(
+        self,
+        out_dir: Path,
+        telemetry: Mapping[str, np.ndarray],
+        events: Sequence[Mapping[str, Any]],
+    ) -> list[Path]:
+        """Draw ``timeline.png`` (position error, commanded torque and the hardware panels
+        the telemetry has data for), then the motion and the estimation error
+        (:func:`dcsim.missions.hold.plots.write_hold_plots`)."""
+        from dcsim.missions.hold.plots import write_hold_plots  # loads matplotlib
+
+        return write_hold_plots(out_dir, self.scenario, telemetry)
 
     def progress(self) -> str:
         """The latest attitude and position errors."""

@@ -8,7 +8,10 @@ components over time.
 of the arm's position Jacobian (zero at a singularity), the angle between the base's
 target-facing side and the target (60° is the thesis's sight limit), the base's
 displacement against half the end effector's (the thesis's criterion), the commanded
-base torque and joint torques, and the change of total linear and angular momentum.
+base torque and joint torques, and the change of total linear and angular momentum; then
+the base's attitude error, when its reference holds an attitude (the panels every
+timeline ends with, :mod:`dcsim.report.hardware`; a manipulator has no thrusters or
+wheels).
 
 ``joints.png``: every joint angle and its reference (±90° are the thesis's mechanical
 limits) and the largest joint tracking error.
@@ -30,7 +33,14 @@ import matplotlib.pyplot as plt  # noqa: E402  (the backend must be chosen first
 import numpy as np  # noqa: E402
 
 from dcsim.missions.reach.settings import ReachMissionSection  # noqa: E402
-from dcsim.report.plots import FrameAxes, plots_folder, save, stacked  # noqa: E402
+from dcsim.report.hardware import hardware_panels  # noqa: E402
+from dcsim.report.plots import (  # noqa: E402
+    FrameAxes,
+    numbered_columns,
+    plots_folder,
+    save,
+    stacked,
+)
 from dcsim.scenario.model import Scenario  # noqa: E402
 
 SIGHT_LIMIT_DEG = 60.0
@@ -141,8 +151,12 @@ def _timeline_figure(
     title: str,
 ) -> None:
     times = telemetry["time"]
-    figure, axes = plt.subplots(4, 2, figsize=(13, 12), sharex=True)
+    extra = hardware_panels(telemetry, scenario)
+    rows = 4 + -(-len(extra) // 2)
+    figure, axes = plt.subplots(rows, 2, figsize=(13, 12 + 2.4 * (rows - 4)), sharex=True)
     axes = axes.ravel()
+    for axis, draw in zip(axes[8:], extra, strict=False):
+        draw(axis)
     axes[0].semilogy(times, np.maximum(telemetry["ee_error"], 1e-12), color=_FLOWN)
     axes[0].set(ylabel="error [m]", title="End-effector tracking error |flown - reference|")
     axes[1].semilogy(times, np.maximum(telemetry["target_distance"], 1e-12), color=_FLOWN)
@@ -162,10 +176,13 @@ def _timeline_figure(
     axes[4].legend(fontsize=8)
     _torques(axes[5], telemetry)
     _momentum(axes[6], axes[7], telemetry)
-    for axis in axes:
+    for axis in axes[8 + len(extra) :]:
+        axis.set_visible(False)
+    for axis in axes[: 8 + len(extra)]:
         _mark_end(axis, path_end)
         axis.grid(alpha=0.3)
-    for axis in axes[-2:]:
+    for axis in axes[8 + len(extra) - 2 : 8 + len(extra)]:  # the bottom of each column
+        axis.xaxis.set_tick_params(labelbottom=True)
         axis.set_xlabel("time [s]")
     figure.suptitle(f"{title}: timeline (dotted: end of the planned path)")
     figure.tight_layout()
@@ -176,7 +193,7 @@ def _torques(axis, telemetry: Mapping[str, np.ndarray]) -> None:
     times = telemetry["time"]
     base = np.linalg.norm(stacked(telemetry, ("tx", "ty", "tz")), axis=1)
     axis.plot(times, base, color="k", lw=1.4, label="base |τ|")
-    for i, name in enumerate(_numbered(telemetry, "joint_torque_"), 1):
+    for i, name in enumerate(numbered_columns(telemetry, "joint_torque_"), 1):
         axis.plot(times, telemetry[name], lw=0.9, label=f"joint {i}")
     thrust = np.linalg.norm(stacked(telemetry, ("fx", "fy", "fz")), axis=1)
     axis.plot(times, thrust, color="0.5", ls="--", lw=1.0, label="base thrust |F| [N]")
@@ -196,19 +213,11 @@ def _momentum(linear_axis, angular_axis, telemetry: Mapping[str, np.ndarray]) ->
         axis.set(ylabel=f"change [{unit}]", title=f"Total {what} momentum: change from the start")
 
 
-def _numbered(telemetry: Mapping[str, np.ndarray], prefix: str) -> list[str]:
-    """The columns ``prefix1``, ``prefix2``, … in order."""
-    names = [
-        name for name in telemetry if name.startswith(prefix) and name[len(prefix) :].isdigit()
-    ]
-    return sorted(names, key=lambda name: int(name[len(prefix) :]))
-
-
 def _joints_figure(
     path: Path, telemetry: Mapping[str, np.ndarray], path_end: float | None, title: str
 ) -> None:
     times = telemetry["time"]
-    joints = _numbered(telemetry, "joint_")
+    joints = numbered_columns(telemetry, "joint_")
     figure, axes = plt.subplots(2, 1, figsize=(11, 9), sharex=True)
     colours = plt.get_cmap("tab10")
     for i, name in enumerate(joints):

@@ -9,8 +9,10 @@ when they come within :data:`SCENE_MARGIN` (or half the flight's size) of the fl
 
 ``timeline.png`` shows speed, commanded thrust, attitude (the angle turned from the
 initial attitude), angular rate, delta-v, tracking error and the surface gap to the
-nearest obstacle against time, with the mission's modes shaded behind, each change of
-mode marked and the path planner's answers (a plan, or "no path") along the top.
+nearest obstacle against time, then the attitude error, the reaction wheels' momenta and
+the thrusters' duty cycles when the telemetry has them (:mod:`dcsim.report.hardware`),
+with the mission's modes shaded behind, each change of mode marked and the path
+planner's answers (a plan, or "no path") along the top.
 
 Axes are named and ticked as :class:`dcsim.report.plots.FrameAxes` says (radial, along-track
 and orbit-normal in the LVLH frame). Drawn with matplotlib's non-interactive Agg
@@ -35,12 +37,14 @@ from matplotlib.patches import Patch  # noqa: E402
 
 from dcsim.messages import ObjectKind, Shape, ShapeKind  # noqa: E402
 from dcsim.missions.transfer.settings import TransferMissionSection  # noqa: E402
+from dcsim.report.hardware import timeline_axes  # noqa: E402
 from dcsim.report.outlines import outline, wireframe  # noqa: E402
 from dcsim.report.plots import (  # noqa: E402
     LEGEND_ROW,
     TITLE_ROOM,
     FrameAxes,
     attitude_panel,
+    label_time,
     obstacle_panel,
     plots_folder,
     rate_panel,
@@ -49,6 +53,7 @@ from dcsim.report.plots import (  # noqa: E402
     stack_layout,
     stacked,
     thrust_panel,
+    top_title,
 )
 from dcsim.scenario.model import Scenario  # noqa: E402
 from dcsim.world.objects import build_objects  # noqa: E402
@@ -394,7 +399,8 @@ def timeline_figure(
     safety_distance: float,
 ) -> Figure:
     """Speed, thrust, attitude, angular rate, delta-v, tracking error and clearance over
-    time, the modes shaded and the planner's answers marked.
+    time, then the hardware panels the telemetry has data for
+    (:mod:`dcsim.report.hardware`), the modes shaded and the planner's answers marked.
 
     Parameters
     ----------
@@ -412,7 +418,7 @@ def timeline_figure(
     times = telemetry["time"]
     robot = scenario.robot
     names = FrameAxes.of(scenario, np.zeros(0)).names
-    figure, axes = plt.subplots(7, 1, figsize=(11, 16), sharex=True)
+    figure, axes, right = timeline_axes(scenario, telemetry, 7, 16.0)
     speed_panel(axes[0], telemetry, robot.max_speed)
     thrust_panel(axes[1], telemetry, robot.max_force, names)
     attitude_panel(axes[2], telemetry)
@@ -423,6 +429,7 @@ def timeline_figure(
     axes[5].set(ylabel="error [m]", title="Tracking error |reference - estimate|")
     obstacle_panel(axes[6], times, telemetry["nearest_obstacle"], safety_distance)
     axes[6].set_title("Clearance: surface gap to the nearest obstacle")
+    label_time(axes)
     for axis in axes:
         _shade_modes(axis, times, telemetry["mode"], modes)
         axis.grid(alpha=0.3)
@@ -436,8 +443,8 @@ def timeline_figure(
         title="mode (shaded; a dash-dot line marks each change) and the planner's answers",
         bbox_to_anchor=(0.5, 1.0 - TITLE_ROOM / figure.get_figheight()),
     )
-    figure.suptitle(f"{scenario.name}: timeline")
-    stack_layout(figure, len(axes), top=TITLE_ROOM + 2 * LEGEND_ROW, right=1.3)
+    top_title(figure, f"{scenario.name}: timeline")
+    stack_layout(figure, len(axes), top=TITLE_ROOM + 2 * LEGEND_ROW, right=max(right, 1.3))
     return figure
 
 

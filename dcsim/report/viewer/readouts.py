@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from dcsim.report.viewer.objects import Handling
+from dcsim.report.viewer.robot import Thrusters
 from dcsim.scenario.model import ManipulatorSection, Scenario
 
 COLUMN_READOUTS = (
@@ -47,6 +48,7 @@ def readouts(
     telemetry: Mapping[str, np.ndarray],
     rows: np.ndarray,
     handling: Handling,
+    thrusters: Thrusters | None = None,
 ) -> list[dict[str, Any]]:
     """The key numbers at the frames' telemetry ``rows``, formatted with their units.
 
@@ -60,13 +62,16 @@ def readouts(
         The frames' rows.
     handling : Handling
         Grab and delivery times (targets captured and delivered).
+    thrusters : Thrusters, optional
+        The thrusters and their duty cycles at the frames.
 
     Returns
     -------
     list of dict
         ``{"label": str, "values": [str] * F}`` each: time, mode, speed (the base's for
         a manipulator), targets captured, delivered and carried (debris), then the
-        columns of :data:`COLUMN_READOUTS` the telemetry has.
+        columns of :data:`COLUMN_READOUTS` the telemetry has, the attitude error (degrees,
+        when the reference held an attitude) and the thrusters firing (their numbers).
     """
     times = np.asarray(telemetry["time"], dtype=float)[rows]
     out = [_readout("time", times, "{:.2f} s")]
@@ -82,7 +87,17 @@ def readouts(
         if column in telemetry and np.isfinite(telemetry[column][rows]).any():
             values = telemetry[column][rows]
             out.append(_readout(label, values, pattern.replace("{total}", total)))
+    if "attitude_error" in telemetry and np.isfinite(telemetry["attitude_error"][rows]).any():
+        error = np.degrees(telemetry["attitude_error"][rows])
+        out.append(_readout("attitude error", error, "{:.3f} deg"))
+    if thrusters is not None:
+        out.append({"label": "thrusters firing", "values": _firing(thrusters.duty)})
     return out
+
+
+def _firing(duty: np.ndarray) -> list[str]:
+    """The numbers of the thrusters that fired at each frame (``duty`` (F, N)), or none."""
+    return [", ".join(str(n + 1) for n in np.flatnonzero(row > 0)) or "none" for row in duty]
 
 
 def _readout(label: str, values: np.ndarray, pattern: str) -> dict[str, Any]:

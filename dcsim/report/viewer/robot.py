@@ -1,4 +1,5 @@
-"""The robot's pose over a run, from its telemetry: base position and attitude, arm links.
+"""The robot's pose over a run, from its telemetry: base position and attitude, arm links,
+the thrusters and how much each fired.
 
 The arm of a manipulator is drawn from its joint angles through dcsim's public robot
 model (:meth:`dcsim.robots.manipulator.ManipulatorModel.forward_kinematics`).
@@ -12,7 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from dcsim.scenario.model import ManipulatorSection, Scenario
+from dcsim.run.recording import duty_columns
+from dcsim.scenario.model import ManipulatorSection, RobotSection, Scenario
 
 _ATTITUDE_COLUMNS = ("qx", "qy", "qz", "qw")
 
@@ -121,3 +123,54 @@ def arm_polylines(
     return np.stack(
         [np.vstack([state[:3], model.forward_kinematics(state).origins]) for state in states]
     )
+
+
+@dataclass(frozen=True)
+class Thrusters:
+    """A free flyer's thrusters and how much each fired at the viewer's frames.
+
+    Attributes
+    ----------
+    positions : ndarray (N, 3)
+        Where each thruster sits, body frame, from the base's centre of mass, m.
+    directions : ndarray (N, 3)
+        Unit direction of each thruster's force on the base, body frame (its plume leaves
+        the other way).
+    duty : ndarray (F, N)
+        Each thruster's mean duty cycle (fraction of the control period it fired, 0 to 1)
+        over the telemetry rows a frame stands for: those after the previous frame's row
+        up to its own, so that no firing between frames is lost.
+    """
+
+    positions: np.ndarray
+    directions: np.ndarray
+    duty: np.ndarray
+
+    @classmethod
+    def of(
+        cls, scenario: Scenario, telemetry: Mapping[str, np.ndarray], rows: np.ndarray
+    ) -> Thrusters | None:
+        """The thrusters of ``scenario``'s robot with their ``duty_i`` columns in
+        ``telemetry`` at the frames' ``rows``; None without thrusters or duty columns."""
+        robot = scenario.robot
+        thrusters = robot.actuators.thrusters if isinstance(robot, RobotSection) else None
+        if thrusters is None:
+            return None
+        names = duty_columns(len(thrusters))
+        if not all(name in telemetry for name in names):
+            return None
+        positions = np.array([t.position for t in thrusters], dtype=float)
+        directions = np.array([t.direction for t in thrusters], dtype=float)
+        directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+        duty = np.column_stack([telemetry[name] for name in names]).astype(float)
+        return cls(positions, directions, frame_means(np.nan_to_num(duty), rows))
+
+
+def frame_means(values: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """The mean of ``values`` (R, ...) over the rows each frame stands for: after the
+    previous frame's row up to and including its own (``rows``, increasing; the first
+    frame's alone)."""
+    starts = np.concatenate([[0], np.asarray(rows[:-1]) + 1])
+    ends = np.asarray(rows) + 1
+    sums = np.add.reduceat(values[: ends[-1]], starts, axis=0)
+    return sums / (ends - starts).reshape(-1, *([1] * (values.ndim - 1)))

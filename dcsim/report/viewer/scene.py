@@ -11,6 +11,11 @@ strings, ready for JSON) that the page's script plays without knowing dcsim:
   the drop point's tolerance sphere; a group's members may be labelled, ``lift`` (m)
   above their centres;
 - ``polylines``: lines redrawn at every frame (the base's body axes, the arm's links);
+- ``thrusters``: a free flyer's thrusters (body-frame ``positions`` and unit force
+  ``directions``), each one's mean ``duty`` cycle over the rows a frame stands for
+  (:class:`~dcsim.report.viewer.robot.Thrusters`) and the plume's ``length`` (m: at
+  duty 0 and added at duty 1); the page draws a plume from each firing thruster
+  against its force, turning with the base; null without thrusters;
 - ``trails``: paths drawn up to the current frame;
 - ``stages``: lines that change at given times (the debris mission's plans);
 - ``readouts``: the key numbers at every frame, formatted; ``events``: the event log
@@ -36,7 +41,7 @@ from dcsim.report.viewer.meshes import Mesh, shape_mesh
 from dcsim.report.viewer.objects import Handling, ObjectTrack, Status, object_tracks
 from dcsim.report.viewer.readouts import event_log, readouts, subtitle, title
 from dcsim.report.viewer.records import RunRecords
-from dcsim.report.viewer.robot import RobotPath, arm_polylines, body_axes
+from dcsim.report.viewer.robot import RobotPath, Thrusters, arm_polylines, body_axes
 from dcsim.scenario.model import ManipulatorSection, frame_axes, point_to_cartesian
 
 MAX_FRAMES = 600
@@ -53,6 +58,7 @@ _PLAN = "#ff7f0e"
 _GOAL = "#2ca02c"
 _DROP = "#555555"
 _BEACON = "#9467bd"
+_PLUME = "#ffa600"
 _AXIS_COLOURS = ("#e41a1c", "#4daf4a", "#377eb8")  # body x, y and z axes
 
 _SPEEDS = (0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000)
@@ -86,7 +92,8 @@ def build_scene(records: RunRecords, max_frames: int = MAX_FRAMES) -> dict[str, 
     handling = Handling.from_events(records.events)
     tracks = object_tracks(records.scenario, times, path, handling)
     arm = arm_polylines(records.scenario, telemetry, path, rows)
-    context = _Context(records, path, rows, times, tracks, arm)
+    thrusters = Thrusters.of(records.scenario, telemetry, rows)
+    context = _Context(records, path, rows, times, tracks, arm, thrusters)
     bodies = [_robot_body(context), *_object_bodies(tracks), *_drop_body(context)]
     stages = _plans(context)
     return {
@@ -97,9 +104,10 @@ def build_scene(records: RunRecords, max_frames: int = MAX_FRAMES) -> dict[str, 
         "static": _static_traces(context),
         "bodies": bodies,
         "polylines": _robot_lines(context),
+        "thrusters": _thrusters(context),
         "trails": _trails(context),
         "stages": stages,
-        "readouts": readouts(records.scenario, telemetry, rows, handling),
+        "readouts": readouts(records.scenario, telemetry, rows, handling, thrusters),
         "events": event_log(records.events),
         "extent": _extent(context, bodies, stages),
         "playback": _playback(times),
@@ -117,6 +125,7 @@ class _Context:
         times: np.ndarray,
         tracks: list[ObjectTrack],
         arm: np.ndarray | None,
+        thrusters: Thrusters | None,
     ) -> None:
         self.records = records
         self.scenario = records.scenario
@@ -126,6 +135,7 @@ class _Context:
         self.times = times
         self.tracks = tracks
         self.arm = arm
+        self.thrusters = thrusters
         self.mission = self.scenario.mission.type
 
     def columns(self, names: Sequence[str]) -> np.ndarray | None:
@@ -280,6 +290,23 @@ def _robot_lines(context: _Context) -> list[dict[str, Any]]:
         arm["marker"] = {"color": "#222222", "size": 4}
         lines.append({"trace": arm, "frames": context.arm})
     return lines
+
+
+def _thrusters(context: _Context) -> dict[str, Any] | None:
+    """The thrusters' geometry and duty cycles, and how the page draws their plumes: from
+    a firing thruster against its force, one robot radius long plus two at full duty (a
+    thruster inside the robot's sphere still shows)."""
+    thrusters = context.thrusters
+    if thrusters is None:
+        return None
+    size = context.robot_size
+    return {
+        "trace": _line_trace("thruster plumes", _PLUME, 8, group="robot"),
+        "positions": thrusters.positions,
+        "directions": thrusters.directions,
+        "duty": thrusters.duty,
+        "length": [size, 2.0 * size],
+    }
 
 
 def _trails(context: _Context) -> list[dict[str, Any]]:

@@ -64,6 +64,26 @@
     return { mesh: mesh, labels: labels };
   }
 
+  // Plumes of the thrusters firing at frame f: from each against its force, turning with
+  // the base, longer the more it fired; separated by gaps (null points).
+  function plumes(thrusters, robot, f) {
+    const p = robot.positions[f];
+    const q = robot.turns ? robot.turns[f] : [0, 0, 0, 1];
+    const points = [];
+    thrusters.duty[f].forEach(function (duty, n) {
+      if (!(duty > 0)) return;
+      const length = thrusters.length[0] + thrusters.length[1] * duty;
+      const at = thrusters.positions[n];
+      const d = thrusters.directions[n];
+      const tip = [at[0] - length * d[0], at[1] - length * d[1], at[2] - length * d[2]];
+      for (const v of [rotate(q, at), rotate(q, tip)]) {
+        points.push([p[0] + v[0], p[1] + v[1], p[2] + v[2]]);
+      }
+      points.push([null, null, null]);
+    });
+    return points;
+  }
+
   function stageAt(stages, t) {
     let shown = null;
     for (const stage of stages) {
@@ -105,6 +125,14 @@
   for (const line of scene.polylines) {
     updates.push({ index: data.length, at: function (f) { return columns(line.frames[f]); } });
     data.push(Object.assign({}, line.trace));
+  }
+  if (scene.thrusters) {
+    const robot = scene.bodies.find(function (g) { return g.trace.name === "robot"; }).members[0];
+    updates.push({
+      index: data.length,
+      at: function (f) { return columns(plumes(scene.thrusters, robot, f)); },
+    });
+    data.push(Object.assign({}, scene.thrusters.trace));
   }
   for (const trail of scene.trails) {
     updates.push({
