@@ -103,6 +103,22 @@ def test_a_cut_last_line_is_left_out_and_mode_changes_survive_thinning(tmp_path)
     assert {499, 500, 501} <= set(thin["x"].astype(int))
 
 
+def test_thinned_rows_carry_the_mean_duty_cycles_of_the_rows_they_stand_for(tmp_path):
+    path = tmp_path / "telemetry.csv"
+    # a thruster fires half the period on every row that ends in 5, which a stride of
+    # ten never lands on; a mode change at row 500 keeps rows 499-501
+    rows = [(k, "B" if k == 500 else "A", 0.5 if k % 10 == 5 else 0.0) for k in range(1000)]
+    lines = [f"{k * 0.1!r},{mode},{k},{duty!r}" for k, mode, duty in rows]
+    path.write_text("time,mode,x,duty_1\n" + "\n".join(lines) + "\n")
+    thin = read_telemetry(path, max_points=100)
+    kept = thin["x"].astype(int)
+    assert 0 < len(kept) < 120 and thin["duty_1"].max() > 0
+    # each kept row's duty times the rows it stands for adds up to every firing
+    stands_for = np.diff(np.concatenate([[-1], kept]))
+    assert thin["duty_1"] @ stands_for == pytest.approx(0.5 * 100)
+    assert np.array_equal(thin["x"], kept)  # other columns are the kept rows' own
+
+
 def test_the_header_carries_units_and_the_reader_gives_the_row_names(tmp_path):
     recorder = Recorder(tmp_path, ("time", "mode", "x", "hits"), units={"time": "s", "x": "m"})
     recorder.start("name: t\n", {"status": "running"})

@@ -387,8 +387,9 @@ def read_telemetry(path: Path, max_points: int | None = None) -> dict[str, np.nd
         The file.
     max_points : int, optional
         Keep about this many rows, evenly spaced, plus the first and last and the rows
-        on both sides of every change of ``mode``; the file is streamed, so memory
-        follows ``max_points``, not the file's length.
+        on both sides of every change of ``mode``; the thrusters' duty cycles of a kept
+        row are their mean over the rows since the previous kept one. The file is
+        streamed, so memory follows ``max_points``, not the file's length.
 
     Returns
     -------
@@ -399,22 +400,62 @@ def read_telemetry(path: Path, max_points: int | None = None) -> dict[str, np.nd
     step = 1 if max_points is None else _stride(count_lines(path) - 1, max_points)
     kept: list[list[str]] = []
     last: list[str] | None = None
+    last_kept = False
     with path.open(encoding="utf-8") as stream:
         header = [column_name(h) for h in stream.readline().rstrip("\n").split(",")]
         mode = header.index("mode") if "mode" in header else None
+        window = _Window([i for i, name in enumerate(header) if name.startswith("duty_")])
         for index, text in enumerate(stream):
             fields = text.rstrip("\n").split(",")
             if not text.endswith("\n") or len(fields) != len(header):
                 continue  # the line a killed run was writing
             switched = mode is not None and last is not None and fields[mode] != last[mode]
-            if switched and last is not None and kept[-1] is not last:
-                kept.append(last)  # a mode change stays sharp however thin the rows
-            if index % step == 0 or switched:
-                kept.append(fields)
+            if switched and last is not None and not last_kept:
+                kept.append(window.close(last))  # a mode change stays sharp however thin
+            window.add(fields)
+            last_kept = index % step == 0 or switched
+            if last_kept:
+                kept.append(window.close(fields))
             last = fields
-    if last is not None and kept[-1] is not last:
-        kept.append(last)
+    if last is not None and not last_kept:
+        kept.append(window.close(last))
     return _parse(header, kept)
+
+
+class _Window:
+    """The rows a thinned row stands for: its duty cycles (columns ``duty_i``) become
+    their mean over the rows since the previous kept row, so that firings between kept
+    rows still show, each with its weight.
+
+    Parameters
+    ----------
+    columns : list of int
+        Positions of the averaged columns in a row.
+    """
+
+    def __init__(self, columns: list[int]) -> None:
+        self._columns = columns
+        self._sums = [0.0] * len(columns)
+        self._count = 0
+
+    def add(self, fields: list[str]) -> None:
+        """Count one row."""
+        if self._columns:
+            self._sums = [
+                s + float(fields[i]) for s, i in zip(self._sums, self._columns, strict=True)
+            ]
+            self._count += 1
+
+    def close(self, fields: list[str]) -> list[str]:
+        """``fields`` with the averaged columns replaced by the window's means; a new
+        window starts."""
+        if not self._columns or self._count == 0:
+            return fields
+        fields = list(fields)
+        for total, i in zip(self._sums, self._columns, strict=True):
+            fields[i] = repr(total / self._count)
+        self._sums, self._count = [0.0] * len(self._columns), 0
+        return fields
 
 
 def count_lines(path: Path) -> int:
