@@ -11,9 +11,16 @@ span, navigation fed the true state:
 - **Basilisk**: the modules of :mod:`dcsim.bench.basilisk_loop`, the dynamics task at
   the same step unless told otherwise.
 
-Two rows: the attitude slew alone (no translation command), and the same slew while
+Three rows: the attitude slew alone (no translation command), the same slew while
 the position is held (dcsim's ``pd`` translation loop; Basilisk's
-``hillFrameRelativeControl`` about a constant chief at the hold point).
+``hillFrameRelativeControl`` about a constant chief at the hold point), and the
+attitude slew on four reaction wheels in a pyramid instead of an ideal torque (dcsim's
+``robot.actuators.reaction_wheels``; Basilisk's ``rwMotorTorque`` and
+``reactionWheelStateEffector``, see :mod:`dcsim.bench.basilisk_loop` for how the two
+wheel models are made the same spacecraft). Both sides share the commanded torque
+among the wheels by the minimum-norm inverse and hold each wheel's torque over the
+control period; the wheels' limits are far above what the slew needs, so none
+saturates.
 
 Gains: ``pd`` closes each loop on a double integrator with poles of
 ``s² + 2ζω s + ω²`` (``kp = ω²``, ``kd = 2ζω`` per unit inertia or mass, unsaturated
@@ -40,11 +47,13 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from dcsim.bench.basilisk_loop import (
     BasiliskSetup,
+    WheelSetup,
     basilisk_missing,
     fly_basilisk,
 )
@@ -77,6 +86,19 @@ INITIAL_ATTITUDE = tuple(
 )
 """The initial attitude ``[x, y, z, w]``: 90° away from the goal."""
 
+PYRAMID = tuple(
+    tuple(float(v) for v in np.array(axis) / np.sqrt(3.0))
+    for axis in ((1, 1, 1), (-1, 1, 1), (-1, -1, 1), (1, -1, 1))
+)
+"""The four wheels' spin axes, body frame: a pyramid about +z, each axis 54.7° from it,
+so that ``Σ ĝ ĝᵀ = 4/3 I`` (the wheels give the same torque about every axis)."""
+
+RPM = 60.0 / (2.0 * np.pi)
+"""Revolutions per minute in one rad/s."""
+
+WHEEL_ROW = "slew on 4 wheels"
+"""The name of the reaction-wheel row."""
+
 TARGET_RATIO = 3.0
 """The target: dcsim's loop within this factor of Basilisk's wall time."""
 
@@ -105,6 +127,15 @@ class SlewCase:
         ``pd``'s position loop: natural frequency (rad/s) and damping ratio.
     attitude_bandwidth, attitude_damping : float
         ``pd``'s attitude loop: natural frequency (rad/s) and damping ratio.
+    wheel_axes : tuple of tuple of float
+        The reaction wheels' unit spin axes, body frame (the wheel row).
+    wheel_inertia : float
+        Each wheel's moment of inertia about its spin axis, kg·m².
+    wheel_max_torque : float
+        Each wheel's torque limit, N·m (the wheels' limit on the base's torque in its
+        weakest direction is 4/3 of it for the pyramid; above what the slew needs).
+    wheel_max_momentum : float
+        Each wheel's momentum limit, N·m·s (above what the slew stores).
     """
 
     mass: float = 100.0
@@ -121,6 +152,10 @@ class SlewCase:
     damping: float = 0.9
     attitude_bandwidth: float = 0.5
     attitude_damping: float = 0.9
+    wheel_axes: tuple[tuple[float, ...], ...] = PYRAMID
+    wheel_inertia: float = 0.1
+    wheel_max_torque: float = 20.0
+    wheel_max_momentum: float = 50.0
 
     @property
     def attitude_gains(self) -> tuple[float, float]:
@@ -161,6 +196,10 @@ class Flight:
         Distance from the start (hold) position, m.
     peak_torque : float
         Largest commanded torque magnitude, N·m.
+    wheel_speed : ndarray (N, wheels)
+        Each reaction wheel's momentum about its axis over its inertia, rad/s (dcsim's
+        ``wheel_speed``; the spin rate relative to the base plus the base's rate about
+        the wheel's axis); no columns with ideal torque.
     phases : dict of str to float
         dcsim's wall time by phase of the run loop (the runner's lap timer), s; empty
         for Basilisk.
@@ -172,7 +211,13 @@ class Flight:
     pointing_error: np.ndarray
     position_error: np.ndarray
     peak_torque: float
+    wheel_speed: np.ndarray
     phases: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def peak_wheel_speed(self) -> float:
+        """The largest wheel speed magnitude of the run, rad/s (nan without wheels)."""
+        return float(np.max(np.abs(self.wheel_speed))) if self.wheel_speed.size else np.nan
 
 
 @dataclass
@@ -185,6 +230,8 @@ class PeerRow:
         What the row flies.
     hold_position : bool
         Whether the position is held too.
+    wheels : bool
+        Whether reaction wheels give the torque (ideal torque otherwise).
     dcsim : list of Flight
         dcsim's runs.
     basilisk : list of Flight
@@ -193,6 +240,7 @@ class PeerRow:
 
     name: str
     hold_position: bool
+    wheels: bool = False
     dcsim: list[Flight] = field(default_factory=list)
     basilisk: list[Flight] = field(default_factory=list)
 
@@ -206,7 +254,7 @@ class PeersResult:
     case : SlewCase
         What was flown.
     rows : list of PeerRow
-        Attitude only, then with the position held.
+        Attitude only, with the position held, on reaction wheels.
     inertia : float
         The free flyer's principal moment of inertia, kg·m² (as PyBullet holds it).
     basilisk_step : float
@@ -223,28 +271,41 @@ class PeersResult:
 
 
 # ---------------------------------------------------------------------- dcsim's side
-def slew_scenario(case: SlewCase, hold_position: bool) -> Scenario:
+def slew_scenario(case: SlewCase, hold_position: bool, wheels: bool = False) -> Scenario:
     """dcsim's scenario of ``case``: a ``hold`` mission of the goal attitude, ``pd``,
-    no localiser, a force-free (geocentric) world with nothing else in it."""
+    no localiser, a force-free (geocentric) world with nothing else in it; with
+    ``wheels``, the case's reaction wheels give the torque (its limit then theirs)."""
+    robot: dict[str, Any] = {
+        "mass": case.mass,
+        "radius": case.radius,
+        "initial": {
+            "attitude": list(case.initial_attitude),
+            "angular_velocity": list(case.initial_angular_velocity),
+            "velocity": list(case.initial_velocity),
+        },
+    }
+    if wheels:
+        wheel = {
+            "inertia": case.wheel_inertia,
+            "max_torque": case.wheel_max_torque,
+            "max_momentum": case.wheel_max_momentum,
+        }
+        robot["actuators"] = {
+            "reaction_wheels": [{"axis": list(axis), **wheel} for axis in case.wheel_axes]
+        }
+    else:
+        robot["max_torque"] = case.max_torque
+    name = "peers-slew" + ("-hold" if hold_position else "") + ("-wheels" if wheels else "")
     return scenario_model(HoldMissionSection).model_validate(
         {
-            "name": "peers-slew" + ("-hold" if hold_position else ""),
+            "name": name,
             "world": {
                 "frame": "geocentric",
                 "physics_step": case.physics_step,
                 "control_period": case.control_period,
                 "duration": case.duration,
             },
-            "robot": {
-                "mass": case.mass,
-                "radius": case.radius,
-                "max_torque": case.max_torque,
-                "initial": {
-                    "attitude": list(case.initial_attitude),
-                    "angular_velocity": list(case.initial_angular_velocity),
-                    "velocity": list(case.initial_velocity),
-                },
-            },
+            "robot": robot,
             "localiser": None,
             "controller": {
                 "plugin": "pd",
@@ -272,18 +333,28 @@ def flyer_inertia(case: SlewCase) -> np.ndarray:
         return np.array(world.robot_spec().inertia)
 
 
-def fly_dcsim(case: SlewCase, hold_position: bool, registry: PluginRegistry) -> Flight:
-    """Fly ``case`` through dcsim's runner and return its record."""
+def wheel_torque_limit(case: SlewCase) -> float:
+    """The torque the case's wheels give the base in its weakest direction, N·m (dcsim's
+    ``robot.max_torque`` on wheels)."""
+    return float(slew_scenario(case, hold_position=False, wheels=True).robot.max_torque)
+
+
+def fly_dcsim(
+    case: SlewCase, hold_position: bool, registry: PluginRegistry, wheels: bool = False
+) -> Flight:
+    """Fly ``case`` through dcsim's runner and return its record (on the case's reaction
+    wheels with ``wheels``)."""
     began, cpu_began = time.perf_counter(), time.process_time()
-    runner = Runner(
-        RunSetup.from_scenario(slew_scenario(case, hold_position), registry), keep_rows=True
-    )
+    scenario = slew_scenario(case, hold_position, wheels)
+    runner = Runner(RunSetup.from_scenario(scenario, registry), keep_rows=True)
     summary = runner.run()
     wall, cpu = time.perf_counter() - began, time.process_time() - cpu_began
     if summary["status"] != "completed":
         raise RuntimeError(f"the dcsim run ended {summary['status']}: {summary['reason']}")
     rows = runner.recorder.rows
     attitudes = np.array([[row[k] for k in ("qx", "qy", "qz", "qw")] for row in rows])
+    columns = [f"wheel_h_{i}" for i in range(1, len(case.wheel_axes) + 1)] if wheels else []
+    momenta = np.array([[row[k] for k in columns] for row in rows]).reshape(len(rows), -1)
     return Flight(
         wall=wall,
         cpu=cpu,
@@ -293,15 +364,17 @@ def fly_dcsim(case: SlewCase, hold_position: bool, registry: PluginRegistry) -> 
         peak_torque=float(
             np.max(np.linalg.norm([[row[k] for k in ("tx", "ty", "tz")] for row in rows], axis=1))
         ),
+        wheel_speed=momenta / case.wheel_inertia,
         phases=dict(summary["wall_time_by_phase_s"]),
     )
 
 
 # ---------------------------------------------------------------------- Basilisk's side
 def basilisk_setup(
-    case: SlewCase, hold_position: bool, inertia: np.ndarray, step: float
+    case: SlewCase, hold_position: bool, inertia: np.ndarray, step: float, wheels: bool = False
 ) -> BasiliskSetup:
-    """The Basilisk loop of ``case``: same body and start, gains matched to ``pd``'s.
+    """The Basilisk loop of ``case``: same body and start, gains matched to ``pd``'s (on
+    the case's reaction wheels with ``wheels``).
 
     Raises
     ------
@@ -324,6 +397,18 @@ def basilisk_setup(
         dynamics_step=step,
         control_period=case.control_period,
         duration=case.duration,
+        wheels=_wheel_setup(case) if wheels else None,
+    )
+
+
+def _wheel_setup(case: SlewCase) -> WheelSetup:
+    """The case's reaction wheels for the Basilisk loop."""
+    axes = np.array(case.wheel_axes, dtype=float).T
+    return WheelSetup(
+        axes=axes / np.linalg.norm(axes, axis=0),
+        inertia=case.wheel_inertia,
+        max_torque=case.wheel_max_torque,
+        max_momentum=case.wheel_max_momentum,
     )
 
 
@@ -337,6 +422,7 @@ def fly_peer(setup: BasiliskSetup) -> Flight:
         pointing_error=pointing_errors(flight.attitudes, setup.goal_attitude),
         position_error=np.linalg.norm(flight.positions, axis=1),
         peak_torque=float(np.max(np.linalg.norm(flight.torques, axis=1))),
+        wheel_speed=flight.wheel_speeds,
     )
 
 
@@ -376,14 +462,18 @@ def bench_peers(
     note = basilisk_missing()
     if note is not None:
         progress(f"Basilisk is not flown: {note}")
-    rows = [PeerRow("attitude slew", False), PeerRow("slew + position hold", True)]
+    rows = [
+        PeerRow("attitude slew", False),
+        PeerRow("slew + position hold", True),
+        PeerRow(WHEEL_ROW, False, wheels=True),
+    ]
     _warm_up(case, registry, inertia, step, basilisk=note is None)
     for repeat in range(1, repeats + 1):
         for row in rows:
-            row.dcsim.append(fly_dcsim(case, row.hold_position, registry))
+            row.dcsim.append(fly_dcsim(case, row.hold_position, registry, row.wheels))
             line = f"{row.name}, run {repeat}/{repeats}: dcsim {row.dcsim[-1].wall:.3f} s"
             if note is None:
-                setup = basilisk_setup(case, row.hold_position, inertia, step)
+                setup = basilisk_setup(case, row.hold_position, inertia, step, row.wheels)
                 row.basilisk.append(fly_peer(setup))
                 line += f", Basilisk {row.basilisk[-1].wall:.3f} s"
             progress(line)
@@ -393,11 +483,13 @@ def bench_peers(
 def _warm_up(
     case: SlewCase, registry: PluginRegistry, inertia: np.ndarray, step: float, basilisk: bool
 ) -> None:
-    """One short run of each side: imports and first-use costs stay out of the timings."""
+    """Short runs of each side, with and without wheels: imports and first-use costs stay
+    out of the timings."""
     short = replace(case, duration=10 * case.control_period)
-    fly_dcsim(short, True, registry)
-    if basilisk:
-        fly_peer(basilisk_setup(short, True, inertia, step))
+    for wheels in (False, True):
+        fly_dcsim(short, True, registry, wheels)
+        if basilisk:
+            fly_peer(basilisk_setup(short, True, inertia, step, wheels))
 
 
 # ---------------------------------------------------------------------- figures
@@ -458,7 +550,9 @@ def notes(result: PeersResult) -> str:
         f"- pd: kp = {kp:g} s⁻², kd = {kd:g} s⁻¹; mrpFeedback: K = {big_k:g} N·m, "
         f"P = {big_p:g} N·m·s.",
         _torque_line(result),
-        _phase_line(result),
+        _wheel_line(result),
+        _phase_line(result, result.rows[0]),
+        _phase_line(result, _wheel_row(result)),
         _cpu_line(result),
     ]
     hold = result.rows[1]
@@ -488,13 +582,45 @@ def _torque_line(result: PeersResult) -> str:
     return line + f": dcsim's limit of {limit:g} N·m is reached, the laws differ there."
 
 
-def _phase_line(result: PeersResult) -> str:
-    """Where dcsim's best attitude-slew run spent its time, ms per simulated second."""
-    best = min(result.rows[0].dcsim, key=lambda f: f.wall)
+def _wheel_line(result: PeersResult) -> str:
+    """The wheels, their limits, and each side's largest torque and wheel speed."""
+    case, row = result.case, _wheel_row(result)
+    limit = wheel_torque_limit(case)
+    flights = [("dcsim", row.dcsim[-1])] + [("Basilisk", f) for f in row.basilisk[-1:]]
+    torques = ", ".join(f"{side} {flight.peak_torque:.3g} N·m" for side, flight in flights)
+    speeds = ", ".join(
+        f"{side} {flight.peak_wheel_speed:.4g} rad/s ({RPM * flight.peak_wheel_speed:.0f} rpm)"
+        for side, flight in flights
+    )
+    fraction = max(f.peak_wheel_speed for _, f in flights) * case.wheel_inertia
+    fraction /= case.wheel_max_momentum
+    within = max(f.peak_torque for _, f in flights) < limit and fraction < 1.0
+    line = (
+        f"- {row.name}: {len(case.wheel_axes)} wheels in a pyramid about +z (axes 54.7° "
+        f"from it), each {case.wheel_inertia:g} kg·m², {case.wheel_max_torque:g} N·m, "
+        f"{case.wheel_max_momentum:g} N·m·s (the base's torque limit {limit:.3g} N·m in "
+        f"its weakest direction); largest commanded torque {torques}; peak wheel speed "
+        f"(momentum / wheel inertia) {speeds}, {100 * fraction:.0f} % of the momentum limit"
+    )
+    line += ": no wheel saturates" if within else ": a wheel limit is reached, the sides differ"
+    if row.basilisk:
+        gap = np.max(np.abs(row.dcsim[-1].wheel_speed[-1] - row.basilisk[-1].wheel_speed[-1]))
+        line += f"; final wheel speeds differ by at most {gap:.2g} rad/s"
+    return line + "."
+
+
+def _wheel_row(result: PeersResult) -> PeerRow:
+    """The reaction-wheel row of ``result``."""
+    return next(row for row in result.rows if row.wheels)
+
+
+def _phase_line(result: PeersResult, row: PeerRow) -> str:
+    """Where dcsim's best run of ``row`` spent its time, ms per simulated second."""
+    best = min(row.dcsim, key=lambda f: f.wall)
     span = result.case.duration
     phases = sorted(best.phases.items(), key=lambda item: -item[1])
     parts = ", ".join(f"{name} {1e3 * seconds / span:.2f}" for name, seconds in phases)
-    return f"- dcsim's best attitude-slew run by phase of the run loop (ms / sim s): {parts}."
+    return f"- dcsim's best {row.name} run by phase of the run loop (ms / sim s): {parts}."
 
 
 def _cpu_line(result: PeersResult) -> str:
@@ -513,61 +639,89 @@ def _cpu_line(result: PeersResult) -> str:
 
 
 def verdict(result: PeersResult) -> str:
-    """Whether dcsim's attitude loop is within :data:`TARGET_RATIO` of Basilisk's wall
-    time (the attitude-only row), in one line."""
-    row = result.rows[0]
-    if not row.basilisk:
-        return (
-            f"target (within {TARGET_RATIO:g}× of Basilisk): not measured, Basilisk was not flown"
+    """Whether dcsim is within :data:`TARGET_RATIO` of Basilisk's wall time, for the
+    attitude loop (the attitude-only row) and for the wheel slew, one line each."""
+    lines = []
+    for row, what in ((result.rows[0], "attitude loop"), (_wheel_row(result), "wheel slew")):
+        if not row.basilisk:
+            lines.append(
+                f"target (dcsim's {what} within {TARGET_RATIO:g}× of Basilisk): "
+                "not measured, Basilisk was not flown"
+            )
+            continue
+        ratio = best_wall(row.dcsim) / best_wall(row.basilisk)
+        met = "met" if ratio <= TARGET_RATIO else "not met"
+        lines.append(
+            f"target (dcsim's {what} within {TARGET_RATIO:g}× of Basilisk's wall time): "
+            f"{met}, {ratio:.2f}×"
         )
-    ratio = best_wall(row.dcsim) / best_wall(row.basilisk)
-    met = "met" if ratio <= TARGET_RATIO else "not met"
-    return (
-        f"target (dcsim's attitude loop within {TARGET_RATIO:g}× of Basilisk's wall time): "
-        f"{met}, {ratio:.2f}×"
-    )
+    return "\n".join(lines)
 
 
 def plot(result: PeersResult, path: Path) -> None:
     """The two sides' runs against time, as a PNG at ``path``: pointing error during
-    the slew and over the whole run (attitude-only row), and distance from the hold
-    point (position-hold row)."""
+    the slew and over the whole run (attitude-only row, then the wheel row), distance
+    from the hold point (position-hold row), and the wheels' speeds."""
     from dcsim.bench.figures import pyplot, save
 
     plt = pyplot()
-    figure, (slew, tail, hold) = plt.subplots(1, 3, figsize=(14, 4.2))
-    colours = {"dcsim": "tab:blue", "Basilisk": "tab:orange"}
+    figure, ((slew, tail, hold), (wheel_slew, wheel_tail, speeds)) = plt.subplots(
+        2, 3, figsize=(14, 8.4)
+    )
     window = min(20.0, result.case.duration)
-    attitude, position = result.rows
-    for side, flight in _last_flights(attitude):
-        degrees = np.degrees(flight.pointing_error)
-        shown = flight.times <= window
-        slew.plot(flight.times[shown], degrees[shown], color=colours[side], label=side)
-        tail.semilogy(flight.times, np.maximum(degrees, 1e-14), color=colours[side])
+    attitude, position = result.rows[:2]
+    _pointing(attitude, slew, tail, window)
+    _pointing(_wheel_row(result), wheel_slew, wheel_tail, window)
     for side, flight in _last_flights(position):
-        hold.plot(flight.times, flight.position_error, color=colours[side], label=side)
-    slew.set(
-        xlabel="time [s]", ylabel="pointing error [deg]", title=f"the slew (first {window:g} s)"
-    )
-    tail.set(
-        xlabel="time [s]",
-        ylabel="pointing error [deg]",
-        title=f"the whole run ({result.case.duration:g} s)",
-    )
+        hold.plot(flight.times, flight.position_error, color=_COLOURS[side], label=side)
+    for side, flight in _last_flights(_wheel_row(result)):
+        style = "-" if side == "dcsim" else "--"
+        speeds.plot(flight.times, flight.wheel_speed, style, color=_COLOURS[side], lw=1.0)
+    for name, axis in (("attitude slew", slew), (WHEEL_ROW, wheel_slew)):
+        axis.set(
+            xlabel="time [s]",
+            ylabel="pointing error [deg]",
+            title=f"{name} (first {window:g} s)",
+        )
+    for name, axis in (("attitude slew", tail), (WHEEL_ROW, wheel_tail)):
+        axis.set(
+            xlabel="time [s]",
+            ylabel="pointing error [deg]",
+            title=f"{name}, the whole run ({result.case.duration:g} s)",
+        )
     hold.set(
         xlabel="time [s]",
         ylabel="distance from the hold point [m]",
         title="slew + position hold",
         xlim=(0, min(60.0, result.case.duration)),
     )
-    for axis in (slew, tail, hold):
+    speeds.set(
+        xlabel="time [s]",
+        ylabel="wheel speed [rad/s]",
+        title="wheel speeds (dcsim solid, Basilisk dashed)",
+        xlim=(0, min(60.0, result.case.duration)),
+    )
+    for axis in (slew, tail, hold, wheel_slew, wheel_tail, speeds):
         axis.grid(alpha=0.3)
     slew.legend()
     figure.suptitle(
-        "dcsim bench peers: pd (dcsim, PyBullet) beside mrpFeedback and "
-        "hillFrameRelativeControl (Basilisk)"
+        "dcsim bench peers: pd (dcsim, PyBullet) beside mrpFeedback, "
+        "hillFrameRelativeControl and rwMotorTorque (Basilisk)"
     )
     save(figure, path, dpi=90)
+
+
+_COLOURS = {"dcsim": "tab:blue", "Basilisk": "tab:orange"}
+
+
+def _pointing(row: PeerRow, slew: Any, tail: Any, window: float) -> None:
+    """Each side's pointing error of ``row``: the first ``window`` seconds (s) on
+    ``slew``, the whole run on a log scale on ``tail``."""
+    for side, flight in _last_flights(row):
+        degrees = np.degrees(flight.pointing_error)
+        shown = flight.times <= window
+        slew.plot(flight.times[shown], degrees[shown], color=_COLOURS[side], label=side)
+        tail.semilogy(flight.times, np.maximum(degrees, 1e-14), color=_COLOURS[side])
 
 
 def _last_flights(row: PeerRow) -> list[tuple[str, Flight]]:
