@@ -26,6 +26,20 @@ integrates the wheels' speeds with its own state. ``mrpFeedback`` is not given t
 wheels' speeds, so its law leaves their momentum out of the gyroscopic term, as
 ``pd``'s does.
 
+Thrusters (optional, instead of wheels) replace it likewise: ``thrForceMapping``
+(``thrForceSign = +1``, all three body axes, its second pass on: the torque shared
+again among the thrusters the first pass fired) gives each thruster a force,
+``thrFiringRemainder`` (no minimum firing time) the on-time ``T f / F_max``, and a
+``thrusterDynamicEffector`` of thrusters built by ``simIncludeThruster.thrusterFactory``
+(``Blank_Thruster``, no minimum on-time) reads the on-times once per period, in the
+flight-software task, and fires each from the period's start. Two behaviours of these
+modules make the thruster loop differ from dcsim's: ``thrFiringRemainder`` commands
+nothing at its first two calls (it takes a previous call time of 0 for "no previous
+call"), so the thrusters first fire at the third period; and the effector switches a
+thruster on or off at the integrator's stage times, so an on-time ending inside a
+dynamics step is rounded to the step's RK4 stages (dcsim's PWM gives a partly covered
+physics step the covered fraction).
+
 Balanced wheels in Basilisk belong to the hub: its inertia includes theirs, and a
 wheel's state is its speed Ω relative to the hub, its momentum about its axis
 ``Js (Ω + ĝ·ω)``. dcsim's wheels carry that momentum ``h`` (:mod:`dcsim.world.wheels`)
@@ -95,6 +109,25 @@ class WheelSetup:
 
 
 @dataclass(frozen=True)
+class ThrusterSetup:
+    """Identical thrusters, SI units, body frame.
+
+    Attributes
+    ----------
+    positions : ndarray (N, 3)
+        Where each thruster sits relative to the centre of mass, m.
+    directions : ndarray (N, 3)
+        The unit direction of each thruster's force on the hub.
+    max_thrust : float
+        Each thruster's thrust when on, N.
+    """
+
+    positions: np.ndarray
+    directions: np.ndarray
+    max_thrust: float
+
+
+@dataclass(frozen=True)
 class BasiliskSetup:
     """What the Basilisk loop flies, in SI units.
 
@@ -125,6 +158,8 @@ class BasiliskSetup:
         Simulated time, s (a whole number of control periods).
     wheels : WheelSetup or None
         Reaction wheels giving the torque; None: ``extForceTorque`` gives it.
+    thrusters : ThrusterSetup or None
+        Thrusters giving the torque (not with wheels); None: ``extForceTorque`` gives it.
     """
 
     mass: float
@@ -139,6 +174,12 @@ class BasiliskSetup:
     control_period: float
     duration: float
     wheels: WheelSetup | None = None
+    thrusters: ThrusterSetup | None = None
+
+    @property
+    def ideal_torque(self) -> bool:
+        """Whether ``extForceTorque`` gives the torque (no wheels, no thrusters)."""
+        return self.wheels is None and self.thrusters is None
 
 
 @dataclass(frozen=True)
@@ -260,6 +301,10 @@ class _Modules:
     rwMotorTorque: Any
     reactionWheelStateEffector: Any
     simIncludeRW: Any
+    thrForceMapping: Any
+    thrFiringRemainder: Any
+    thrusterDynamicEffector: Any
+    simIncludeThruster: Any
     macros: Any
     messaging: Any
 
@@ -276,14 +321,22 @@ def _modules() -> _Modules:
             inertial3D,
             mrpFeedback,
             rwMotorTorque,
+            thrFiringRemainder,
+            thrForceMapping,
         )
         from Basilisk.simulation import (
             extForceTorque,
             reactionWheelStateEffector,
             simpleNav,
             spacecraft,
+            thrusterDynamicEffector,
         )
-        from Basilisk.utilities import SimulationBaseClass, macros, simIncludeRW
+        from Basilisk.utilities import (
+            SimulationBaseClass,
+            macros,
+            simIncludeRW,
+            simIncludeThruster,
+        )
 
         _CACHE.append(
             _Modules(
@@ -298,6 +351,10 @@ def _modules() -> _Modules:
                 rwMotorTorque,
                 reactionWheelStateEffector,
                 simIncludeRW,
+                thrForceMapping,
+                thrFiringRemainder,
+                thrusterDynamicEffector,
+                simIncludeThruster,
                 macros,
                 messaging,
             )
@@ -336,7 +393,7 @@ def _build(m: _Modules, setup: BasiliskSetup) -> _Loop:
     hub = _hub(m, setup)
     loop.add("dynamics", hub)
     actuator = None
-    if setup.wheels is None or setup.position_gains is not None:
+    if setup.ideal_torque or setup.position_gains is not None:
         actuator = m.extForceTorque.ExtForceTorque()
         actuator.ModelTag = "extForceTorque"
         hub.addDynamicEffector(actuator)
@@ -352,6 +409,8 @@ def _build(m: _Modules, setup: BasiliskSetup) -> _Loop:
     control = _attitude_loop(m, loop, setup, navigation, vehicle_msg)
     if setup.wheels is not None:
         _wheel_loop(m, loop, setup, hub, control)
+    elif setup.thrusters is not None:
+        _thruster_loop(m, loop, setup.thrusters, hub, control, vehicle_msg)
     elif actuator is not None:
         actuator.cmdTorqueInMsg.subscribeTo(control.cmdTorqueOutMsg)
     if setup.position_gains is not None and actuator is not None:
@@ -422,6 +481,42 @@ def _wheel_loop(m: _Modules, loop: _Loop, setup: BasiliskSetup, hub: Any, contro
     loop.add("fsw", torques, effector)
     loop.speeds = effector.rwSpeedOutMsg.recorder(_nanos(setup.control_period))
     loop.add("fsw", loop.speeds)
+
+
+def _thruster_loop(
+    m: _Modules, loop: _Loop, thrusters: ThrusterSetup, hub: Any, control: Any, vehicle_msg: Any
+) -> None:
+    """thrForceMapping → thrFiringRemainder → thrusterDynamicEffector in the
+    flight-software task, the thrusters on ``hub``."""
+    factory = m.simIncludeThruster.thrusterFactory()
+    for position, direction in zip(thrusters.positions, thrusters.directions, strict=True):
+        factory.create(
+            "Blank_Thruster",
+            position.tolist(),
+            np.asarray(direction, dtype=float),
+            MaxThrust=float(thrusters.max_thrust),
+            MinOnTime=0.0,
+        )
+    effector = m.thrusterDynamicEffector.ThrusterDynamicEffector()
+    factory.addToSpacecraft("thrusters", effector, hub)
+    parameters = factory.getConfigMessage()
+    mapping = m.thrForceMapping.thrForceMapping()
+    mapping.ModelTag = "thrForceMapping"
+    mapping.controlAxes_B = np.eye(3).ravel().tolist()
+    mapping.thrForceSign = 1  # thrusters push only
+    mapping.use2ndLoop = 1
+    mapping.cmdTorqueInMsg.subscribeTo(control.cmdTorqueOutMsg)
+    mapping.thrConfigInMsg.subscribeTo(parameters)
+    mapping.vehConfigInMsg.subscribeTo(vehicle_msg)
+    firing = m.thrFiringRemainder.thrFiringRemainder()
+    firing.ModelTag = "thrFiringRemainder"
+    firing.thrMinFireTime = 0.0
+    firing.baseThrustState = 0  # on-pulsing
+    firing.thrConfInMsg.subscribeTo(parameters)
+    firing.thrForceInMsg.subscribeTo(mapping.thrForceCmdOutMsg)
+    effector.cmdsInMsg.subscribeTo(firing.onTimeOutMsg)
+    loop.parts.extend([factory, parameters])
+    loop.add("fsw", mapping, firing, effector)
 
 
 def _attitude_loop(

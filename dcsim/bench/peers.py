@@ -11,16 +11,22 @@ span, navigation fed the true state:
 - **Basilisk**: the modules of :mod:`dcsim.bench.basilisk_loop`, the dynamics task at
   the same step unless told otherwise.
 
-Three rows: the attitude slew alone (no translation command), the same slew while
+Four rows: the attitude slew alone (no translation command), the same slew while
 the position is held (dcsim's ``pd`` translation loop; Basilisk's
-``hillFrameRelativeControl`` about a constant chief at the hold point), and the
-attitude slew on four reaction wheels in a pyramid instead of an ideal torque (dcsim's
+``hillFrameRelativeControl`` about a constant chief at the hold point), the attitude
+slew on four reaction wheels in a pyramid instead of an ideal torque (dcsim's
 ``robot.actuators.reaction_wheels``; Basilisk's ``rwMotorTorque`` and
 ``reactionWheelStateEffector``, see :mod:`dcsim.bench.basilisk_loop` for how the two
-wheel models are made the same spacecraft). Both sides share the commanded torque
-among the wheels by the minimum-norm inverse and hold each wheel's torque over the
-control period; the wheels' limits are far above what the slew needs, so none
-saturates.
+wheel models are made the same spacecraft), and the attitude slew on twelve thrusters
+in six opposed couples (dcsim's ``robot.actuators.thrusters``: allocation and
+pulse-width modulation; Basilisk's ``thrForceMapping``, ``thrFiringRemainder`` and
+``thrusterDynamicEffector``). Both sides share the commanded torque among the wheels by
+the minimum-norm inverse and hold each wheel's torque over the control period; the
+wheels' and thrusters' limits are above what the slew needs, so none saturates. The
+thruster row flies the same slew only roughly: Basilisk's thruster modules fire from the
+third period on and round on-times to the integrator's stages
+(:mod:`dcsim.bench.basilisk_loop`), which leaves its pointing in a limit cycle where
+dcsim's converges.
 
 Gains: ``pd`` closes each loop on a double integrator with poles of
 ``s² + 2ζω s + ω²`` (``kp = ω²``, ``kd = 2ζω`` per unit inertia or mass, unsaturated
@@ -47,12 +53,13 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
 from dcsim.bench.basilisk_loop import (
     BasiliskSetup,
+    ThrusterSetup,
     WheelSetup,
     basilisk_missing,
     fly_basilisk,
@@ -93,11 +100,35 @@ PYRAMID = tuple(
 """The four wheels' spin axes, body frame: a pyramid about +z, each axis 54.7° from it,
 so that ``Σ ĝ ĝᵀ = 4/3 I`` (the wheels give the same torque about every axis)."""
 
+COUPLES = (
+    ((0, 1, 0), (1, 0, 0)),
+    ((0, -1, 0), (1, 0, 0)),
+    ((0, 1, 0), (-1, 0, 0)),
+    ((0, -1, 0), (-1, 0, 0)),
+    ((0, 0, 1), (0, 1, 0)),
+    ((0, 0, -1), (0, 1, 0)),
+    ((0, 0, 1), (0, -1, 0)),
+    ((0, 0, -1), (0, -1, 0)),
+    ((1, 0, 0), (0, 0, 1)),
+    ((-1, 0, 0), (0, 0, 1)),
+    ((1, 0, 0), (0, 0, -1)),
+    ((-1, 0, 0), (0, 0, -1)),
+)
+"""Twelve thrusters in six opposed couples, ``(position / arm, direction)``, body frame:
+the x thrusters sit on ±y (torque about z), the y ones on ±z, the z ones on ±x; each
+couple gives a torque about one axis and no force."""
+
+TorqueBy = Literal["ideal", "wheels", "thrusters"]
+"""What gives a row's torque: the ideal torque, the reaction wheels or the thrusters."""
+
 RPM = 60.0 / (2.0 * np.pi)
 """Revolutions per minute in one rad/s."""
 
 WHEEL_ROW = "slew on 4 wheels"
 """The name of the reaction-wheel row."""
+
+THRUSTER_ROW = "slew on 12 thrusters"
+"""The name of the thruster row."""
 
 TARGET_RATIO = 3.0
 """The target: dcsim's loop within this factor of Basilisk's wall time."""
@@ -136,6 +167,10 @@ class SlewCase:
         weakest direction is 4/3 of it for the pyramid; above what the slew needs).
     wheel_max_momentum : float
         Each wheel's momentum limit, N·m·s (above what the slew stores).
+    thruster_arm : float
+        Distance of the thrusters from the centre of mass, m (:data:`COUPLES`).
+    thruster_max_thrust : float
+        Each thruster's thrust, N (a couple gives ``2 arm F`` about its axis).
     """
 
     mass: float = 100.0
@@ -156,6 +191,8 @@ class SlewCase:
     wheel_inertia: float = 0.1
     wheel_max_torque: float = 20.0
     wheel_max_momentum: float = 50.0
+    thruster_arm: float = 1.0
+    thruster_max_thrust: float = 10.0
 
     @property
     def attitude_gains(self) -> tuple[float, float]:
@@ -230,8 +267,8 @@ class PeerRow:
         What the row flies.
     hold_position : bool
         Whether the position is held too.
-    wheels : bool
-        Whether reaction wheels give the torque (ideal torque otherwise).
+    torque_by : str
+        What gives the torque (:data:`TorqueBy`).
     dcsim : list of Flight
         dcsim's runs.
     basilisk : list of Flight
@@ -240,7 +277,7 @@ class PeerRow:
 
     name: str
     hold_position: bool
-    wheels: bool = False
+    torque_by: TorqueBy = "ideal"
     dcsim: list[Flight] = field(default_factory=list)
     basilisk: list[Flight] = field(default_factory=list)
 
@@ -254,7 +291,7 @@ class PeersResult:
     case : SlewCase
         What was flown.
     rows : list of PeerRow
-        Attitude only, with the position held, on reaction wheels.
+        Attitude only, with the position held, on reaction wheels, on thrusters.
     inertia : float
         The free flyer's principal moment of inertia, kg·m² (as PyBullet holds it).
     basilisk_step : float
@@ -271,10 +308,11 @@ class PeersResult:
 
 
 # ---------------------------------------------------------------------- dcsim's side
-def slew_scenario(case: SlewCase, hold_position: bool, wheels: bool = False) -> Scenario:
+def slew_scenario(case: SlewCase, hold_position: bool, torque_by: TorqueBy = "ideal") -> Scenario:
     """dcsim's scenario of ``case``: a ``hold`` mission of the goal attitude, ``pd``,
-    no localiser, a force-free (geocentric) world with nothing else in it; with
-    ``wheels``, the case's reaction wheels give the torque (its limit then theirs)."""
+    no localiser, a force-free (geocentric) world with nothing else in it; the case's
+    reaction wheels or thrusters give the torque as ``torque_by`` says (its limit then
+    theirs)."""
     robot: dict[str, Any] = {
         "mass": case.mass,
         "radius": case.radius,
@@ -284,18 +322,12 @@ def slew_scenario(case: SlewCase, hold_position: bool, wheels: bool = False) -> 
             "velocity": list(case.initial_velocity),
         },
     }
-    if wheels:
-        wheel = {
-            "inertia": case.wheel_inertia,
-            "max_torque": case.wheel_max_torque,
-            "max_momentum": case.wheel_max_momentum,
-        }
-        robot["actuators"] = {
-            "reaction_wheels": [{"axis": list(axis), **wheel} for axis in case.wheel_axes]
-        }
-    else:
+    if torque_by == "ideal":
         robot["max_torque"] = case.max_torque
-    name = "peers-slew" + ("-hold" if hold_position else "") + ("-wheels" if wheels else "")
+    else:
+        robot["actuators"] = {_section(torque_by): _actuators(case, torque_by)}
+    name = "peers-slew" + ("-hold" if hold_position else "")
+    name += "" if torque_by == "ideal" else f"-{torque_by}"
     return scenario_model(HoldMissionSection).model_validate(
         {
             "name": name,
@@ -333,19 +365,43 @@ def flyer_inertia(case: SlewCase) -> np.ndarray:
         return np.array(world.robot_spec().inertia)
 
 
-def wheel_torque_limit(case: SlewCase) -> float:
-    """The torque the case's wheels give the base in its weakest direction, N·m (dcsim's
-    ``robot.max_torque`` on wheels)."""
-    return float(slew_scenario(case, hold_position=False, wheels=True).robot.max_torque)
+def _section(torque_by: TorqueBy) -> str:
+    """The ``robot.actuators`` key of the wheels or the thrusters."""
+    return {"wheels": "reaction_wheels", "thrusters": "thrusters"}[torque_by]
+
+
+def _actuators(case: SlewCase, torque_by: TorqueBy) -> list[dict[str, Any]]:
+    """The case's reaction wheels or thrusters as ``robot.actuators`` lists them."""
+    if torque_by == "wheels":
+        wheel = {
+            "inertia": case.wheel_inertia,
+            "max_torque": case.wheel_max_torque,
+            "max_momentum": case.wheel_max_momentum,
+        }
+        return [{"axis": list(axis), **wheel} for axis in case.wheel_axes]
+    return [
+        {
+            "position": [case.thruster_arm * v for v in position],
+            "direction": list(direction),
+            "max_thrust": case.thruster_max_thrust,
+        }
+        for position, direction in COUPLES
+    ]
+
+
+def torque_limit(case: SlewCase, torque_by: TorqueBy) -> float:
+    """The torque dcsim's robot is limited to, N·m: the case's, or what its wheels or
+    thrusters give the base in its weakest direction."""
+    return float(slew_scenario(case, False, torque_by).robot.max_torque)
 
 
 def fly_dcsim(
-    case: SlewCase, hold_position: bool, registry: PluginRegistry, wheels: bool = False
+    case: SlewCase, hold_position: bool, registry: PluginRegistry, torque_by: TorqueBy = "ideal"
 ) -> Flight:
-    """Fly ``case`` through dcsim's runner and return its record (on the case's reaction
-    wheels with ``wheels``)."""
+    """Fly ``case`` through dcsim's runner and return its record (the torque given as
+    ``torque_by`` says)."""
     began, cpu_began = time.perf_counter(), time.process_time()
-    scenario = slew_scenario(case, hold_position, wheels)
+    scenario = slew_scenario(case, hold_position, torque_by)
     runner = Runner(RunSetup.from_scenario(scenario, registry), keep_rows=True)
     summary = runner.run()
     wall, cpu = time.perf_counter() - began, time.process_time() - cpu_began
@@ -353,7 +409,8 @@ def fly_dcsim(
         raise RuntimeError(f"the dcsim run ended {summary['status']}: {summary['reason']}")
     rows = runner.recorder.rows
     attitudes = np.array([[row[k] for k in ("qx", "qy", "qz", "qw")] for row in rows])
-    columns = [f"wheel_h_{i}" for i in range(1, len(case.wheel_axes) + 1)] if wheels else []
+    wheels = range(1, len(case.wheel_axes) + 1) if torque_by == "wheels" else []
+    columns = [f"wheel_h_{i}" for i in wheels]
     momenta = np.array([[row[k] for k in columns] for row in rows]).reshape(len(rows), -1)
     return Flight(
         wall=wall,
@@ -371,10 +428,14 @@ def fly_dcsim(
 
 # ---------------------------------------------------------------------- Basilisk's side
 def basilisk_setup(
-    case: SlewCase, hold_position: bool, inertia: np.ndarray, step: float, wheels: bool = False
+    case: SlewCase,
+    hold_position: bool,
+    inertia: np.ndarray,
+    step: float,
+    torque_by: TorqueBy = "ideal",
 ) -> BasiliskSetup:
-    """The Basilisk loop of ``case``: same body and start, gains matched to ``pd``'s (on
-    the case's reaction wheels with ``wheels``).
+    """The Basilisk loop of ``case``: same body and start, gains matched to ``pd``'s, the
+    torque given as ``torque_by`` says.
 
     Raises
     ------
@@ -397,7 +458,8 @@ def basilisk_setup(
         dynamics_step=step,
         control_period=case.control_period,
         duration=case.duration,
-        wheels=_wheel_setup(case) if wheels else None,
+        wheels=_wheel_setup(case) if torque_by == "wheels" else None,
+        thrusters=_thruster_setup(case) if torque_by == "thrusters" else None,
     )
 
 
@@ -409,6 +471,16 @@ def _wheel_setup(case: SlewCase) -> WheelSetup:
         inertia=case.wheel_inertia,
         max_torque=case.wheel_max_torque,
         max_momentum=case.wheel_max_momentum,
+    )
+
+
+def _thruster_setup(case: SlewCase) -> ThrusterSetup:
+    """The case's thrusters for the Basilisk loop."""
+    positions, directions = (np.array(part, dtype=float) for part in zip(*COUPLES, strict=True))
+    return ThrusterSetup(
+        positions=case.thruster_arm * positions,
+        directions=directions,
+        max_thrust=case.thruster_max_thrust,
     )
 
 
@@ -465,15 +537,16 @@ def bench_peers(
     rows = [
         PeerRow("attitude slew", False),
         PeerRow("slew + position hold", True),
-        PeerRow(WHEEL_ROW, False, wheels=True),
+        PeerRow(WHEEL_ROW, False, torque_by="wheels"),
+        PeerRow(THRUSTER_ROW, False, torque_by="thrusters"),
     ]
     _warm_up(case, registry, inertia, step, basilisk=note is None)
     for repeat in range(1, repeats + 1):
         for row in rows:
-            row.dcsim.append(fly_dcsim(case, row.hold_position, registry, row.wheels))
+            row.dcsim.append(fly_dcsim(case, row.hold_position, registry, row.torque_by))
             line = f"{row.name}, run {repeat}/{repeats}: dcsim {row.dcsim[-1].wall:.3f} s"
             if note is None:
-                setup = basilisk_setup(case, row.hold_position, inertia, step, row.wheels)
+                setup = basilisk_setup(case, row.hold_position, inertia, step, row.torque_by)
                 row.basilisk.append(fly_peer(setup))
                 line += f", Basilisk {row.basilisk[-1].wall:.3f} s"
             progress(line)
@@ -483,13 +556,14 @@ def bench_peers(
 def _warm_up(
     case: SlewCase, registry: PluginRegistry, inertia: np.ndarray, step: float, basilisk: bool
 ) -> None:
-    """Short runs of each side, with and without wheels: imports and first-use costs stay
-    out of the timings."""
+    """Short runs of each side on each actuator: imports and first-use costs stay out of
+    the timings."""
     short = replace(case, duration=10 * case.control_period)
-    for wheels in (False, True):
-        fly_dcsim(short, True, registry, wheels)
+    torque_by: TorqueBy
+    for torque_by in ("ideal", "wheels", "thrusters"):
+        fly_dcsim(short, True, registry, torque_by)
         if basilisk:
-            fly_peer(basilisk_setup(short, True, inertia, step, wheels))
+            fly_peer(basilisk_setup(short, True, inertia, step, torque_by))
 
 
 # ---------------------------------------------------------------------- figures
@@ -551,8 +625,10 @@ def notes(result: PeersResult) -> str:
         f"P = {big_p:g} N·m·s.",
         _torque_line(result),
         _wheel_line(result),
+        _thruster_line(result),
         _phase_line(result, result.rows[0]),
         _phase_line(result, _wheel_row(result)),
+        _phase_line(result, _row(result, "thrusters")),
         _cpu_line(result),
     ]
     hold = result.rows[1]
@@ -585,7 +661,7 @@ def _torque_line(result: PeersResult) -> str:
 def _wheel_line(result: PeersResult) -> str:
     """The wheels, their limits, and each side's largest torque and wheel speed."""
     case, row = result.case, _wheel_row(result)
-    limit = wheel_torque_limit(case)
+    limit = torque_limit(case, "wheels")
     flights = [("dcsim", row.dcsim[-1])] + [("Basilisk", f) for f in row.basilisk[-1:]]
     torques = ", ".join(f"{side} {flight.peak_torque:.3g} N·m" for side, flight in flights)
     speeds = ", ".join(
@@ -609,9 +685,32 @@ def _wheel_line(result: PeersResult) -> str:
     return line + "."
 
 
+def _thruster_line(result: PeersResult) -> str:
+    """The thrusters, their limit, each side's largest torque and how still each side's
+    pointing ends."""
+    case, row = result.case, _row(result, "thrusters")
+    flights = [("dcsim", row.dcsim[-1])] + [("Basilisk", f) for f in row.basilisk[-1:]]
+    torques = ", ".join(f"{side} {flight.peak_torque:.3g} N·m" for side, flight in flights)
+    tails = ", ".join(
+        f"{side} {np.degrees(np.max(flight.pointing_error[-len(flight.times) // 10 :])):.2g}°"
+        for side, flight in flights
+    )
+    return (
+        f"- {row.name}: six opposed couples {case.thruster_arm:g} m from the centre of mass, "
+        f"{case.thruster_max_thrust:g} N each (the base's torque limit "
+        f"{torque_limit(case, 'thrusters'):.3g} N·m about each axis); largest commanded "
+        f"torque {torques}; largest pointing error over the run's last tenth {tails}."
+    )
+
+
 def _wheel_row(result: PeersResult) -> PeerRow:
     """The reaction-wheel row of ``result``."""
-    return next(row for row in result.rows if row.wheels)
+    return _row(result, "wheels")
+
+
+def _row(result: PeersResult, torque_by: TorqueBy) -> PeerRow:
+    """The row of ``result`` whose torque ``torque_by`` gives."""
+    return next(row for row in result.rows if row.torque_by == torque_by)
 
 
 def _phase_line(result: PeersResult, row: PeerRow) -> str:
@@ -660,53 +759,41 @@ def verdict(result: PeersResult) -> str:
 
 def plot(result: PeersResult, path: Path) -> None:
     """The two sides' runs against time, as a PNG at ``path``: pointing error during
-    the slew and over the whole run (attitude-only row, then the wheel row), distance
-    from the hold point (position-hold row), and the wheels' speeds."""
+    the slew and over the whole run (attitude-only row, the wheel row, the thruster
+    row), distance from the hold point (position-hold row), and the wheels' speeds."""
     from dcsim.bench.figures import pyplot, save
 
     plt = pyplot()
-    figure, ((slew, tail, hold), (wheel_slew, wheel_tail, speeds)) = plt.subplots(
-        2, 3, figsize=(14, 8.4)
-    )
+    figure, axes = plt.subplots(3, 3, figsize=(14, 12.6))
     window = min(20.0, result.case.duration)
-    attitude, position = result.rows[:2]
-    _pointing(attitude, slew, tail, window)
-    _pointing(_wheel_row(result), wheel_slew, wheel_tail, window)
-    for side, flight in _last_flights(position):
+    shown = (0, min(60.0, result.case.duration))
+    for (slew, tail, _), torque_by in zip(axes, ("ideal", "wheels", "thrusters"), strict=True):
+        _pointing(_row(result, torque_by), slew, tail, window, result.case.duration)
+    hold, speeds = axes[0][2], axes[1][2]
+    for side, flight in _last_flights(result.rows[1]):
         hold.plot(flight.times, flight.position_error, color=_COLOURS[side], label=side)
     for side, flight in _last_flights(_wheel_row(result)):
         style = "-" if side == "dcsim" else "--"
         speeds.plot(flight.times, flight.wheel_speed, style, color=_COLOURS[side], lw=1.0)
-    for name, axis in (("attitude slew", slew), (WHEEL_ROW, wheel_slew)):
-        axis.set(
-            xlabel="time [s]",
-            ylabel="pointing error [deg]",
-            title=f"{name} (first {window:g} s)",
-        )
-    for name, axis in (("attitude slew", tail), (WHEEL_ROW, wheel_tail)):
-        axis.set(
-            xlabel="time [s]",
-            ylabel="pointing error [deg]",
-            title=f"{name}, the whole run ({result.case.duration:g} s)",
-        )
     hold.set(
         xlabel="time [s]",
         ylabel="distance from the hold point [m]",
         title="slew + position hold",
-        xlim=(0, min(60.0, result.case.duration)),
+        xlim=shown,
     )
     speeds.set(
         xlabel="time [s]",
         ylabel="wheel speed [rad/s]",
         title="wheel speeds (dcsim solid, Basilisk dashed)",
-        xlim=(0, min(60.0, result.case.duration)),
+        xlim=shown,
     )
-    for axis in (slew, tail, hold, wheel_slew, wheel_tail, speeds):
+    for axis in (hold, speeds):
         axis.grid(alpha=0.3)
-    slew.legend()
+    axes[2][2].axis("off")
+    axes[0][0].legend()
     figure.suptitle(
-        "dcsim bench peers: pd (dcsim, PyBullet) beside mrpFeedback, "
-        "hillFrameRelativeControl and rwMotorTorque (Basilisk)"
+        "dcsim bench peers: pd (dcsim, PyBullet) beside mrpFeedback, hillFrameRelativeControl, "
+        "rwMotorTorque and thrForceMapping (Basilisk)"
     )
     save(figure, path, dpi=90)
 
@@ -714,14 +801,24 @@ def plot(result: PeersResult, path: Path) -> None:
 _COLOURS = {"dcsim": "tab:blue", "Basilisk": "tab:orange"}
 
 
-def _pointing(row: PeerRow, slew: Any, tail: Any, window: float) -> None:
+def _pointing(row: PeerRow, slew: Any, tail: Any, window: float, duration: float) -> None:
     """Each side's pointing error of ``row``: the first ``window`` seconds (s) on
-    ``slew``, the whole run on a log scale on ``tail``."""
+    ``slew``, the whole run of ``duration`` seconds on a log scale on ``tail``."""
     for side, flight in _last_flights(row):
         degrees = np.degrees(flight.pointing_error)
         shown = flight.times <= window
         slew.plot(flight.times[shown], degrees[shown], color=_COLOURS[side], label=side)
         tail.semilogy(flight.times, np.maximum(degrees, 1e-14), color=_COLOURS[side])
+    slew.set(
+        xlabel="time [s]", ylabel="pointing error [deg]", title=f"{row.name} (first {window:g} s)"
+    )
+    tail.set(
+        xlabel="time [s]",
+        ylabel="pointing error [deg]",
+        title=f"{row.name}, the whole run ({duration:g} s)",
+    )
+    for axis in (slew, tail):
+        axis.grid(alpha=0.3)
 
 
 def _last_flights(row: PeerRow) -> list[tuple[str, Flight]]:
