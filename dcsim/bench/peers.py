@@ -121,6 +121,9 @@ couple gives a torque about one axis and no force."""
 TorqueBy = Literal["ideal", "wheels", "thrusters"]
 """What gives a row's torque: the ideal torque, the reaction wheels or the thrusters."""
 
+TORQUES: tuple[TorqueBy, ...] = ("ideal", "wheels", "thrusters")
+"""Every :data:`TorqueBy`, in the rows' order."""
+
 RPM = 60.0 / (2.0 * np.pi)
 """Revolutions per minute in one rad/s."""
 
@@ -559,8 +562,7 @@ def _warm_up(
     """Short runs of each side on each actuator: imports and first-use costs stay out of
     the timings."""
     short = replace(case, duration=10 * case.control_period)
-    torque_by: TorqueBy
-    for torque_by in ("ideal", "wheels", "thrusters"):
+    for torque_by in TORQUES:
         fly_dcsim(short, True, registry, torque_by)
         if basilisk:
             fly_peer(basilisk_setup(short, True, inertia, step, torque_by))
@@ -767,7 +769,7 @@ def plot(result: PeersResult, path: Path) -> None:
     figure, axes = plt.subplots(3, 3, figsize=(14, 12.6))
     window = min(20.0, result.case.duration)
     shown = (0, min(60.0, result.case.duration))
-    for (slew, tail, _), torque_by in zip(axes, ("ideal", "wheels", "thrusters"), strict=True):
+    for (slew, tail, _), torque_by in zip(axes, TORQUES, strict=True):
         _pointing(_row(result, torque_by), slew, tail, window, result.case.duration)
     hold, speeds = axes[0][2], axes[1][2]
     for side, flight in _last_flights(result.rows[1]):
