@@ -288,12 +288,13 @@ def bench_peers_command(
     """dcsim's attitude loop beside Basilisk's: the same slew, gains and rates.
 
     A rigid free flyer slews 90° to a fixed inertial attitude under a PD law at 10 Hz,
-    truth-fed, once with translation free, once holding its position and once on four
-    reaction wheels; dcsim (the hold mission, pd, PyBullet, its reaction wheels) and
-    Basilisk (spacecraft hub, extForceTorque, simpleNav, inertial3D, attTrackingError,
-    mrpFeedback, hillFrameRelativeControl, rwMotorTorque, reactionWheelStateEffector)
-    fly it alternately, REPEATS times each. Prints a Markdown table for
-    docs/benchmarks.md.
+    truth-fed, once with translation free, once holding its position, once on four
+    reaction wheels and once on twelve thrusters; dcsim (the hold mission, pd, PyBullet,
+    its reaction wheels and thrusters) and Basilisk (spacecraft hub, extForceTorque,
+    simpleNav, inertial3D, attTrackingError, mrpFeedback, hillFrameRelativeControl,
+    rwMotorTorque, reactionWheelStateEffector, thrForceMapping, thrFiringRemainder,
+    thrusterDynamicEffector) fly it alternately, REPEATS times each. Prints a Markdown
+    table for docs/benchmarks.md.
     Basilisk is optional (pip install 'dcsim[peers]'); without it the dcsim side runs
     alone.
     """
