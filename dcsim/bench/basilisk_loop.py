@@ -17,6 +17,37 @@ The loop, in two tasks of one process:
   ``extForceTorque``, which reads the commands once per period; the hub applies them
   over every dynamics step of the period (a zero-order hold, as dcsim's world does).
 
+Reaction wheels (optional) replace ``extForceTorque``'s torque: ``rwMotorTorque``
+shares ``mrpFeedback``'s torque among the wheels by the minimum-norm inverse (as
+dcsim's wheels do), and a ``reactionWheelStateEffector`` of balanced wheels (built by
+``simIncludeRW.rwFactory``, type ``custom``) reads those torques once per period, in the
+flight-software task after ``rwMotorTorque``, and holds them over the period; the hub
+integrates the wheels' speeds with its own state. ``mrpFeedback`` is not given the
+wheels' speeds, so its law leaves their momentum out of the gyroscopic term, as
+``pd``'s does.
+
+Thrusters (optional, instead of wheels) replace it likewise: ``thrForceMapping``
+(``thrForceSign = +1``, all three body axes, its second pass on: the torque shared
+again among the thrusters the first pass fired) gives each thruster a force,
+``thrFiringRemainder`` (no minimum firing time) the on-time ``T f / F_max``, and a
+``thrusterDynamicEffector`` of thrusters built by ``simIncludeThruster.thrusterFactory``
+(``Blank_Thruster``, no minimum on-time) reads the on-times once per period, in the
+flight-software task, and fires each from the period's start. Two behaviours of these
+modules make the thruster loop differ from dcsim's: ``thrFiringRemainder`` commands
+nothing at its first two calls (it takes a previous call time of 0 for "no previous
+call"), so the thrusters first fire at the third period; and the effector switches a
+thruster on or off at the integrator's stage times, so an on-time ending inside a
+dynamics step is rounded to the step's RK4 stages (dcsim's PWM gives a partly covered
+physics step the covered fraction).
+
+Balanced wheels in Basilisk belong to the hub: its inertia includes theirs, and a
+wheel's state is its speed Ω relative to the hub, its momentum about its axis
+``Js (Ω + ĝ·ω)``. dcsim's wheels carry that momentum ``h`` (:mod:`dcsim.world.wheels`)
+with a base whose inertia leaves out the wheels' inertia about their spin axes. The
+same spacecraft is therefore a hub of inertia ``I + Σ Js ĝ ĝᵀ`` here (``I`` dcsim's),
+its wheels starting at ``Ω = −ĝ·ω`` (dcsim's start at ``h = 0``); both sides then fly
+``I ω̇ = −Σ ĝ u − ω × (I ω + Σ ĝ h)``, ``ḣ = u``.
+
 Position hold: Basilisk's translational feedback module, ``hillFrameRelativeControl``,
 is a PD on the position relative to a chief spacecraft in the chief's Hill frame, with
 relative-orbit feed-forward. The chief here is the hold point as a constant
@@ -55,6 +86,48 @@ _NANO = 1_000_000_000
 
 
 @dataclass(frozen=True)
+class WheelSetup:
+    """Identical reaction wheels, SI units, body frame.
+
+    Attributes
+    ----------
+    axes : ndarray (3, N)
+        Unit spin axes as columns.
+    inertia : float
+        Each wheel's moment of inertia about its spin axis, kg·m².
+    max_torque : float
+        Each wheel's largest motor torque, N·m.
+    max_momentum : float
+        Each wheel's largest momentum about its axis, N·m·s (Basilisk's speed limit
+        ``max_momentum / inertia``).
+    """
+
+    axes: np.ndarray
+    inertia: float
+    max_torque: float
+    max_momentum: float
+
+
+@dataclass(frozen=True)
+class ThrusterSetup:
+    """Identical thrusters, SI units, body frame.
+
+    Attributes
+    ----------
+    positions : ndarray (N, 3)
+        Where each thruster sits relative to the centre of mass, m.
+    directions : ndarray (N, 3)
+        The unit direction of each thruster's force on the hub.
+    max_thrust : float
+        Each thruster's thrust when on, N.
+    """
+
+    positions: np.ndarray
+    directions: np.ndarray
+    max_thrust: float
+
+
+@dataclass(frozen=True)
 class BasiliskSetup:
     """What the Basilisk loop flies, in SI units.
 
@@ -83,6 +156,10 @@ class BasiliskSetup:
         Period of the flight-software task, s.
     duration : float
         Simulated time, s (a whole number of control periods).
+    wheels : WheelSetup or None
+        Reaction wheels giving the torque; None: ``extForceTorque`` gives it.
+    thrusters : ThrusterSetup or None
+        Thrusters giving the torque (not with wheels); None: ``extForceTorque`` gives it.
     """
 
     mass: float
@@ -96,6 +173,13 @@ class BasiliskSetup:
     dynamics_step: float
     control_period: float
     duration: float
+    wheels: WheelSetup | None = None
+    thrusters: ThrusterSetup | None = None
+
+    @property
+    def ideal_torque(self) -> bool:
+        """Whether ``extForceTorque`` gives the torque (no wheels, no thrusters)."""
+        return self.wheels is None and self.thrusters is None
 
 
 @dataclass(frozen=True)
@@ -116,6 +200,9 @@ class BasiliskFlight:
         True position relative to :data:`HOLD_POINT`, inertial frame, m.
     torques : ndarray (N, 3)
         ``mrpFeedback``'s commanded torque, body frame, N·m.
+    wheel_speeds : ndarray (N, wheels)
+        Each wheel's momentum about its axis over its inertia, ``Ω + ĝ·ω``, rad/s
+        (what dcsim reports as its wheels' speeds); no columns without wheels.
     """
 
     wall: float
@@ -124,6 +211,7 @@ class BasiliskFlight:
     attitudes: np.ndarray
     positions: np.ndarray
     torques: np.ndarray
+    wheel_speeds: np.ndarray
 
 
 def basilisk_missing() -> str | None:
@@ -184,7 +272,17 @@ def fly_basilisk(setup: BasiliskSetup) -> BasiliskFlight:
         attitudes=quaternion_from_mrp(np.asarray(loop.states.sigma_BN)),
         positions=np.asarray(loop.states.r_BN_N) - np.asarray(HOLD_POINT),
         torques=np.asarray(loop.torques.torqueRequestBody),
+        wheel_speeds=_wheel_speeds(loop, setup.wheels),
     )
+
+
+def _wheel_speeds(loop: _Loop, wheels: WheelSetup | None) -> np.ndarray:
+    """The recorded wheels' ``Ω + ĝ·ω``, rad/s (N, wheels)."""
+    if wheels is None:
+        return np.zeros((len(loop.states.times()), 0))
+    count = wheels.axes.shape[1]
+    relative = np.asarray(loop.speeds.wheelSpeeds)[:, :count]
+    return relative + np.asarray(loop.states.omega_BN_B) @ wheels.axes
 
 
 # ---------------------------------------------------------------------- building
@@ -200,6 +298,14 @@ class _Modules:
     attTrackingError: Any
     mrpFeedback: Any
     hillFrameRelativeControl: Any
+    rwMotorTorque: Any
+    reactionWheelStateEffector: Any
+    simIncludeRW: Any
+    thrForceMapping: Any
+    thrFiringRemainder: Any
+    thrusterDynamicEffector: Any
+    simIncludeThruster: Any
+    macros: Any
     messaging: Any
 
 
@@ -214,9 +320,23 @@ def _modules() -> _Modules:
             hillFrameRelativeControl,
             inertial3D,
             mrpFeedback,
+            rwMotorTorque,
+            thrFiringRemainder,
+            thrForceMapping,
         )
-        from Basilisk.simulation import extForceTorque, simpleNav, spacecraft
-        from Basilisk.utilities import SimulationBaseClass
+        from Basilisk.simulation import (
+            extForceTorque,
+            reactionWheelStateEffector,
+            simpleNav,
+            spacecraft,
+            thrusterDynamicEffector,
+        )
+        from Basilisk.utilities import (
+            SimulationBaseClass,
+            macros,
+            simIncludeRW,
+            simIncludeThruster,
+        )
 
         _CACHE.append(
             _Modules(
@@ -228,6 +348,14 @@ def _modules() -> _Modules:
                 attTrackingError,
                 mrpFeedback,
                 hillFrameRelativeControl,
+                rwMotorTorque,
+                reactionWheelStateEffector,
+                simIncludeRW,
+                thrForceMapping,
+                thrFiringRemainder,
+                thrusterDynamicEffector,
+                simIncludeThruster,
+                macros,
                 messaging,
             )
         )
@@ -242,6 +370,7 @@ class _Loop:
     sim: Any
     states: Any = None
     torques: Any = None
+    speeds: Any = None
     parts: list[Any] = field(default_factory=list)
 
     def add(self, task: str, *modules: Any) -> None:
@@ -263,12 +392,14 @@ def _build(m: _Modules, setup: BasiliskSetup) -> _Loop:
     process.addTask(loop.sim.CreateNewTask("fsw", _nanos(setup.control_period)), 1)
     hub = _hub(m, setup)
     loop.add("dynamics", hub)
-    actuator = m.extForceTorque.ExtForceTorque()
-    actuator.ModelTag = "extForceTorque"
-    hub.addDynamicEffector(actuator)
+    actuator = None
+    if setup.ideal_torque or setup.position_gains is not None:
+        actuator = m.extForceTorque.ExtForceTorque()
+        actuator.ModelTag = "extForceTorque"
+        hub.addDynamicEffector(actuator)
     vehicle = m.messaging.VehicleConfigMsgPayload()
     vehicle.massSC = setup.mass
-    vehicle.ISCPntB_B = np.asarray(setup.inertia, dtype=float).ravel().tolist()
+    vehicle.ISCPntB_B = _hub_inertia(setup).ravel().tolist()
     vehicle_msg = m.messaging.VehicleConfigMsg().write(vehicle)
     loop.parts.append(vehicle_msg)
     navigation = m.simpleNav.SimpleNav()
@@ -276,15 +407,31 @@ def _build(m: _Modules, setup: BasiliskSetup) -> _Loop:
     navigation.scStateInMsg.subscribeTo(hub.scStateOutMsg)
     loop.add("fsw", navigation)
     control = _attitude_loop(m, loop, setup, navigation, vehicle_msg)
-    actuator.cmdTorqueInMsg.subscribeTo(control.cmdTorqueOutMsg)
-    if setup.position_gains is not None:
+    if setup.wheels is not None:
+        _wheel_loop(m, loop, setup, hub, control)
+    elif setup.thrusters is not None:
+        _thruster_loop(m, loop, setup.thrusters, hub, control, vehicle_msg)
+    elif actuator is not None:
+        actuator.cmdTorqueInMsg.subscribeTo(control.cmdTorqueOutMsg)
+    if setup.position_gains is not None and actuator is not None:
         hold = _position_loop(m, loop, setup.position_gains, navigation, vehicle_msg)
         actuator.cmdForceInertialInMsg.subscribeTo(hold.forceOutMsg)
-    loop.add("fsw", actuator)
+    if actuator is not None:
+        loop.add("fsw", actuator)
     loop.states = hub.scStateOutMsg.recorder(_nanos(setup.control_period))
     loop.torques = control.cmdTorqueOutMsg.recorder(_nanos(setup.control_period))
     loop.add("fsw", loop.states, loop.torques)
     return loop
+
+
+def _hub_inertia(setup: BasiliskSetup) -> np.ndarray:
+    """The hub's inertia about its centre of mass, body frame, kg·m²: the setup's, plus
+    the wheels' about their spin axes (``Σ Js ĝ ĝᵀ``, see the module's notes)."""
+    inertia = np.asarray(setup.inertia, dtype=float)
+    if setup.wheels is None:
+        return inertia
+    axes = setup.wheels.axes
+    return inertia + setup.wheels.inertia * (axes @ axes.T)
 
 
 def _hub(m: _Modules, setup: BasiliskSetup) -> Any:
@@ -292,13 +439,84 @@ def _hub(m: _Modules, setup: BasiliskSetup) -> Any:
     hub = m.spacecraft.Spacecraft()
     hub.ModelTag = "hub"
     hub.hub.mHub = setup.mass
-    hub.hub.IHubPntBc_B = np.asarray(setup.inertia, dtype=float).tolist()
+    hub.hub.IHubPntBc_B = _hub_inertia(setup).tolist()
     hub.hub.r_CN_NInit = [[v] for v in HOLD_POINT]
     hub.hub.v_CN_NInit = [[float(v)] for v in setup.velocity]
     hub.hub.sigma_BNInit = [[float(v)] for v in mrp_from_quaternion(setup.attitude)]
-    body_rate = rotate(_conjugate(setup.attitude), setup.angular_velocity)
-    hub.hub.omega_BN_BInit = [[float(v)] for v in body_rate]
+    hub.hub.omega_BN_BInit = [[float(v)] for v in _initial_body_rate(setup)]
     return hub
+
+
+def _initial_body_rate(setup: BasiliskSetup) -> np.ndarray:
+    """The initial angular velocity in body axes, rad/s."""
+    return rotate(_conjugate(setup.attitude), setup.angular_velocity)
+
+
+def _wheel_loop(m: _Modules, loop: _Loop, setup: BasiliskSetup, hub: Any, control: Any) -> None:
+    """rwMotorTorque → reactionWheelStateEffector in the flight-software task, the wheels
+    on ``hub``, their speeds recorded."""
+    wheels = setup.wheels
+    assert wheels is not None
+    factory = m.simIncludeRW.rwFactory()
+    rpm = m.macros.RPM  # rad/s in one rpm: the factory takes speeds in rpm
+    for axis, rate in zip(wheels.axes.T, wheels.axes.T @ _initial_body_rate(setup), strict=True):
+        factory.create(
+            "custom",
+            axis.tolist(),
+            Js=float(wheels.inertia),
+            u_max=float(wheels.max_torque),
+            Omega_max=float(wheels.max_momentum / wheels.inertia / rpm),
+            Omega=float(-rate / rpm),  # zero momentum about the axis, as dcsim's wheels
+        )
+    effector = m.reactionWheelStateEffector.ReactionWheelStateEffector()
+    factory.addToSpacecraft("reactionWheels", effector, hub)
+    parameters = factory.getConfigMessage()
+    torques = m.rwMotorTorque.rwMotorTorque()
+    torques.ModelTag = "rwMotorTorque"
+    torques.controlAxes_B = np.eye(3).ravel().tolist()
+    torques.vehControlInMsg.subscribeTo(control.cmdTorqueOutMsg)
+    torques.rwParamsInMsg.subscribeTo(parameters)
+    effector.rwMotorCmdInMsg.subscribeTo(torques.rwMotorTorqueOutMsg)
+    loop.parts.extend([factory, parameters])
+    loop.add("fsw", torques, effector)
+    loop.speeds = effector.rwSpeedOutMsg.recorder(_nanos(setup.control_period))
+    loop.add("fsw", loop.speeds)
+
+
+def _thruster_loop(
+    m: _Modules, loop: _Loop, thrusters: ThrusterSetup, hub: Any, control: Any, vehicle_msg: Any
+) -> None:
+    """thrForceMapping → thrFiringRemainder → thrusterDynamicEffector in the
+    flight-software task, the thrusters on ``hub``."""
+    factory = m.simIncludeThruster.thrusterFactory()
+    for position, direction in zip(thrusters.positions, thrusters.directions, strict=True):
+        factory.create(
+            "Blank_Thruster",
+            position.tolist(),
+            np.asarray(direction, dtype=float),
+            MaxThrust=float(thrusters.max_thrust),
+            MinOnTime=0.0,
+        )
+    effector = m.thrusterDynamicEffector.ThrusterDynamicEffector()
+    factory.addToSpacecraft("thrusters", effector, hub)
+    parameters = factory.getConfigMessage()
+    mapping = m.thrForceMapping.thrForceMapping()
+    mapping.ModelTag = "thrForceMapping"
+    mapping.controlAxes_B = np.eye(3).ravel().tolist()
+    mapping.thrForceSign = 1  # thrusters push only
+    mapping.use2ndLoop = 1
+    mapping.cmdTorqueInMsg.subscribeTo(control.cmdTorqueOutMsg)
+    mapping.thrConfigInMsg.subscribeTo(parameters)
+    mapping.vehConfigInMsg.subscribeTo(vehicle_msg)
+    firing = m.thrFiringRemainder.thrFiringRemainder()
+    firing.ModelTag = "thrFiringRemainder"
+    firing.thrMinFireTime = 0.0
+    firing.baseThrustState = 0  # on-pulsing
+    firing.thrConfInMsg.subscribeTo(parameters)
+    firing.thrForceInMsg.subscribeTo(mapping.thrForceCmdOutMsg)
+    effector.cmdsInMsg.subscribeTo(firing.onTimeOutMsg)
+    loop.parts.extend([factory, parameters])
+    loop.add("fsw", mapping, firing, effector)
 
 
 def _attitude_loop(

@@ -11,9 +11,22 @@ span, navigation fed the true state:
 - **Basilisk**: the modules of :mod:`dcsim.bench.basilisk_loop`, the dynamics task at
   the same step unless told otherwise.
 
-Two rows: the attitude slew alone (no translation command), and the same slew while
+Four rows: the attitude slew alone (no translation command), the same slew while
 the position is held (dcsim's ``pd`` translation loop; Basilisk's
-``hillFrameRelativeControl`` about a constant chief at the hold point).
+``hillFrameRelativeControl`` about a constant chief at the hold point), the attitude
+slew on four reaction wheels in a pyramid instead of an ideal torque (dcsim's
+``robot.actuators.reaction_wheels``; Basilisk's ``rwMotorTorque`` and
+``reactionWheelStateEffector``, see :mod:`dcsim.bench.basilisk_loop` for how the two
+wheel models are made the same spacecraft), and the attitude slew on twelve thrusters
+in six opposed couples (dcsim's ``robot.actuators.thrusters``: allocation and
+pulse-width modulation; Basilisk's ``thrForceMapping``, ``thrFiringRemainder`` and
+``thrusterDynamicEffector``). Both sides share the commanded torque among the wheels by
+the minimum-norm inverse and hold each wheel's torque over the control period; the
+wheels' and thrusters' limits are above what the slew needs, so none saturates. The
+thruster row flies the same slew only roughly: Basilisk's thruster modules fire from the
+third period on and round on-times to the integrator's stages
+(:mod:`dcsim.bench.basilisk_loop`), which leaves its pointing in a limit cycle where
+dcsim's converges.
 
 Gains: ``pd`` closes each loop on a double integrator with poles of
 ``s² + 2ζω s + ω²`` (``kp = ω²``, ``kd = 2ζω`` per unit inertia or mass, unsaturated
@@ -40,11 +53,14 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any, Literal
 
 import numpy as np
 
 from dcsim.bench.basilisk_loop import (
     BasiliskSetup,
+    ThrusterSetup,
+    WheelSetup,
     basilisk_missing,
     fly_basilisk,
 )
@@ -77,6 +93,46 @@ INITIAL_ATTITUDE = tuple(
 )
 """The initial attitude ``[x, y, z, w]``: 90° away from the goal."""
 
+PYRAMID = tuple(
+    tuple(float(v) for v in np.array(axis) / np.sqrt(3.0))
+    for axis in ((1, 1, 1), (-1, 1, 1), (-1, -1, 1), (1, -1, 1))
+)
+"""The four wheels' spin axes, body frame: a pyramid about +z, each axis 54.7° from it,
+so that ``Σ ĝ ĝᵀ = 4/3 I`` (the wheels give the same torque about every axis)."""
+
+COUPLES = (
+    ((0, 1, 0), (1, 0, 0)),
+    ((0, -1, 0), (1, 0, 0)),
+    ((0, 1, 0), (-1, 0, 0)),
+    ((0, -1, 0), (-1, 0, 0)),
+    ((0, 0, 1), (0, 1, 0)),
+    ((0, 0, -1), (0, 1, 0)),
+    ((0, 0, 1), (0, -1, 0)),
+    ((0, 0, -1), (0, -1, 0)),
+    ((1, 0, 0), (0, 0, 1)),
+    ((-1, 0, 0), (0, 0, 1)),
+    ((1, 0, 0), (0, 0, -1)),
+    ((-1, 0, 0), (0, 0, -1)),
+)
+"""Twelve thrusters in six opposed couples, ``(position / arm, direction)``, body frame:
+the x thrusters sit on ±y (torque about z), the y ones on ±z, the z ones on ±x; each
+couple gives a torque about one axis and no force."""
+
+TorqueBy = Literal["ideal", "wheels", "thrusters"]
+"""What gives a row's torque: the ideal torque, the reaction wheels or the thrusters."""
+
+TORQUES: tuple[TorqueBy, ...] = ("ideal", "wheels", "thrusters")
+"""Every :data:`TorqueBy`, in the rows' order."""
+
+RPM = 60.0 / (2.0 * np.pi)
+"""Revolutions per minute in one rad/s."""
+
+WHEEL_ROW = "slew on 4 wheels"
+"""The name of the reaction-wheel row."""
+
+THRUSTER_ROW = "slew on 12 thrusters"
+"""The name of the thruster row."""
+
 TARGET_RATIO = 3.0
 """The target: dcsim's loop within this factor of Basilisk's wall time."""
 
@@ -105,6 +161,19 @@ class SlewCase:
         ``pd``'s position loop: natural frequency (rad/s) and damping ratio.
     attitude_bandwidth, attitude_damping : float
         ``pd``'s attitude loop: natural frequency (rad/s) and damping ratio.
+    wheel_axes : tuple of tuple of float
+        The reaction wheels' unit spin axes, body frame (the wheel row).
+    wheel_inertia : float
+        Each wheel's moment of inertia about its spin axis, kg·m².
+    wheel_max_torque : float
+        Each wheel's torque limit, N·m (the wheels' limit on the base's torque in its
+        weakest direction is 4/3 of it for the pyramid; above what the slew needs).
+    wheel_max_momentum : float
+        Each wheel's momentum limit, N·m·s (above what the slew stores).
+    thruster_arm : float
+        Distance of the thrusters from the centre of mass, m (:data:`COUPLES`).
+    thruster_max_thrust : float
+        Each thruster's thrust, N (a couple gives ``2 arm F`` about its axis).
     """
 
     mass: float = 100.0
@@ -121,6 +190,12 @@ class SlewCase:
     damping: float = 0.9
     attitude_bandwidth: float = 0.5
     attitude_damping: float = 0.9
+    wheel_axes: tuple[tuple[float, ...], ...] = PYRAMID
+    wheel_inertia: float = 0.1
+    wheel_max_torque: float = 20.0
+    wheel_max_momentum: float = 50.0
+    thruster_arm: float = 1.0
+    thruster_max_thrust: float = 10.0
 
     @property
     def attitude_gains(self) -> tuple[float, float]:
@@ -161,6 +236,10 @@ class Flight:
         Distance from the start (hold) position, m.
     peak_torque : float
         Largest commanded torque magnitude, N·m.
+    wheel_speed : ndarray (N, wheels)
+        Each reaction wheel's momentum about its axis over its inertia, rad/s (dcsim's
+        ``wheel_speed``; the spin rate relative to the base plus the base's rate about
+        the wheel's axis); no columns with ideal torque.
     phases : dict of str to float
         dcsim's wall time by phase of the run loop (the runner's lap timer), s; empty
         for Basilisk.
@@ -172,7 +251,13 @@ class Flight:
     pointing_error: np.ndarray
     position_error: np.ndarray
     peak_torque: float
+    wheel_speed: np.ndarray
     phases: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def peak_wheel_speed(self) -> float:
+        """The largest wheel speed magnitude of the run, rad/s (nan without wheels)."""
+        return float(np.max(np.abs(self.wheel_speed))) if self.wheel_speed.size else np.nan
 
 
 @dataclass
@@ -185,6 +270,8 @@ class PeerRow:
         What the row flies.
     hold_position : bool
         Whether the position is held too.
+    torque_by : str
+        What gives the torque (:data:`TorqueBy`).
     dcsim : list of Flight
         dcsim's runs.
     basilisk : list of Flight
@@ -193,6 +280,7 @@ class PeerRow:
 
     name: str
     hold_position: bool
+    torque_by: TorqueBy = "ideal"
     dcsim: list[Flight] = field(default_factory=list)
     basilisk: list[Flight] = field(default_factory=list)
 
@@ -206,7 +294,7 @@ class PeersResult:
     case : SlewCase
         What was flown.
     rows : list of PeerRow
-        Attitude only, then with the position held.
+        Attitude only, with the position held, on reaction wheels, on thrusters.
     inertia : float
         The free flyer's principal moment of inertia, kg·m² (as PyBullet holds it).
     basilisk_step : float
@@ -223,28 +311,36 @@ class PeersResult:
 
 
 # ---------------------------------------------------------------------- dcsim's side
-def slew_scenario(case: SlewCase, hold_position: bool) -> Scenario:
+def slew_scenario(case: SlewCase, hold_position: bool, torque_by: TorqueBy = "ideal") -> Scenario:
     """dcsim's scenario of ``case``: a ``hold`` mission of the goal attitude, ``pd``,
-    no localiser, a force-free (geocentric) world with nothing else in it."""
+    no localiser, a force-free (geocentric) world with nothing else in it; the case's
+    reaction wheels or thrusters give the torque as ``torque_by`` says (its limit then
+    theirs)."""
+    robot: dict[str, Any] = {
+        "mass": case.mass,
+        "radius": case.radius,
+        "initial": {
+            "attitude": list(case.initial_attitude),
+            "angular_velocity": list(case.initial_angular_velocity),
+            "velocity": list(case.initial_velocity),
+        },
+    }
+    if torque_by == "ideal":
+        robot["max_torque"] = case.max_torque
+    else:
+        robot["actuators"] = {_section(torque_by): _actuators(case, torque_by)}
+    name = "peers-slew" + ("-hold" if hold_position else "")
+    name += "" if torque_by == "ideal" else f"-{torque_by}"
     return scenario_model(HoldMissionSection).model_validate(
         {
-            "name": "peers-slew" + ("-hold" if hold_position else ""),
+            "name": name,
             "world": {
                 "frame": "geocentric",
                 "physics_step": case.physics_step,
                 "control_period": case.control_period,
                 "duration": case.duration,
             },
-            "robot": {
-                "mass": case.mass,
-                "radius": case.radius,
-                "max_torque": case.max_torque,
-                "initial": {
-                    "attitude": list(case.initial_attitude),
-                    "angular_velocity": list(case.initial_angular_velocity),
-                    "velocity": list(case.initial_velocity),
-                },
-            },
+            "robot": robot,
             "localiser": None,
             "controller": {
                 "plugin": "pd",
@@ -272,18 +368,53 @@ def flyer_inertia(case: SlewCase) -> np.ndarray:
         return np.array(world.robot_spec().inertia)
 
 
-def fly_dcsim(case: SlewCase, hold_position: bool, registry: PluginRegistry) -> Flight:
-    """Fly ``case`` through dcsim's runner and return its record."""
+def _section(torque_by: TorqueBy) -> str:
+    """The ``robot.actuators`` key of the wheels or the thrusters."""
+    return {"wheels": "reaction_wheels", "thrusters": "thrusters"}[torque_by]
+
+
+def _actuators(case: SlewCase, torque_by: TorqueBy) -> list[dict[str, Any]]:
+    """The case's reaction wheels or thrusters as ``robot.actuators`` lists them."""
+    if torque_by == "wheels":
+        wheel = {
+            "inertia": case.wheel_inertia,
+            "max_torque": case.wheel_max_torque,
+            "max_momentum": case.wheel_max_momentum,
+        }
+        return [{"axis": list(axis), **wheel} for axis in case.wheel_axes]
+    return [
+        {
+            "position": [case.thruster_arm * v for v in position],
+            "direction": list(direction),
+            "max_thrust": case.thruster_max_thrust,
+        }
+        for position, direction in COUPLES
+    ]
+
+
+def torque_limit(case: SlewCase, torque_by: TorqueBy) -> float:
+    """The torque dcsim's robot is limited to, N·m: the case's, or what its wheels or
+    thrusters give the base in its weakest direction."""
+    return float(slew_scenario(case, False, torque_by).robot.max_torque)
+
+
+def fly_dcsim(
+    case: SlewCase, hold_position: bool, registry: PluginRegistry, torque_by: TorqueBy = "ideal"
+) -> Flight:
+    """Fly ``case`` through dcsim's runner and return its record (the torque given as
+    ``torque_by`` says)."""
     began, cpu_began = time.perf_counter(), time.process_time()
-    runner = Runner(
-        RunSetup.from_scenario(slew_scenario(case, hold_position), registry), keep_rows=True
-    )
+    scenario = slew_scenario(case, hold_position, torque_by)
+    runner = Runner(RunSetup.from_scenario(scenario, registry), keep_rows=True)
     summary = runner.run()
     wall, cpu = time.perf_counter() - began, time.process_time() - cpu_began
     if summary["status"] != "completed":
         raise RuntimeError(f"the dcsim run ended {summary['status']}: {summary['reason']}")
     rows = runner.recorder.rows
     attitudes = np.array([[row[k] for k in ("qx", "qy", "qz", "qw")] for row in rows])
+    wheels = range(1, len(case.wheel_axes) + 1) if torque_by == "wheels" else []
+    columns = [f"wheel_h_{i}" for i in wheels]
+    momenta = np.array([[row[k] for k in columns] for row in rows]).reshape(len(rows), -1)
     return Flight(
         wall=wall,
         cpu=cpu,
@@ -293,15 +424,21 @@ def fly_dcsim(case: SlewCase, hold_position: bool, registry: PluginRegistry) -> 
         peak_torque=float(
             np.max(np.linalg.norm([[row[k] for k in ("tx", "ty", "tz")] for row in rows], axis=1))
         ),
+        wheel_speed=momenta / case.wheel_inertia,
         phases=dict(summary["wall_time_by_phase_s"]),
     )
 
 
 # ---------------------------------------------------------------------- Basilisk's side
 def basilisk_setup(
-    case: SlewCase, hold_position: bool, inertia: np.ndarray, step: float
+    case: SlewCase,
+    hold_position: bool,
+    inertia: np.ndarray,
+    step: float,
+    torque_by: TorqueBy = "ideal",
 ) -> BasiliskSetup:
-    """The Basilisk loop of ``case``: same body and start, gains matched to ``pd``'s.
+    """The Basilisk loop of ``case``: same body and start, gains matched to ``pd``'s, the
+    torque given as ``torque_by`` says.
 
     Raises
     ------
@@ -324,6 +461,29 @@ def basilisk_setup(
         dynamics_step=step,
         control_period=case.control_period,
         duration=case.duration,
+        wheels=_wheel_setup(case) if torque_by == "wheels" else None,
+        thrusters=_thruster_setup(case) if torque_by == "thrusters" else None,
+    )
+
+
+def _wheel_setup(case: SlewCase) -> WheelSetup:
+    """The case's reaction wheels for the Basilisk loop."""
+    axes = np.array(case.wheel_axes, dtype=float).T
+    return WheelSetup(
+        axes=axes / np.linalg.norm(axes, axis=0),
+        inertia=case.wheel_inertia,
+        max_torque=case.wheel_max_torque,
+        max_momentum=case.wheel_max_momentum,
+    )
+
+
+def _thruster_setup(case: SlewCase) -> ThrusterSetup:
+    """The case's thrusters for the Basilisk loop."""
+    positions, directions = (np.array(part, dtype=float) for part in zip(*COUPLES, strict=True))
+    return ThrusterSetup(
+        positions=case.thruster_arm * positions,
+        directions=directions,
+        max_thrust=case.thruster_max_thrust,
     )
 
 
@@ -337,6 +497,7 @@ def fly_peer(setup: BasiliskSetup) -> Flight:
         pointing_error=pointing_errors(flight.attitudes, setup.goal_attitude),
         position_error=np.linalg.norm(flight.positions, axis=1),
         peak_torque=float(np.max(np.linalg.norm(flight.torques, axis=1))),
+        wheel_speed=flight.wheel_speeds,
     )
 
 
@@ -376,14 +537,19 @@ def bench_peers(
     note = basilisk_missing()
     if note is not None:
         progress(f"Basilisk is not flown: {note}")
-    rows = [PeerRow("attitude slew", False), PeerRow("slew + position hold", True)]
+    rows = [
+        PeerRow("attitude slew", False),
+        PeerRow("slew + position hold", True),
+        PeerRow(WHEEL_ROW, False, torque_by="wheels"),
+        PeerRow(THRUSTER_ROW, False, torque_by="thrusters"),
+    ]
     _warm_up(case, registry, inertia, step, basilisk=note is None)
     for repeat in range(1, repeats + 1):
         for row in rows:
-            row.dcsim.append(fly_dcsim(case, row.hold_position, registry))
+            row.dcsim.append(fly_dcsim(case, row.hold_position, registry, row.torque_by))
             line = f"{row.name}, run {repeat}/{repeats}: dcsim {row.dcsim[-1].wall:.3f} s"
             if note is None:
-                setup = basilisk_setup(case, row.hold_position, inertia, step)
+                setup = basilisk_setup(case, row.hold_position, inertia, step, row.torque_by)
                 row.basilisk.append(fly_peer(setup))
                 line += f", Basilisk {row.basilisk[-1].wall:.3f} s"
             progress(line)
@@ -393,11 +559,13 @@ def bench_peers(
 def _warm_up(
     case: SlewCase, registry: PluginRegistry, inertia: np.ndarray, step: float, basilisk: bool
 ) -> None:
-    """One short run of each side: imports and first-use costs stay out of the timings."""
+    """Short runs of each side on each actuator: imports and first-use costs stay out of
+    the timings."""
     short = replace(case, duration=10 * case.control_period)
-    fly_dcsim(short, True, registry)
-    if basilisk:
-        fly_peer(basilisk_setup(short, True, inertia, step))
+    for torque_by in TORQUES:
+        fly_dcsim(short, True, registry, torque_by)
+        if basilisk:
+            fly_peer(basilisk_setup(short, True, inertia, step, torque_by))
 
 
 # ---------------------------------------------------------------------- figures
@@ -458,7 +626,11 @@ def notes(result: PeersResult) -> str:
         f"- pd: kp = {kp:g} s⁻², kd = {kd:g} s⁻¹; mrpFeedback: K = {big_k:g} N·m, "
         f"P = {big_p:g} N·m·s.",
         _torque_line(result),
-        _phase_line(result),
+        _wheel_line(result),
+        _thruster_line(result),
+        _phase_line(result, result.rows[0]),
+        _phase_line(result, _wheel_row(result)),
+        _phase_line(result, _row(result, "thrusters")),
         _cpu_line(result),
     ]
     hold = result.rows[1]
@@ -488,13 +660,68 @@ def _torque_line(result: PeersResult) -> str:
     return line + f": dcsim's limit of {limit:g} N·m is reached, the laws differ there."
 
 
-def _phase_line(result: PeersResult) -> str:
-    """Where dcsim's best attitude-slew run spent its time, ms per simulated second."""
-    best = min(result.rows[0].dcsim, key=lambda f: f.wall)
+def _wheel_line(result: PeersResult) -> str:
+    """The wheels, their limits, and each side's largest torque and wheel speed."""
+    case, row = result.case, _wheel_row(result)
+    limit = torque_limit(case, "wheels")
+    flights = [("dcsim", row.dcsim[-1])] + [("Basilisk", f) for f in row.basilisk[-1:]]
+    torques = ", ".join(f"{side} {flight.peak_torque:.3g} N·m" for side, flight in flights)
+    speeds = ", ".join(
+        f"{side} {flight.peak_wheel_speed:.4g} rad/s ({RPM * flight.peak_wheel_speed:.0f} rpm)"
+        for side, flight in flights
+    )
+    fraction = max(f.peak_wheel_speed for _, f in flights) * case.wheel_inertia
+    fraction /= case.wheel_max_momentum
+    within = max(f.peak_torque for _, f in flights) < limit and fraction < 1.0
+    line = (
+        f"- {row.name}: {len(case.wheel_axes)} wheels in a pyramid about +z (axes 54.7° "
+        f"from it), each {case.wheel_inertia:g} kg·m², {case.wheel_max_torque:g} N·m, "
+        f"{case.wheel_max_momentum:g} N·m·s (the base's torque limit {limit:.3g} N·m in "
+        f"its weakest direction); largest commanded torque {torques}; peak wheel speed "
+        f"(momentum / wheel inertia) {speeds}, {100 * fraction:.0f} % of the momentum limit"
+    )
+    line += ": no wheel saturates" if within else ": a wheel limit is reached, the sides differ"
+    if row.basilisk:
+        gap = np.max(np.abs(row.dcsim[-1].wheel_speed[-1] - row.basilisk[-1].wheel_speed[-1]))
+        line += f"; final wheel speeds differ by at most {gap:.2g} rad/s"
+    return line + "."
+
+
+def _thruster_line(result: PeersResult) -> str:
+    """The thrusters, their limit, each side's largest torque and how still each side's
+    pointing ends."""
+    case, row = result.case, _row(result, "thrusters")
+    flights = [("dcsim", row.dcsim[-1])] + [("Basilisk", f) for f in row.basilisk[-1:]]
+    torques = ", ".join(f"{side} {flight.peak_torque:.3g} N·m" for side, flight in flights)
+    tails = ", ".join(
+        f"{side} {np.degrees(np.max(flight.pointing_error[-len(flight.times) // 10 :])):.2g}°"
+        for side, flight in flights
+    )
+    return (
+        f"- {row.name}: six opposed couples {case.thruster_arm:g} m from the centre of mass, "
+        f"{case.thruster_max_thrust:g} N each (the base's torque limit "
+        f"{torque_limit(case, 'thrusters'):.3g} N·m about each axis); largest commanded "
+        f"torque {torques}; largest pointing error over the run's last tenth {tails}."
+    )
+
+
+def _wheel_row(result: PeersResult) -> PeerRow:
+    """The reaction-wheel row of ``result``."""
+    return _row(result, "wheels")
+
+
+def _row(result: PeersResult, torque_by: TorqueBy) -> PeerRow:
+    """The row of ``result`` whose torque ``torque_by`` gives."""
+    return next(row for row in result.rows if row.torque_by == torque_by)
+
+
+def _phase_line(result: PeersResult, row: PeerRow) -> str:
+    """Where dcsim's best run of ``row`` spent its time, ms per simulated second."""
+    best = min(row.dcsim, key=lambda f: f.wall)
     span = result.case.duration
     phases = sorted(best.phases.items(), key=lambda item: -item[1])
     parts = ", ".join(f"{name} {1e3 * seconds / span:.2f}" for name, seconds in phases)
-    return f"- dcsim's best attitude-slew run by phase of the run loop (ms / sim s): {parts}."
+    return f"- dcsim's best {row.name} run by phase of the run loop (ms / sim s): {parts}."
 
 
 def _cpu_line(result: PeersResult) -> str:
@@ -513,61 +740,87 @@ def _cpu_line(result: PeersResult) -> str:
 
 
 def verdict(result: PeersResult) -> str:
-    """Whether dcsim's attitude loop is within :data:`TARGET_RATIO` of Basilisk's wall
-    time (the attitude-only row), in one line."""
-    row = result.rows[0]
-    if not row.basilisk:
-        return (
-            f"target (within {TARGET_RATIO:g}× of Basilisk): not measured, Basilisk was not flown"
+    """Whether dcsim is within :data:`TARGET_RATIO` of Basilisk's wall time, for the
+    attitude loop (the attitude-only row) and for the wheel slew, one line each."""
+    lines = []
+    for row, what in ((result.rows[0], "attitude loop"), (_wheel_row(result), "wheel slew")):
+        if not row.basilisk:
+            lines.append(
+                f"target (dcsim's {what} within {TARGET_RATIO:g}× of Basilisk): "
+                "not measured, Basilisk was not flown"
+            )
+            continue
+        ratio = best_wall(row.dcsim) / best_wall(row.basilisk)
+        met = "met" if ratio <= TARGET_RATIO else "not met"
+        lines.append(
+            f"target (dcsim's {what} within {TARGET_RATIO:g}× of Basilisk's wall time): "
+            f"{met}, {ratio:.2f}×"
         )
-    ratio = best_wall(row.dcsim) / best_wall(row.basilisk)
-    met = "met" if ratio <= TARGET_RATIO else "not met"
-    return (
-        f"target (dcsim's attitude loop within {TARGET_RATIO:g}× of Basilisk's wall time): "
-        f"{met}, {ratio:.2f}×"
-    )
+    return "\n".join(lines)
 
 
 def plot(result: PeersResult, path: Path) -> None:
     """The two sides' runs against time, as a PNG at ``path``: pointing error during
-    the slew and over the whole run (attitude-only row), and distance from the hold
-    point (position-hold row)."""
+    the slew and over the whole run (attitude-only row, the wheel row, the thruster
+    row), distance from the hold point (position-hold row), and the wheels' speeds."""
     from dcsim.bench.figures import pyplot, save
 
     plt = pyplot()
-    figure, (slew, tail, hold) = plt.subplots(1, 3, figsize=(14, 4.2))
-    colours = {"dcsim": "tab:blue", "Basilisk": "tab:orange"}
+    figure, axes = plt.subplots(3, 3, figsize=(14, 12.6))
     window = min(20.0, result.case.duration)
-    attitude, position = result.rows
-    for side, flight in _last_flights(attitude):
-        degrees = np.degrees(flight.pointing_error)
-        shown = flight.times <= window
-        slew.plot(flight.times[shown], degrees[shown], color=colours[side], label=side)
-        tail.semilogy(flight.times, np.maximum(degrees, 1e-14), color=colours[side])
-    for side, flight in _last_flights(position):
-        hold.plot(flight.times, flight.position_error, color=colours[side], label=side)
-    slew.set(
-        xlabel="time [s]", ylabel="pointing error [deg]", title=f"the slew (first {window:g} s)"
-    )
-    tail.set(
-        xlabel="time [s]",
-        ylabel="pointing error [deg]",
-        title=f"the whole run ({result.case.duration:g} s)",
-    )
+    shown = (0, min(60.0, result.case.duration))
+    for (slew, tail, _), torque_by in zip(axes, TORQUES, strict=True):
+        _pointing(_row(result, torque_by), slew, tail, window, result.case.duration)
+    hold, speeds = axes[0][2], axes[1][2]
+    for side, flight in _last_flights(result.rows[1]):
+        hold.plot(flight.times, flight.position_error, color=_COLOURS[side], label=side)
+    for side, flight in _last_flights(_wheel_row(result)):
+        style = "-" if side == "dcsim" else "--"
+        speeds.plot(flight.times, flight.wheel_speed, style, color=_COLOURS[side], lw=1.0)
     hold.set(
         xlabel="time [s]",
         ylabel="distance from the hold point [m]",
         title="slew + position hold",
-        xlim=(0, min(60.0, result.case.duration)),
+        xlim=shown,
     )
-    for axis in (slew, tail, hold):
+    speeds.set(
+        xlabel="time [s]",
+        ylabel="wheel speed [rad/s]",
+        title="wheel speeds (dcsim solid, Basilisk dashed)",
+        xlim=shown,
+    )
+    for axis in (hold, speeds):
         axis.grid(alpha=0.3)
-    slew.legend()
+    axes[2][2].axis("off")
+    axes[0][0].legend()
     figure.suptitle(
-        "dcsim bench peers: pd (dcsim, PyBullet) beside mrpFeedback and "
-        "hillFrameRelativeControl (Basilisk)"
+        "dcsim bench peers: pd (dcsim, PyBullet) beside mrpFeedback, hillFrameRelativeControl, "
+        "rwMotorTorque and thrForceMapping (Basilisk)"
     )
     save(figure, path, dpi=90)
+
+
+_COLOURS = {"dcsim": "tab:blue", "Basilisk": "tab:orange"}
+
+
+def _pointing(row: PeerRow, slew: Any, tail: Any, window: float, duration: float) -> None:
+    """Each side's pointing error of ``row``: the first ``window`` seconds (s) on
+    ``slew``, the whole run of ``duration`` seconds on a log scale on ``tail``."""
+    for side, flight in _last_flights(row):
+        degrees = np.degrees(flight.pointing_error)
+        shown = flight.times <= window
+        slew.plot(flight.times[shown], degrees[shown], color=_COLOURS[side], label=side)
+        tail.semilogy(flight.times, np.maximum(degrees, 1e-14), color=_COLOURS[side])
+    slew.set(
+        xlabel="time [s]", ylabel="pointing error [deg]", title=f"{row.name} (first {window:g} s)"
+    )
+    tail.set(
+        xlabel="time [s]",
+        ylabel="pointing error [deg]",
+        title=f"{row.name}, the whole run ({duration:g} s)",
+    )
+    for axis in (slew, tail):
+        axis.grid(alpha=0.3)
 
 
 def _last_flights(row: PeerRow) -> list[tuple[str, Flight]]:

@@ -10,6 +10,7 @@ from dcsim_plugins.controllers.pd import design_gains
 
 from dcsim.bench import peers
 from dcsim.bench.basilisk_loop import basilisk_missing, mrp_from_quaternion, quaternion_from_mrp
+from dcsim.geometry import rotate
 from dcsim.registry.discovery import PluginRegistry
 
 BASILISK = basilisk_missing()
@@ -37,6 +38,38 @@ def basilisk_rows():
         hold: peers.fly_peer(peers.basilisk_setup(SHORT, hold, inertia, SHORT.physics_step))
         for hold in (False, True)
     }
+
+
+@pytest.fixture(scope="module")
+def dcsim_wheels(registry):
+    """dcsim's slew on the case's four reaction wheels over the short span."""
+    return peers.fly_dcsim(SHORT, False, registry, "wheels")
+
+
+@pytest.fixture(scope="module")
+def basilisk_wheels():
+    inertia = peers.flyer_inertia(SHORT)
+    return peers.fly_peer(peers.basilisk_setup(SHORT, False, inertia, SHORT.physics_step, "wheels"))
+
+
+@pytest.fixture(scope="module")
+def thruster_rows(registry):
+    """Each side's slew on the case's twelve thrusters over the short span (Basilisk's
+    None when it is not installed)."""
+    ours = peers.fly_dcsim(SHORT, False, registry, "thrusters")
+    if BASILISK is not None:
+        return ours, None
+    inertia = peers.flyer_inertia(SHORT)
+    setup = peers.basilisk_setup(SHORT, False, inertia, SHORT.physics_step, "thrusters")
+    return ours, peers.fly_peer(setup)
+
+
+def wheel_momentum_in_world(flight: peers.Flight, index: int) -> np.ndarray:
+    """The wheels' angular momentum ``R A h`` at sample ``index``, world frame, N·m·s."""
+    body = np.array(SHORT.wheel_axes).T @ (SHORT.wheel_inertia * flight.wheel_speed[index])
+    error = flight.pointing_error[index]
+    assert error < 1e-6  # at the goal attitude: R is the goal's
+    return rotate(np.asarray(SHORT.goal_attitude), body)
 
 
 def test_the_case_is_a_real_slew_and_its_gains_are_the_pd_plugins():
@@ -69,6 +102,36 @@ def test_dcsim_holds_the_position_only_when_asked(dcsim_rows):
     assert dcsim_rows[False].position_error[-1] == pytest.approx(drift, rel=1e-6)
     held = dcsim_rows[True].position_error
     assert 0.05 < held.max() < 0.5 and held[-1] < 1e-3
+
+
+def test_dcsim_slews_on_its_wheels_and_they_keep_the_momentum(dcsim_rows, dcsim_wheels):
+    flight = dcsim_wheels
+    assert flight.times == pytest.approx(dcsim_rows[False].times)
+    assert np.degrees(flight.pointing_error[0]) == pytest.approx(90.0)
+    assert np.degrees(flight.pointing_error[-1]) < 1e-4
+    assert flight.wheel_speed.shape == (len(flight.times), 4)
+    assert np.all(flight.wheel_speed[0] == 0.0)
+    # the commanded torque is within what the wheels give; no wheel near its limit
+    assert 5.0 < flight.peak_torque < peers.torque_limit(SHORT, "wheels")
+    assert 20.0 < flight.peak_wheel_speed < 0.5 * SHORT.wheel_max_momentum / SHORT.wheel_inertia
+    # at rest at the goal the wheels hold all of the initial angular momentum I ω0
+    initial = 0.4 * SHORT.mass * SHORT.radius**2 * np.asarray(SHORT.initial_angular_velocity)
+    assert wheel_momentum_in_world(flight, -1) == pytest.approx(initial, abs=1e-6)
+    # the wheels deliver the commanded torque: the slew is the ideal torque's, but for
+    # the gyroscopic torque of the momentum they carry (0.08 degrees apart at most)
+    assert np.degrees(peers.largest_gap(flight, dcsim_rows[False])) < 0.2
+
+
+def test_dcsim_slews_on_its_thruster_couples_without_pushing(dcsim_rows, thruster_rows):
+    flight = thruster_rows[0]
+    assert flight.times == pytest.approx(dcsim_rows[False].times)
+    assert flight.wheel_speed.shape == (len(flight.times), 0)
+    assert np.degrees(flight.pointing_error[-1]) < 1e-4
+    assert 5.0 < flight.peak_torque < peers.torque_limit(SHORT, "thrusters") == 20.0
+    # the couples give no force: the free flyer drifts as with the ideal torque
+    assert flight.position_error == pytest.approx(dcsim_rows[False].position_error, abs=1e-9)
+    # pulses from the period's start give the mean torque a little early: 0.5 degrees
+    assert np.degrees(peers.largest_gap(flight, dcsim_rows[False])) < 1.0
 
 
 def test_mrps_and_quaternions_convert_both_ways():
@@ -106,6 +169,43 @@ def test_basilisk_flies_the_same_slew(dcsim_rows, basilisk_rows):
 
 
 @needs_basilisk
+def test_basilisk_flies_the_same_wheel_slew(dcsim_wheels, basilisk_wheels):
+    ours, theirs = dcsim_wheels, basilisk_wheels
+    assert theirs.times == pytest.approx(ours.times)
+    assert theirs.wheel_speed.shape == ours.wheel_speed.shape
+    assert theirs.wheel_speed[0] == pytest.approx(ours.wheel_speed[0], abs=1e-12)
+    # the same final pointing: 1.30e-6 and 1.14e-6 degrees after 40 s; the residues of
+    # the two laws' transients (1.4 degrees apart in the slew, as without wheels) decay
+    # alike and differ by 1.6e-7 degrees
+    final = np.degrees([ours.pointing_error[-1], theirs.pointing_error[-1]])
+    assert final.max() < 1e-5
+    assert abs(final[0] - final[1]) < 1e-6
+    gap = np.degrees(peers.largest_gap(ours, theirs))
+    assert 0.1 < gap < 3.0
+    # the stiffer MRP law spins the wheels up a little faster: 81.0 and 83.9 rad/s
+    assert theirs.peak_wheel_speed == pytest.approx(ours.peak_wheel_speed, rel=0.05)
+    # at rest the wheels hold the same momentum, which depends only on the total angular
+    # momentum and the attitude: 6e-7 rad/s apart after 40 s; a wheel started with
+    # Basilisk's default Ω = 0, or the hub's inertia without the wheels', moves them by
+    # 0.03 rad/s
+    assert theirs.wheel_speed[-1] == pytest.approx(ours.wheel_speed[-1], abs=1e-5)
+
+
+@needs_basilisk
+def test_basilisk_flies_the_thruster_slew_roughly_as_dcsim_does(thruster_rows):
+    ours, theirs = thruster_rows
+    assert theirs.times == pytest.approx(ours.times)
+    assert theirs.position_error == pytest.approx(ours.position_error, abs=1e-9)
+    # Basilisk's thrusters first fire at 0.2 s and switch at the integrator's stages:
+    # its slew is 2.47 degrees from dcsim's at most and ends in a limit cycle of about
+    # 0.03 degrees (dcsim's: 1.2e-6 degrees after 40 s)
+    assert 1.0 < np.degrees(peers.largest_gap(ours, theirs)) < 4.0
+    tail = np.degrees(theirs.pointing_error[-len(theirs.times) // 10 :])
+    assert 1e-3 < tail.max() < 0.1
+    assert np.degrees(ours.pointing_error[-1]) < 1e-5
+
+
+@needs_basilisk
 def test_basilisk_holds_the_position_as_dcsim_does(dcsim_rows, basilisk_rows):
     free, held = basilisk_rows[False], basilisk_rows[True]
     assert free.position_error == pytest.approx(
@@ -121,6 +221,8 @@ def test_the_table_has_both_rows_and_the_verdict(registry):
     assert [line.split("|")[1].strip() for line in table[2:]] == [
         "attitude slew",
         "slew + position hold",
+        "slew on 4 wheels",
+        "slew on 12 thrusters",
     ]
     text = peers.notes(result) + "\n" + peers.verdict(result)
     if BASILISK is None:
@@ -128,9 +230,15 @@ def test_the_table_has_both_rows_and_the_verdict(registry):
             cells = [cell.strip() for cell in line.strip("| ").split("|")]
             assert len(cells) == 10 and float(cells[8]) > 0 and cells[9] in ("yes", "no")
         assert "target (dcsim's attitude loop within 3× of Basilisk's wall time): " in text
+        assert "target (dcsim's wheel slew within 3× of Basilisk's wall time): " in text
+        assert "final wheel speeds differ by at most" in text
     else:
         assert f"Basilisk was not flown: {BASILISK}" in text
-        assert "not measured, Basilisk was not flown" in text
+        assert text.count("not measured, Basilisk was not flown") == 2
+    assert "- slew on 4 wheels: 4 wheels in a pyramid" in text
+    assert "peak wheel speed (momentum / wheel inertia) dcsim " in text
+    assert "no wheel saturates" in text
+    assert "- slew on 12 thrusters: six opposed couples 1 m from the centre of mass" in text
 
 
 def test_the_command_prints_the_table_and_draws_the_plot(dcsim_cli, tmp_path):
@@ -139,6 +247,8 @@ def test_the_command_prints_the_table_and_draws_the_plot(dcsim_cli, tmp_path):
     assert result.returncode == 0, result.stderr
     assert "| attitude slew |" in result.stdout
     assert "| slew + position hold |" in result.stdout
+    assert "| slew on 4 wheels |" in result.stdout
+    assert "| slew on 12 thrusters |" in result.stdout
     assert "attitude slew, run 1/1: dcsim" in result.stderr
     if BASILISK is not None:
         assert "Basilisk is not flown: " in result.stderr

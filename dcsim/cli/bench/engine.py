@@ -279,17 +279,22 @@ def bench_campaign_command(
     help="Basilisk's dynamics step, s; it must divide the 0.1 s control period "
     "(default: dcsim's physics step, 0.01 s).",
 )
-@plot_option("Write the pointing error (and the position hold) against time as a PNG.")
+@plot_option(
+    "Write the pointing error, the position hold and the wheel speeds against time as a PNG."
+)
 def bench_peers_command(
     duration: float, repeats: int, basilisk_step: float | None, plot_path: Path | None
 ) -> None:
     """dcsim's attitude loop beside Basilisk's: the same slew, gains and rates.
 
     A rigid free flyer slews 90° to a fixed inertial attitude under a PD law at 10 Hz,
-    truth-fed, once with translation free and once holding its position; dcsim (the
-    hold mission, pd, PyBullet) and Basilisk (spacecraft hub, extForceTorque, simpleNav,
-    inertial3D, attTrackingError, mrpFeedback, hillFrameRelativeControl) fly it
-    alternately, REPEATS times each. Prints a Markdown table for docs/benchmarks.md.
+    truth-fed, once with translation free, once holding its position, once on four
+    reaction wheels and once on twelve thrusters; dcsim (the hold mission, pd, PyBullet,
+    its reaction wheels and thrusters) and Basilisk (spacecraft hub, extForceTorque,
+    simpleNav, inertial3D, attTrackingError, mrpFeedback, hillFrameRelativeControl,
+    rwMotorTorque, reactionWheelStateEffector, thrForceMapping, thrFiringRemainder,
+    thrusterDynamicEffector) fly it alternately, REPEATS times each. Prints a Markdown
+    table for docs/benchmarks.md.
     Basilisk is optional (pip install 'dcsim[peers]'); without it the dcsim side runs
     alone.
     """
