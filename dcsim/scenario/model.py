@@ -484,13 +484,25 @@ class UnloadingSpec(Section):
 _AXIS_NAMES = ("+x", "-x", "+y", "-y", "+z", "-z")
 
 
+ThrusterKey = tuple[tuple[Vec3, Vec3, float], ...]
+"""Each thruster's position, direction and maximum thrust: what its geometry depends on."""
+
+
 def thruster_matrices(thrusters: list[ThrusterSpec]) -> tuple[Vector, Vector]:
     """Force (N) and torque (N·m) of each thruster at full thrust, body frame: the
     columns of two (3, N) matrices."""
-    positions = np.array([t.position for t in thrusters], dtype=float)
-    directions = np.array([t.direction for t in thrusters], dtype=float)
+    return _matrices(_thruster_key(thrusters))
+
+
+def _thruster_key(thrusters: list[ThrusterSpec]) -> ThrusterKey:
+    return tuple((t.position, t.direction, t.max_thrust) for t in thrusters)
+
+
+def _matrices(thrusters: ThrusterKey) -> tuple[Vector, Vector]:
+    positions = np.array([p for p, _, _ in thrusters], dtype=float)
+    directions = np.array([d for _, d, _ in thrusters], dtype=float)
     directions /= np.linalg.norm(directions, axis=1)[:, None]
-    thrust = np.array([t.max_thrust for t in thrusters])
+    thrust = np.array([f for _, _, f in thrusters])
     return (directions * thrust[:, None]).T, (np.cross(positions, directions) * thrust[:, None]).T
 
 
@@ -524,11 +536,26 @@ def axis_capacities(produced: Vector, held: Vector) -> Vector:
     return np.array(capacities)
 
 
+def thruster_capacities(thrusters: list[ThrusterSpec]) -> tuple[Vector, Vector]:
+    """The largest force (N) along, and torque (N·m) about, each body axis direction
+    (+x, -x, +y, -y, +z, -z) the thrusters give with the other held at zero
+    (:func:`axis_capacities`), each (6,), read-only (a layout's are computed once)."""
+    return _capacities(_thruster_key(thrusters))
+
+
+@functools.lru_cache(maxsize=32)
+def _capacities(thrusters: ThrusterKey) -> tuple[Vector, Vector]:
+    forces, torques = _matrices(thrusters)
+    capacities = axis_capacities(forces, torques), axis_capacities(torques, forces)
+    for array in capacities:
+        array.setflags(write=False)
+    return capacities
+
+
 def _thrusters_push_every_way(thrusters: list[ThrusterSpec]) -> list[ThrusterSpec]:
-    forces, torques = thruster_matrices(thrusters)
     missing = []
-    for what, produced, held in (("force", forces, torques), ("torque", torques, forces)):
-        capacities = axis_capacities(produced, held)
+    force_capacities, torque_capacities = thruster_capacities(thrusters)
+    for what, capacities in (("force", force_capacities), ("torque", torque_capacities)):
         weak = [name for name, c in zip(_AXIS_NAMES, capacities, strict=True) if c <= 1e-9]
         if weak:
             missing.append(f"no {what} along {', '.join(weak)}")
@@ -601,8 +628,7 @@ class ActuatorsSpec(Section):
             limits = np.array([wheel.max_torque for wheel in self.reaction_wheels]) / rows
             return float(limits.min())
         if self.thrusters is not None:
-            forces, torques = thruster_matrices(self.thrusters)
-            return float(axis_capacities(torques, forces).min())
+            return float(thruster_capacities(self.thrusters)[1].min())
         return None
 
     def force_limit(self) -> float | None:
@@ -610,8 +636,7 @@ class ActuatorsSpec(Section):
         (the smallest of the six axis directions' linear programmes); None when ideal."""
         if self.thrusters is None:
             return None
-        forces, torques = thruster_matrices(self.thrusters)
-        return float(axis_capacities(forces, torques).min())
+        return float(thruster_capacities(self.thrusters)[0].min())
 
 
 class RobotSection(RobotBaseSection):

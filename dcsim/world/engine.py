@@ -63,6 +63,7 @@ from dcsim.world.payload import Payload
 from dcsim.world.pybullet_client import connect_direct, pb
 from dcsim.world.robot_body import RobotBody
 from dcsim.world.sensors import Sensors
+from dcsim.world.vector3 import turn
 
 _BROAD_PHASE_SLACK = 1e-3  # m added to the swept reach of each control period
 
@@ -609,6 +610,8 @@ class World:
         exact, dt = self._exact_forces, self.physics_step
         parts = exact is not None and exact.has_parts
         wheels, actuators = self.wheels, self.actuators
+        if profile is not None:  # each step's body force and torque, as plain floats
+            body_forces, body_torques = profile.forces.tolist(), profile.torques.tolist()
         if wheels is not None:  # the base's mass, and so its inertia, is set per period
             ix, iy, iz = pb.getDynamicsInfo(body, -1, physicsClientId=client)[2]
             moments = (ix, iy, iz)
@@ -618,14 +621,14 @@ class World:
         started: list[CollisionEvent] = []
         for k in range(self.steps_per_control):
             position, attitude = get_pose(body, client)
-            if profile is None:
-                assert thrusts is not None
+            if thrusts is not None:
                 tx, ty, tz = thrusts[k]
                 step_torque = torque
             else:
-                rotation = np.reshape(pb.getMatrixFromQuaternion(attitude), (3, 3))
-                tx, ty, tz = (rotation @ profile.forces[k]).tolist()
-                step_torque = tuple((rotation @ profile.torques[k] + torque).tolist())
+                rotation = pb.getMatrixFromQuaternion(attitude)
+                tx, ty, tz = turn(rotation, body_forces[k])
+                qx, qy, qz = turn(rotation, body_torques[k])
+                step_torque = (qx + torque[0], qy + torque[1], qz + torque[2])
             fx, fy, fz = tx + dx, ty + dy, tz + dz
             if n is not None:
                 ax, ay, az = cw_acceleration(n, position, get_velocity(body, client)[0])

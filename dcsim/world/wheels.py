@@ -26,69 +26,16 @@ explicit gyroscopic term drifts for unequal ones, wheels or not).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from dcsim.scenario.model import WheelSpec, wheel_axes
+from dcsim.world.vector3 import Matrix, Vec, cross, rotated, turn, turn_back
 
 _AT_LIMIT = 1.0 - 1e-12
 """Fraction of ``max_momentum`` from which a wheel counts as saturated (rounding)."""
 
 _ITERATIONS = 3
 """Fixed-point iterations of the base's reaction per physics step."""
-
-Vec = tuple[float, float, float]
-"""A 3-vector in plain floats: each physics step's arithmetic on 3-vectors is done in
-floats, which at this size costs a tenth of numpy's."""
-
-Matrix = tuple[float, ...]
-"""A 3×3 rotation matrix as nine floats, row by row (PyBullet's
-``getMatrixFromQuaternion``)."""
-
-
-def _turn(m: Matrix, v: Vec) -> Vec:
-    """``M v``."""
-    x, y, z = v
-    return (
-        m[0] * x + m[1] * y + m[2] * z,
-        m[3] * x + m[4] * y + m[5] * z,
-        m[6] * x + m[7] * y + m[8] * z,
-    )
-
-
-def _turn_back(m: Matrix, v: Vec) -> Vec:
-    """``Mᵀ v``."""
-    x, y, z = v
-    return (
-        m[0] * x + m[3] * y + m[6] * z,
-        m[1] * x + m[4] * y + m[7] * z,
-        m[2] * x + m[5] * y + m[8] * z,
-    )
-
-
-def _cross(a: Vec, b: Vec) -> Vec:
-    """``a × b``."""
-    ax, ay, az = a
-    bx, by, bz = b
-    return (ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx)
-
-
-def _rotated(rotation_vector: Vec, v: Vec) -> Vec:
-    """``v`` turned by a rotation vector (axis times angle, rad), by Rodrigues' formula."""
-    x, y, z = rotation_vector
-    angle = math.sqrt(x * x + y * y + z * z)
-    if angle == 0.0:
-        return v
-    k = (x / angle, y / angle, z / angle)
-    c, s = math.cos(angle), math.sin(angle)
-    across = _cross(k, v)
-    along = (k[0] * v[0] + k[1] * v[1] + k[2] * v[2]) * (1.0 - c)
-    return (
-        v[0] * c + across[0] * s + k[0] * along,
-        v[1] * c + across[1] * s + k[1] * along,
-        v[2] * c + across[2] * s + k[2] * along,
-    )
 
 
 class ReactionWheels:
@@ -219,19 +166,19 @@ class ReactionWheels:
             torques.append(tau)
             momenta.append(h_next)
             peak = max(peak, abs(h_next) / limit)
-        before = _turn(rotation, self._body(self._h))
+        before = turn(rotation, self._body(self._h))
         body_after = self._body(momenta)
         self._tau, self._h, self.peak_fraction = torques, momenta, peak
         ix, iy, iz = moments
 
         def rate_change(applied: Vec) -> Vec:
             """I⁻¹ applied Δt, world frame, rad/s."""
-            bx, by, bz = _turn_back(rotation, applied)
-            return _turn(rotation, (bx / ix * dt, by / iy * dt, bz / iz * dt))
+            bx, by, bz = turn_back(rotation, applied)
+            return turn(rotation, (bx / ix * dt, by / iy * dt, bz / iz * dt))
 
-        wx, wy, wz = _turn_back(rotation, angular_velocity)
-        spin = _turn(rotation, (ix * wx, iy * wy, iz * wz))  # I ω, world frame
-        gyroscopic = _cross(angular_velocity, spin)
+        wx, wy, wz = turn_back(rotation, angular_velocity)
+        spin = turn(rotation, (ix * wx, iy * wy, iz * wz))  # I ω, world frame
+        gyroscopic = cross(angular_velocity, spin)
         free = rate_change(
             (torque[0] - gyroscopic[0], torque[1] - gyroscopic[1], torque[2] - gyroscopic[2])
         )
@@ -240,18 +187,18 @@ class ReactionWheels:
             angular_velocity[1] + free[1],
             angular_velocity[2] + free[2],
         )
-        wheel = _turn(rotation, self._body(torques))
-        carried = _cross(angular_velocity, before)
+        wheel = turn(rotation, self._body(torques))
+        carried = cross(angular_velocity, before)
         reaction = (-wheel[0] - carried[0], -wheel[1] - carried[1], -wheel[2] - carried[2])
-        after = _turn(rotation, body_after)
+        after = turn(rotation, body_after)
         for _ in range(_ITERATIONS):
             change = rate_change(reaction)
-            turn = (
+            rotation_step = (
                 (free_rate[0] + change[0]) * dt,
                 (free_rate[1] + change[1]) * dt,
                 (free_rate[2] + change[2]) * dt,
             )
-            turned = _rotated(turn, after)
+            turned = rotated(rotation_step, after)
             reaction = (
                 (before[0] - turned[0]) / dt,
                 (before[1] - turned[1]) / dt,
