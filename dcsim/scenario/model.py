@@ -405,7 +405,8 @@ class WheelSpec(Section):
         unit="kg*m^2",
         gt=0,
         description="The wheel's moment of inertia about its spin axis; it gives the "
-        "wheel's spin rate (momentum / inertia). The base's `inertia` includes the wheels.",
+        "wheel's spin rate (momentum / inertia). The base's `inertia` includes the wheels' "
+        "mass but not this: a wheel's momentum about its axis is counted apart.",
     )
     max_torque: float = quantity(unit="N*m", gt=0, description="Largest wheel torque magnitude.")
     max_momentum: float = quantity(

@@ -82,7 +82,8 @@ class ReactionWheels:
 
     @property
     def speeds(self) -> np.ndarray:
-        """Each wheel's spin rate relative to the base, ``h_i / J_i``, rad/s (N,)."""
+        """Each wheel's spin rate ``h_i / J_i``, rad/s (N,): about its axis in inertial
+        space (its rate relative to the base plus the base's about the axis)."""
         return self.momentum / self._inertia
 
     def command(self, body_torque: np.ndarray) -> np.ndarray:
