@@ -6,24 +6,74 @@ axis) and give accelerations of the same shape in m/s².
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
 from dcsim.geometry import Vector
 
-Gravity = Callable[[Vector], Vector]
-"""An acceleration field: inertial positions (…, 3), m → accelerations (…, 3), m/s²."""
+Point = tuple[float, float, float]
+"""One inertial position or acceleration in plain floats, m or m/s²."""
+
+
+class Gravity(Protocol):
+    """An acceleration field: inertial positions (…, 3), m → accelerations (…, 3), m/s²;
+    :meth:`at` gives one point's in plain floats (the per-period linearisation calls it
+    for a few points, where numpy's overhead is most of the cost)."""
+
+    def __call__(self, position: Vector) -> Vector:
+        """Accelerations (…, 3), m/s², at inertial positions (…, 3), m."""
+        ...
+
+    def at(self, x: float, y: float, z: float) -> Point:
+        """The acceleration at one inertial position, m/s²."""
+        ...
+
+
+@dataclass(frozen=True)
+class _PointMass:
+    mu: float
+
+    def __call__(self, position: Vector) -> Vector:
+        r2 = np.einsum("...i,...i->...", position, position)[..., None]
+        return -self.mu * position / (r2 * np.sqrt(r2))
+
+    def at(self, x: float, y: float, z: float) -> Point:
+        r2 = x * x + y * y + z * z
+        scale = -self.mu / (r2 * math.sqrt(r2))
+        return (scale * x, scale * y, scale * z)
+
+
+@dataclass(frozen=True)
+class _PointMassJ2:
+    central: _PointMass
+    factor: float  # −(3/2) J2 μ R², m⁵/s²
+
+    def __call__(self, position: Vector) -> Vector:
+        r2 = np.einsum("...i,...i->...", position, position)[..., None]
+        z2 = position[..., 2:3] ** 2 / r2
+        scale = self.factor / (r2 * r2 * np.sqrt(r2))
+        plane = 1.0 - 5.0 * z2
+        zonal = np.concatenate(
+            (position[..., :2] * plane, position[..., 2:3] * (plane + 2.0)), axis=-1
+        )
+        return self.central(position) + scale * zonal
+
+    def at(self, x: float, y: float, z: float) -> Point:
+        r2 = x * x + y * y + z * z
+        r = math.sqrt(r2)
+        plane = 1.0 - 5.0 * (z * z / r2)
+        scale = self.factor / (r2 * r2 * r)
+        cx, cy, cz = self.central.at(x, y, z)
+        return (cx + scale * x * plane, cy + scale * y * plane, cz + scale * z * (plane + 2.0))
 
 
 def point_mass(mu: float) -> Gravity:
     """``a = −μ r / |r|³`` (μ in m³/s²)."""
-
-    def gravity(position: Vector) -> Vector:
-        r2 = np.einsum("...i,...i->...", position, position)[..., None]
-        return -mu * position / (r2 * np.sqrt(r2))
-
-    return gravity
+    return _PointMass(mu)
 
 
 def with_j2(mu: float, j2: float, body_radius: float) -> Gravity:
@@ -40,20 +90,7 @@ def with_j2(mu: float, j2: float, body_radius: float) -> Gravity:
     body_radius : float
         The harmonic's reference radius, m.
     """
-    central = point_mass(mu)
-    factor = -1.5 * j2 * mu * body_radius**2
-
-    def gravity(position: Vector) -> Vector:
-        r2 = np.einsum("...i,...i->...", position, position)[..., None]
-        z2 = position[..., 2:3] ** 2 / r2
-        scale = factor / (r2 * r2 * np.sqrt(r2))
-        plane = 1.0 - 5.0 * z2
-        zonal = np.concatenate(
-            (position[..., :2] * plane, position[..., 2:3] * (plane + 2.0)), axis=-1
-        )
-        return central(position) + scale * zonal
-
-    return gravity
+    return _PointMassJ2(_PointMass(mu), -1.5 * j2 * mu * body_radius**2)
 
 
 Potential = Callable[[Vector], Vector]

@@ -86,6 +86,11 @@ class RelativeDynamics:
     ) -> list[AffineAcceleration]:
         """Each body's relative acceleration over one period, expanded about its state.
 
+        The acceleration at the period's start and end, and its gradient in position by
+        central differences of the gravity (±``JACOBIAN_STEP`` along each LVLH axis; the
+        frame's terms are exact), evaluated body by body in plain floats: for the few
+        bodies of a robot, numpy's overhead would be most of the cost.
+
         Parameters
         ----------
         start, end : LvlhFrame
@@ -95,40 +100,108 @@ class RelativeDynamics:
         rho, rho_dot : ndarray (N, 3)
             The bodies' LVLH states at the period's start, m and m/s.
         """
-        h = JACOBIAN_STEP
-        count = len(rho)
-        # one gravity call: each body at the start, shifted by ±h along each LVLH axis,
-        # and at the end (only the gravity depends nonlinearly on position)
-        start_points = start.position + rho @ start.axes.T  # (N, 3), inertial
-        shifts = np.concatenate((np.eye(3), -np.eye(3))) * h @ start.axes.T  # (6, 3)
-        points = np.concatenate(
-            (
-                start_points,
-                (start_points[:, None, :] + shifts).reshape(-1, 3),
-                end.position + rho @ end.axes.T,
+        first, last = _FloatFrame.of(start), _FloatFrame.of(end)
+        gravity, h = self.gravity.at, JACOBIAN_STEP
+        fields = []
+        for p, v in zip(rho.tolist(), rho_dot.tolist(), strict=True):
+            px, py, pz = first.inertial(p)
+            at_start = first.relative(gravity(px, py, pz), p, v)
+            at_end = last.relative(gravity(*last.inertial(p)), p, v)
+            rows = []  # row j: ∂(Cᵀ g)/∂ρ_j
+            for ax, ay, az in first.columns:
+                ux, uy, uz = gravity(px + h * ax, py + h * ay, pz + h * az)
+                wx, wy, wz = gravity(px - h * ax, py - h * ay, pz - h * az)
+                scale = 0.5 / h
+                rows.append(
+                    first.to_lvlh(((ux - wx) * scale, (uy - wy) * scale, (uz - wz) * scale))
+                )
+            (a11, a12, a13), (a21, a22, a23), (a31, a32, a33) = first.position_terms
+            jacobian = (
+                (rows[0][0] + a11, rows[1][0] + a12, rows[2][0] + a13),
+                (rows[0][1] + a21, rows[1][1] + a22, rows[2][1] + a23),
+                (rows[0][2] + a31, rows[1][2] + a32, rows[2][2] + a33),
             )
+            drift = (
+                (at_end[0] - at_start[0]) / period,
+                (at_end[1] - at_start[1]) / period,
+                (at_end[2] - at_start[2]) / period,
+            )
+            position = (p[0], p[1], p[2])
+            velocity = (v[0], v[1], v[2])
+            fields.append(
+                AffineAcceleration(
+                    at_start, drift, jacobian, first.velocity_terms, position, velocity
+                )
+            )
+        return fields
+
+
+Vec = tuple[float, float, float]
+"""A 3-vector in plain floats."""
+
+Rows = tuple[Vec, Vec, Vec]
+"""A 3×3 matrix in plain floats, row by row."""
+
+
+def _rows(matrix: Vector) -> Rows:
+    (a, b, c), (d, e, f), (g, i, j) = matrix.tolist()
+    return ((a, b, c), (d, e, f), (g, i, j))
+
+
+@dataclass(frozen=True)
+class _FloatFrame:
+    """An :class:`~dcsim.world.orbit.frame.LvlhFrame` in plain floats: the chief's
+    position and acceleration, the axes matrix ``C`` by rows and by columns (the LVLH
+    axes in inertial components) and the frame's terms."""
+
+    position: Vec
+    acceleration: Vec
+    rows: Rows
+    columns: Rows
+    position_terms: Rows
+    velocity_terms: Rows
+
+    @classmethod
+    def of(cls, frame: LvlhFrame) -> _FloatFrame:
+        """The frame's numbers as floats."""
+        position_terms, velocity_terms = frame.frame_terms
+        (x, y, z), (ax, ay, az) = frame.position.tolist(), frame.acceleration.tolist()
+        return cls(
+            (x, y, z),
+            (ax, ay, az),
+            _rows(frame.axes),
+            _rows(frame.axes.T),
+            _rows(position_terms),
+            _rows(velocity_terms),
         )
-        pulls = self.gravity(points)
-        shifted = pulls[count : 7 * count].reshape(count, 6, 3)
-        starts_terms, end_terms = start.frame_terms, end.frame_terms
-        at_start = (
-            (pulls[:count] - start.acceleration) @ start.axes
-            + rho @ starts_terms[0].T
-            + rho_dot @ starts_terms[1].T
+
+    def inertial(self, rho: list[float]) -> Vec:
+        """``r_c + C ρ``, m."""
+        x, y, z = rho
+        (a, b, c), (d, e, f), (g, h, i) = self.rows
+        cx, cy, cz = self.position
+        return (cx + a * x + b * y + c * z, cy + d * x + e * y + f * z, cz + g * x + h * y + i * z)
+
+    def to_lvlh(self, vector: Vec) -> Vec:
+        """``Cᵀ v``: an inertial vector's LVLH components."""
+        x, y, z = vector
+        (a, b, c), (d, e, f), (g, h, i) = self.columns
+        return (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
+
+    def relative(self, pull: Vec, rho: list[float], rho_dot: list[float]) -> Vec:
+        """The relative acceleration of a point at ``(ρ, ρ̇)`` feeling ``pull`` (m/s²,
+        inertial): ``Cᵀ (g − a_c) + A_ρ ρ + A_v ρ̇``."""
+        ax, ay, az = self.acceleration
+        gx, gy, gz = self.to_lvlh((pull[0] - ax, pull[1] - ay, pull[2] - az))
+        x, y, z = rho
+        u, v, w = rho_dot
+        (p11, p12, p13), (p21, p22, p23), (p31, p32, p33) = self.position_terms
+        (q11, q12, q13), (q21, q22, q23), (q31, q32, q33) = self.velocity_terms
+        return (
+            gx + p11 * x + p12 * y + p13 * z + q11 * u + q12 * v + q13 * w,
+            gy + p21 * x + p22 * y + p23 * z + q21 * u + q22 * v + q23 * w,
+            gz + p31 * x + p32 * y + p33 * z + q31 * u + q32 * v + q33 * w,
         )
-        at_end = (
-            (pulls[7 * count :] - end.acceleration) @ end.axes
-            + rho @ end_terms[0].T
-            + rho_dot @ end_terms[1].T
-        )
-        gradient = (shifted[:, :3] - shifted[:, 3:]) @ start.axes / (2.0 * h)  # (N, axis j, i)
-        jacobians = np.swapaxes(gradient, 1, 2) + starts_terms[0]
-        velocity_jacobian = starts_terms[1]
-        drift = (at_end - at_start) / period
-        return [
-            AffineAcceleration.of(a, d, j, velocity_jacobian, p, v)
-            for a, d, j, p, v in zip(at_start, drift, jacobians, rho, rho_dot, strict=True)
-        ]
 
 
 @dataclass(frozen=True, slots=True)
