@@ -217,13 +217,13 @@ class Actuators:
             on_times = thrusters.modulate(firing.on_times)
         fractions = thrusters.step_fractions(on_times)
         needed = thrusters.propellant(fractions)
-        fractions = fractions * propellant.draw(needed)[:, None]
+        allowed = propellant.draw(needed)
+        fractions = fractions * allowed[:, None]
         forces, torques = thrusters.wrench(fractions)
         self.duty = fractions.sum(axis=0) * self._dt / self._period
-        used = float(thrusters.propellant(fractions).sum())
-        propellant.book_thrust(row_lengths(forces), rotation @ forces.mean(axis=0), mass)
         mean_force = forces.mean(axis=0)
-        self._split_propellant(used, mean_force, centre)
+        propellant.book_thrust(row_lengths(forces), rotation @ mean_force, mass)
+        self._split_propellant(float(needed @ allowed), mean_force, centre)
         mean_torque = torques.mean(axis=0) - np.cross(centre, mean_force)
         return ThrustProfile(forces, torques, mean_torque)
 

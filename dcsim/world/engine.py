@@ -11,13 +11,14 @@ composes its pieces:
 - :mod:`~dcsim.world.environment`: Clohessy–Wiltshire forces and the propellant;
 - :mod:`~dcsim.world.sensors`: beacon ranges, object tracks, attitude and rate;
 - :mod:`~dcsim.world.payload`: objects held by the robot (a mission attaches them);
-- :mod:`~dcsim.world.objects`: the targets and obstacles and their motion.
+- :mod:`~dcsim.world.objects`: the targets and obstacles and their motion;
+- :mod:`~dcsim.world.actuators`: the free flyer's thrusters and reaction wheels.
 
-- **Robot**: its base is driven by thrust (clipped to ``max_force`` and to the
-  propellant left) and torque (no propellant): ideal, clipped to ``max_torque``, or
-  the reaction of the free flyer's reaction wheels (:mod:`~dcsim.world.wheels`); a
-  manipulator's joints by joint torques. The base's mass is updated once per control
-  period.
+- **Robot**: its base is driven by thrust and torque: ideal (thrust clipped to
+  ``max_force`` and to the propellant left, torque to ``max_torque``, using none), or
+  what the free flyer's thrusters and reaction wheels deliver
+  (:mod:`~dcsim.world.actuators`); a manipulator's joints by joint torques. The base's
+  mass is updated once per control period.
 - **Objects**: targets and obstacles, spheres, boxes or cylinders of fixed orientation,
   follow their motion models exactly while free.
 - **Collisions**: every physics step, the robot and what it carries against every
@@ -467,10 +468,10 @@ class World:
             "delivered": self.field.count(ObjectStatus.REMOVED),
             "collisions": len(self.collisions),
             "nearest_obstacle_distance": self.nearest_obstacle_distance(),
-            **self._wheel_outputs(),
+            **self._hardware_outputs(),
         }
 
-    def _wheel_outputs(self) -> dict[str, Any]:
+    def _hardware_outputs(self) -> dict[str, Any]:
         """The reaction wheels' momenta (N·m·s), spin rates (rad/s) and the torque they
         gave the base over the last physics step (body frame, N·m); each thruster's duty
         cycle over the last control period (a fraction) and whether the thrusters are
@@ -515,7 +516,7 @@ class World:
             torque = tuple(float(q) for q in self.inputs.disturbance_torque)
             started = self._fly_period(None, disturbance, torque, profile)
         else:
-            commanded = self._ideal_torque()
+            commanded = self._torque_on_base()
             torque = tuple(
                 float(q)
                 for q in commanded + np.asarray(self.inputs.disturbance_torque, dtype=float)
@@ -530,7 +531,7 @@ class World:
         """The base's body-to-world rotation matrix now."""
         return np.reshape(pb.getMatrixFromQuaternion(self.base_state()[2].tolist()), (3, 3))
 
-    def _ideal_torque(self) -> np.ndarray:
+    def _torque_on_base(self) -> np.ndarray:
         """The commanded torque clipped to ``max_torque``, world frame, N·m; with reaction
         wheels, zero: the wheels take the command (in body axes, each wheel clipped to its
         limits) and the base gets their reaction step by step."""

@@ -61,12 +61,13 @@ class ReactionWheels:
         self._allocation = np.linalg.pinv(self.axes)
         self._inertia = np.array([wheel.inertia for wheel in wheels])
         self._max_torque = np.array([wheel.max_torque for wheel in wheels])
-        self._max_momentum = np.array([wheel.max_momentum for wheel in wheels])
-        self._limits = self._max_momentum.tolist()
+        self._limits = [wheel.max_momentum for wheel in wheels]
         self._h = [0.0] * len(wheels)
         self._tau = [0.0] * len(wheels)
         self._command_list = [0.0] * len(wheels)
         self._saturated = [False] * len(wheels)
+        self._started: list[int] = []
+        self._fraction = 0.0
         self.peak_fraction = 0.0
 
     @property
@@ -123,7 +124,7 @@ class ReactionWheels:
 
     def momentum_fraction(self) -> float:
         """The largest ``|h_i| / max_momentum_i`` of the wheels now."""
-        return max(abs(h) / limit for h, limit in zip(self._h, self._limits, strict=True))
+        return self._fraction
 
     def body_momentum(self) -> np.ndarray:
         """The wheels' angular momentum ``A h``, body frame, N·m·s (3,)."""
@@ -158,7 +159,7 @@ class ReactionWheels:
         tuple of 3 float
             The wheels' torque on the base over the step, world frame, N·m.
         """
-        torques, momenta, peak = [], [], self.peak_fraction
+        torques, momenta, saturated, fraction = [], [], [], 0.0
         for command, h, limit in zip(self._command_list, self._h, self._limits, strict=True):
             low, high = min((-limit - h) / dt, 0.0), max((limit - h) / dt, 0.0)
             tau = low if command < low else high if command > high else command
@@ -166,10 +167,17 @@ class ReactionWheels:
             h_next = -limit if h_next < -limit else limit if h_next > limit else h_next
             torques.append(tau)
             momenta.append(h_next)
-            peak = max(peak, abs(h_next) / limit)
+            saturated.append(abs(h_next) >= _AT_LIMIT * limit)
+            fraction = max(fraction, abs(h_next) / limit)
+        self._started = [
+            i
+            for i, (now, was) in enumerate(zip(saturated, self._saturated, strict=True))
+            if now and not was
+        ]
         before = turn(rotation, self._body(self._h))
         body_after = self._body(momenta)
-        self._tau, self._h, self.peak_fraction = torques, momenta, peak
+        self._tau, self._h, self._saturated = torques, momenta, saturated
+        self._fraction, self.peak_fraction = fraction, max(self.peak_fraction, fraction)
         ix, iy, iz = moments
 
         def rate_change(applied: Vec) -> Vec:
@@ -215,21 +223,10 @@ class ReactionWheels:
         return (x, y, z)
 
     def newly_saturated(self) -> list[int]:
-        """Indices of the wheels that reached their momentum limit since the last call.
-
-        A wheel is saturated while ``|h_i|`` is at ``max_momentum``; it is reported once
-        per such episode.
-        """
-        at_limit = [
-            abs(h) >= _AT_LIMIT * limit for h, limit in zip(self._h, self._limits, strict=True)
-        ]
-        started = [
-            i
-            for i, (now, was) in enumerate(zip(at_limit, self._saturated, strict=True))
-            if now and not was
-        ]
-        self._saturated = at_limit
-        return started
+        """Indices of the wheels that reached their momentum limit in the last physics
+        step (:meth:`step`): a wheel is saturated while ``|h_i|`` is at ``max_momentum``,
+        and reported once per such episode."""
+        return self._started
 
     def delivered(self) -> np.ndarray:
         """The torque the wheels gave the base over the last physics step, ``-A τ``,
