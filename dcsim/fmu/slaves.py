@@ -49,7 +49,6 @@ from dcsim.fmu.variables import (
     WHEELS_DIRECT,
     FmuVariable,
     closed_loop_variables,
-    hardware,
     joint_count,
     plant_variables,
 )
@@ -59,7 +58,7 @@ from dcsim.run.loop import Runner
 from dcsim.run.seeding import component_rng
 from dcsim.run.setup import setup_run
 from dcsim.scenario import Scenario, read_scenario
-from dcsim.scenario.model import ManipulatorSection, point_to_cartesian
+from dcsim.scenario.model import ManipulatorSection, point_to_cartesian, robot_hardware
 from dcsim.world import World, WorldInputs
 
 SCENARIO_RESOURCE = "scenario.yaml"
@@ -431,7 +430,7 @@ class PlantSlave(_ScenarioSlave):
         self.world = World(scenario, component_rng(scenario.world.seed, "world"))
         self._collided = False
         self._ignored: set[str] = set()
-        thrusters, wheels = hardware(scenario.robot)
+        thrusters, wheels = robot_hardware(scenario.robot)
         self._thrusters, self._wheels = len(thrusters), len(wheels)
 
     def _advance(self) -> None:

@@ -30,7 +30,7 @@ from dcsim.scenario.model import (
     RobotSection,
     Scenario,
     ThrusterSpec,
-    WheelSpec,
+    robot_hardware,
 )
 
 AXES = ("x", "y", "z")
@@ -164,20 +164,10 @@ def joint_torque_inputs(robot: RobotSection | ManipulatorSection) -> list[FmuVar
     ]
 
 
-def hardware(
-    robot: RobotSection | ManipulatorSection,
-) -> tuple[list[ThrusterSpec], list[WheelSpec]]:
-    """The thrusters and the reaction wheels of a scenario's robot, in the scenario's
-    order (none for ideal force and torque, and for a manipulator)."""
-    if not isinstance(robot, RobotSection):
-        return [], []
-    return list(robot.actuators.thrusters or ()), list(robot.actuators.reaction_wheels or ())
-
-
 def hardware_inputs(scenario: Scenario) -> list[FmuVariable]:
     """The plant's per-thruster on-times (s) and per-wheel torques (N·m), each set with
     the Boolean that makes them replace the allocation of ``force`` and ``torque``."""
-    thrusters, wheels = hardware(scenario.robot)
+    thrusters, wheels = robot_hardware(scenario.robot)
     period = scenario.world.control_period
     inputs = [
         FmuVariable(
@@ -246,7 +236,7 @@ def hardware_outputs(robot: RobotSection | ManipulatorSection) -> list[FmuVariab
     """Both FMUs' outputs of the hardware: each wheel's momentum (N·m·s), each thruster's
     duty cycle over the last control period, and with thrusters the propellant burnt for
     attitude (kg)."""
-    thrusters, wheels = hardware(robot)
+    thrusters, wheels = robot_hardware(robot)
     outputs = [
         FmuVariable(
             WHEEL_MOMENTUM.format(i),
@@ -285,7 +275,7 @@ def hardware_outputs(robot: RobotSection | ManipulatorSection) -> list[FmuVariab
 def attitude_error_output(robot: RobotSection | ManipulatorSection) -> list[FmuVariable]:
     """The closed loop's attitude error (rad), for a robot with thrusters or reaction
     wheels only."""
-    if not any(hardware(robot)):
+    if not any(robot_hardware(robot)):
         return []
     return [
         FmuVariable(

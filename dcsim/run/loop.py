@@ -57,6 +57,7 @@ from dcsim.scenario.model import (
     ManipulatorSection,
     RobotSection,
     point_to_cartesian,
+    robot_hardware,
 )
 from dcsim.world import World, WorldInputs
 from dcsim.world.orbit.validity import cw_error_estimate
@@ -663,12 +664,8 @@ class Runner:
 def actuator_counts(robot: RobotSection | ManipulatorSection) -> ActuatorCounts:
     """How many thrusters and reaction wheels the robot has (its joints are counted
     from its observations)."""
-    if not isinstance(robot, RobotSection):
-        return ActuatorCounts()
-    actuators = robot.actuators
-    return ActuatorCounts(
-        thrusters=len(actuators.thrusters or ()), wheels=len(actuators.reaction_wheels or ())
-    )
+    thrusters, wheels = robot_hardware(robot)
+    return ActuatorCounts(thrusters=len(thrusters), wheels=len(wheels))
 
 
 def _position_sigmas(covariance: np.ndarray) -> list[float]:

@@ -691,6 +691,16 @@ class RobotSection(RobotBaseSection):
         return robot.model_copy(update=update) if update else robot
 
 
+def robot_hardware(
+    robot: RobotSection | ManipulatorSection,
+) -> tuple[list[ThrusterSpec], list[WheelSpec]]:
+    """The thrusters and the reaction wheels of a scenario's robot, in the scenario's
+    order (none for ideal force and torque, and for a manipulator)."""
+    if not isinstance(robot, RobotSection):
+        return [], []
+    return list(robot.actuators.thrusters or ()), list(robot.actuators.reaction_wheels or ())
+
+
 def _ordered(limits: tuple[float, float]) -> tuple[float, float]:
     if not limits[0] <= limits[1]:
         raise ValueError("give [lower, upper], lower at most upper")
