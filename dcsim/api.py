@@ -14,6 +14,7 @@ Runs (docs/python.md)
     gives a :class:`RunResult`: summary, telemetry (a pandas DataFrame, units in the
     column names), events, plugins.
 Plugin kinds
+    :class:`SensorModel` (one of :data:`SENSOR_SLOTS`), :class:`Tracker`,
     :class:`Localiser`, :class:`TaskPlanner`, :class:`PathPlanner`, :class:`Controller`
     (and their common base :class:`Plugin`).
 Parameters
@@ -28,7 +29,9 @@ Messages
     :class:`MotionInput`, :class:`Reference`, :class:`Command`, :class:`RobotSpec`;
     the typed contract of its ``model``, :class:`RobotModel`.
     Sensing: :class:`ObjectTrack`, :class:`ObjectKind`, :class:`Shape`, :class:`ShapeKind`,
-    :class:`BeaconRange`, :class:`Observations`, :class:`Surroundings`.
+    :class:`BeaconRange`, :class:`Observations`, :class:`Surroundings`; the readings of
+    sensor models, :class:`AttitudeReading`, :class:`RateReading`, :class:`Detection`,
+    and what they read, :class:`SensorSetup`, :class:`SensedTruth`, :class:`KnownObject`.
     Path planning: :class:`PathProblem`, :class:`GoalRegion`, :class:`FrameDynamics`,
     :class:`FrameKind`, :class:`ChiefOrbit`, :class:`OrbitModel`, :class:`Bounds`,
     :class:`CostWeights`, :class:`Trajectory`,
@@ -128,16 +131,19 @@ from dcsim.geometry import (
     unit,
 )
 from dcsim.messages import (
+    AttitudeReading,
     BeaconRange,
     Bounds,
     ChiefOrbit,
     Command,
     CostWeights,
+    Detection,
     DropPoint,
     DropVisit,
     FrameDynamics,
     FrameKind,
     GoalRegion,
+    KnownObject,
     Message,
     MotionInput,
     NoPath,
@@ -149,9 +155,12 @@ from dcsim.messages import (
     Plan,
     PlanTask,
     Prior,
+    RateReading,
     Reference,
     RobotSpec,
     RobotState,
+    SensedTruth,
+    SensorSetup,
     Shape,
     ShapeKind,
     StateEstimate,
@@ -175,12 +184,15 @@ from dcsim.registry.discovery import PluginRegistry
 from dcsim.registry.hookspecs import hookimpl
 from dcsim.registry.interfaces import (
     PLUGIN_KINDS,
+    SENSOR_SLOTS,
     Controller,
     Localiser,
     PathPlanner,
     PathPlannerParams,
     Plugin,
+    SensorModel,
     TaskPlanner,
+    Tracker,
 )
 from dcsim.rest_to_rest import cruise_speed, rest_to_rest_time, shortest_leg
 from dcsim.robots.dh import DHLink, DHRobot, ManipulatorBase, thesis_manipulator
@@ -277,7 +289,16 @@ __all__ = [
     "Command",
     "Controller",
     "CostWeights",
+    "AttitudeReading",
     "cruise_speed",
+    "Detection",
+    "KnownObject",
+    "RateReading",
+    "SensedTruth",
+    "SENSOR_SLOTS",
+    "SensorModel",
+    "SensorSetup",
+    "Tracker",
     "DcsimError",
     "DHLink",
     "DHRobot",

@@ -89,7 +89,7 @@ def test_unknown_name_suggests_the_closest():
 
 def test_unknown_kind_lists_the_kinds():
     with pytest.raises(
-        PluginNotFoundError, match="kinds: localiser, task_planner, path_planner, controller"
+        PluginNotFoundError, match="kinds: sensor, tracker, localiser, task_planner, path_planner, controller"
     ):
         PluginRegistry().plugins("navigator")
 

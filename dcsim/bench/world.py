@@ -243,7 +243,7 @@ def loop_floor(
         steps = ticks * world.steps_per_control
         stepping = _best(lambda: _step_bare(world, steps), repeats)
         forced = _best(lambda: _step_with_forces(world, steps), repeats)
-        ranges = world.beacon_ranges()
+        ranges = list(world.beacon_ranges())
         localiser = setup.plugins["localiser"]
         assert isinstance(localiser, Localiser)  # the run set it up for the localiser role
         position = world.base_state()[0]

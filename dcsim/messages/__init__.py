@@ -21,10 +21,16 @@ from dcsim.messages.planning import (
     Trajectory,
 )
 from dcsim.messages.sensing import (
+    AttitudeReading,
     BeaconRange,
+    Detection,
+    KnownObject,
     ObjectKind,
     ObjectTrack,
     Observations,
+    RateReading,
+    SensedTruth,
+    SensorSetup,
     Shape,
     ShapeKind,
     Surroundings,
@@ -41,7 +47,13 @@ from dcsim.messages.state import (
 from dcsim.messages.tasks import DropPoint, DropVisit, Plan, PlanTask, TaskRequest
 
 __all__ = [
+    "AttitudeReading",
     "BeaconRange",
+    "Detection",
+    "KnownObject",
+    "RateReading",
+    "SensedTruth",
+    "SensorSetup",
     "Bounds",
     "Command",
     "CostWeights",

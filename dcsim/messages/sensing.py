@@ -1,12 +1,17 @@
 """Messages about what the robot senses: space objects, beacon ranges, its own attitude.
 
 They follow the source thesis's topics (Objects, Beacons). Vectors are read-only float
-arrays in the world frame; times are scenario seconds; quaternions are ``[x, y, z, w]``.
+arrays in the world frame unless a field says otherwise; times are scenario seconds;
+quaternions are ``[x, y, z, w]``. A sensor model (:class:`~dcsim.api.SensorModel`) reads
+a :class:`SensedTruth` and gives readings (:class:`BeaconRange`, :class:`AttitudeReading`,
+:class:`RateReading`, :class:`Detection`); a tracker turns detections into
+:class:`ObjectTrack` s; the robot's plugins see them gathered in :class:`Observations`.
 """
 
 from __future__ import annotations
 
 import enum
+from dataclasses import field
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -96,10 +101,16 @@ class ObjectTrack(Message):
     radius : float
         Radius of the object's bounding sphere, m (from ``shape`` when given as 0).
     motion : MotionModel or None
-        The object's motion parameters, for prediction; None if unknown, in which case
-        prediction assumes constant velocity.
+        The motion :meth:`predict` follows: under ideal sensing the object's own motion;
+        from a tracker, the frame's free dynamics from the track's state; None if unknown,
+        in which case prediction assumes constant velocity.
     shape : Shape
-        The object's true shape; given as None (the default), a sphere of ``radius``.
+        The object's shape as known: its true shape under ideal sensing or from a
+        sensor that sees shapes, else a bounding sphere; given as None (the default), a
+        sphere of ``radius``.
+    covariance : ndarray (6, 6) or None
+        Covariance of the state ``[position, velocity]`` at ``time``, m² and m²/s², m²/s
+        off the diagonal blocks; None when the state is exact (ideal sensing).
     """
 
     id: int
@@ -113,6 +124,7 @@ class ObjectTrack(Message):
     # None at construction means a sphere of ``radius``; __post_init__ replaces it, so the
     # attribute is always a Shape (mypy cannot type a field's converter).
     shape: Shape = None  # type: ignore[assignment]
+    covariance: Vector | None = array_field(shape=(6, 6), default=None, optional=True)
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -150,6 +162,174 @@ class BeaconRange(Message):
 
 
 @message
+class AttitudeReading(Message):
+    """The star tracker's measured attitude.
+
+    Attributes
+    ----------
+    time : float
+        Time of the measurement, s.
+    attitude : ndarray (4,)
+        Measured body-to-world rotation ``[x, y, z, w]`` (a unit quaternion).
+    sigma : ndarray (3,)
+        Standard deviation of the error about each body axis, rad.
+    """
+
+    time: float
+    attitude: Vector = array_field(shape=(4,))
+    sigma: Vector = array_field(default=(0.0, 0.0, 0.0))
+
+
+@message
+class RateReading(Message):
+    """The gyros' measured angular velocity.
+
+    Attributes
+    ----------
+    time : float
+        Time of the measurement, s.
+    angular_velocity : ndarray (3,)
+        Measured angular velocity of the base, body frame, rad/s.
+    sigma : float
+        Standard deviation of one reading's white noise per axis, rad/s (the angle random
+        walk over the sampling interval; the bias is not included).
+    """
+
+    time: float
+    angular_velocity: Vector = array_field()
+    sigma: float = 0.0
+
+
+@message
+class Detection(Message):
+    """One object as an object sensor (lidar or camera) sees it at one instant.
+
+    The sensor recognises what it sees (each object carries its catalogue identity, kind
+    and mass), so a tracker associates detections by ``id``; its position is measured
+    relative to the robot.
+
+    Attributes
+    ----------
+    time : float
+        Time of the measurement, s.
+    id : int
+        The object's identifier.
+    kind : ObjectKind
+        Target or obstacle.
+    relative_position : ndarray (3,)
+        Measured position of the object's centre relative to the robot's base, along the
+        world frame's axes, m.
+    covariance : ndarray (3, 3)
+        Covariance of ``relative_position``'s error, m².
+    radius : float
+        Radius of the object's bounding sphere as the sensor sizes it, m.
+    mass : float
+        The object's catalogue mass, kg.
+    shape : Shape or None
+        The object's shape when the sensor sees shapes; None otherwise.
+    """
+
+    time: float
+    id: int
+    kind: ObjectKind
+    relative_position: Vector = array_field()
+    covariance: Vector = array_field(shape=(3, 3))
+    radius: float = 0.0
+    mass: float = 0.0
+    shape: Shape | None = None
+
+
+@message
+class KnownObject(Message):
+    """A space object as the world knows it, for sensor models (not seen by plugins).
+
+    Attributes
+    ----------
+    id : int
+        The object's identifier.
+    kind : ObjectKind
+        Target or obstacle.
+    mass : float
+        kg.
+    shape : Shape
+        Its true collision shape.
+    """
+
+    id: int
+    kind: ObjectKind
+    mass: float
+    shape: Shape
+
+
+@message
+class SensorSetup(Message):
+    """What a sensor model is told before a run.
+
+    Attributes
+    ----------
+    control_period : float
+        Time between two calls of the model's ``measure``, s (the control period).
+    beacons : ndarray (B, 3)
+        Beacon positions, world frame, m.
+    beacon_noise : float
+        Standard deviation of the white range noise (``beacons.noise_sigma``), m.
+    beacon_max_range : float
+        Beacons farther away give no range (``beacons.max_range``; inf for none), m.
+    beacon_report_nearest : int
+        Ranges reported at most per reading (``beacons.report_nearest``).
+    object_range : float
+        Reach of the object sensor (``robot.sensor_range``), m.
+    objects : tuple of KnownObject
+        The world's objects, in the order of :class:`SensedTruth`'s object arrays.
+    """
+
+    control_period: float
+    beacons: Vector = array_field(shape=(-1, 3), default=np.zeros((0, 3)))
+    beacon_noise: float = 0.0
+    beacon_max_range: float = np.inf
+    beacon_report_nearest: int = 1
+    object_range: float = np.inf
+    objects: tuple[KnownObject, ...] = ()
+
+
+_NONE_FREE = np.zeros(0, dtype=bool)
+_NONE_FREE.setflags(write=False)
+
+
+@message
+class SensedTruth(Message):
+    """The true state a sensor model measures at one instant (for sensor models only).
+
+    Attributes
+    ----------
+    time : float
+        s.
+    position, velocity : ndarray (3,)
+        The robot base's position (m) and velocity (m/s), world frame.
+    attitude : ndarray (4,)
+        The base's body-to-world rotation ``[x, y, z, w]``.
+    angular_velocity : ndarray (3,)
+        The base's angular velocity, world frame, rad/s.
+    object_positions, object_velocities : ndarray (N, 3)
+        Every object's position (m) and velocity (m/s), world frame, in the order of
+        :attr:`SensorSetup.objects`; empty (0, 3) unless the scenario has an object
+        sensor model.
+    free : ndarray of bool (N,)
+        Whether each object is free (not held by the robot, not delivered): a sensor
+        sees only free objects.
+    """
+
+    time: float
+    position: Vector = array_field()
+    velocity: Vector = array_field()
+    attitude: Vector = array_field(shape=(4,))
+    angular_velocity: Vector = array_field()
+    object_positions: Vector = array_field(shape=(-1, 3), default=np.zeros((0, 3)))
+    object_velocities: Vector = array_field(shape=(-1, 3), default=np.zeros((0, 3)))
+    free: np.ndarray = field(default_factory=lambda: _NONE_FREE)
+
+
+@message
 class Observations(Message):
     """Everything the robot's sensors report at one instant.
 
@@ -160,13 +340,24 @@ class Observations(Message):
     ranges : tuple of BeaconRange
         Beacon ranges measured now (possibly none).
     tracks : tuple of ObjectTrack
-        Objects within sensor range.
+        Objects within sensor range: the truth under ideal object sensing, else the
+        tracker's tracks.
     attitude : ndarray (4,)
-        Base attitude from the star tracker, ``[x, y, z, w]``.
+        Base attitude as the star tracker gives it, ``[x, y, z, w]``: the truth under
+        ideal sensing, else its latest reading.
     angular_velocity : ndarray (3,)
-        Base angular velocity from the gyros, world frame, rad/s.
+        Base angular velocity as the gyros give it, world frame, rad/s: the truth under
+        ideal sensing, else their latest reading turned into the world frame by
+        ``attitude``.
     joint_positions, joint_velocities : ndarray (n,)
         Joint encoder readings; empty for a free flyer.
+    detections : tuple of Detection
+        The object sensor's detections now (empty under ideal object sensing, or when
+        it gives no reading now).
+    star_tracker : AttitudeReading or None
+        The star tracker's reading now; None under ideal sensing or between readings.
+    gyros : RateReading or None
+        The gyros' reading now; None under ideal sensing or between readings.
     """
 
     time: float
@@ -176,6 +367,9 @@ class Observations(Message):
     angular_velocity: Vector = array_field(default=(0.0, 0.0, 0.0))
     joint_positions: Vector = array_field(shape=(-1,), default=())
     joint_velocities: Vector = array_field(shape=(-1,), default=())
+    detections: tuple[Detection, ...] = ()
+    star_tracker: AttitudeReading | None = None
+    gyros: RateReading | None = None
 
     def obstacles(self) -> tuple[ObjectTrack, ...]:
         """The tracks of obstacles."""

@@ -27,6 +27,7 @@ from dcsim.missions.base import Mission
 from dcsim.registry.discovery import BUILTIN_DISTRIBUTION
 from dcsim.registry.interfaces import PLUGIN_KINDS
 from dcsim.scenario.model import Scenario
+from dcsim.scenario.sensors import sensor_choices
 
 MISSION_GROUP = "dcsim.missions"
 """The entry point group missions are found in."""
@@ -101,12 +102,15 @@ def mission_types() -> dict[str, type[Mission]]:
 def scenario_roles(scenario: Scenario) -> tuple[str, ...]:
     """The plugin roles a scenario's run uses, in data-flow order.
 
-    Those its mission needs, and the optional ones (``role_defaults`` of None in the
+    Those its mission needs, the tracker when an object sensor has a model, and the
+    optional ones (``role_defaults`` of None in the
     mission's settings) for which the scenario names a plugin.
     """
     mission = mission_class(scenario.mission.type)
     optional = [role for role, default in mission.Settings.role_defaults.items() if default is None]
     used = set(mission.roles) | {role for role in optional if getattr(scenario, role) is not None}
+    if sensor_choices(scenario.sensors)["objects"] is not None:
+        used.add("tracker")  # detections become tracks
     return tuple(role for role in PLUGIN_KINDS if role in used)
 
 

@@ -1,6 +1,8 @@
 """What each plugin kind hands back, and the check every answer passes at the boundary.
 
-A localiser's ``estimate()`` gives a :class:`~dcsim.messages.StateEstimate`, a task
+A sensor model's ``measure()`` gives its sensor's readings (:data:`SENSOR_READINGS`), a
+tracker's ``update()`` a tuple of :class:`~dcsim.messages.ObjectTrack`, a localiser's
+``estimate()`` gives a :class:`~dcsim.messages.StateEstimate`, a task
 planner's ``plan()`` a :class:`~dcsim.messages.Plan`, a path planner's ``plan()`` a
 :class:`~dcsim.messages.Trajectory` or a :class:`~dcsim.messages.NoPath` with a reason,
 and a controller's ``command()`` a :class:`~dcsim.messages.Command`. Messages check
@@ -17,11 +19,22 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator
 from dataclasses import dataclass, fields, is_dataclass
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 
-from dcsim.messages import Command, NoPath, Plan, StateEstimate, Trajectory
+from dcsim.messages import (
+    AttitudeReading,
+    BeaconRange,
+    Command,
+    Detection,
+    NoPath,
+    ObjectTrack,
+    Plan,
+    RateReading,
+    StateEstimate,
+    Trajectory,
+)
 
 
 @dataclass(frozen=True)
@@ -44,6 +57,12 @@ class Answer:
 
 
 ANSWERS: dict[str, Answer] = {
+    "sensor": Answer(
+        "measure",
+        (tuple, AttitudeReading, RateReading, type(None)),
+        "the readings its sensor gives (dcsim.api.SENSOR_SLOTS) with finite numbers",
+    ),
+    "tracker": Answer("update", (tuple,), "a tuple of ObjectTrack with finite numbers"),
     "localiser": Answer("estimate", (StateEstimate,), "a StateEstimate with finite numbers"),
     "task_planner": Answer("plan", (Plan,), "a Plan with finite times and points"),
     "path_planner": Answer(
@@ -62,6 +81,16 @@ ANSWERS: dict[str, Answer] = {
 """The answer each plugin kind owes, by kind."""
 
 
+SENSOR_READINGS: dict[str, tuple[type, bool]] = {
+    "beacon_ranges": (BeaconRange, True),
+    "star_tracker": (AttitudeReading, False),
+    "gyros": (RateReading, False),
+    "objects": (Detection, True),
+}
+"""What a sensor model of each slot gives: the reading's type, and whether it gives a
+tuple of them (else one, or None between readings)."""
+
+
 class ActuatorCounts(NamedTuple):
     """How many joints, thrusters and reaction wheels a robot has: a command gives one
     joint torque, thruster on-time or wheel torque per actuator of that kind, or none."""
@@ -72,7 +101,11 @@ class ActuatorCounts(NamedTuple):
 
 
 def output_problem(
-    kind: str, method: str, output: Any, actuators: ActuatorCounts | None = None
+    kind: str,
+    method: str,
+    output: Any,
+    actuators: ActuatorCounts | None = None,
+    measures: str | None = None,
 ) -> str | None:
     """What is wrong with a plugin's answer, in words, or None when nothing is.
 
@@ -89,6 +122,8 @@ def output_problem(
     actuators : ActuatorCounts, optional
         The robot's joints, thrusters and wheels, when known: a command gives one value
         per actuator of a kind, or none.
+    measures : str, optional
+        A sensor model's slot (its ``measures``), which says what it gives.
 
     Returns
     -------
@@ -100,18 +135,60 @@ def output_problem(
         return None
     if not isinstance(output, answer.types):
         return f"returned {type(output).__name__}"
+    if kind == "sensor":
+        return _reading_problem(output, measures)
+    if kind == "tracker":
+        return _items_problem(cast(tuple[Any, ...], output), ObjectTrack)
     if isinstance(output, NoPath):
         return None if str(output.reason).strip() else "returned a NoPath without a reason"
-    if not math.isfinite(_sum_of_numbers(output)):  # NaN and ±inf survive a sum
-        for name, value in _numbers(output):
-            if not _finite(value):
-                return f"returned non-finite numbers: {name} {_show(value)}"
+    problem = _non_finite(output)
+    if problem is not None:
+        return problem
     if isinstance(output, Command) and actuators is not None:
         return _command_shape_problem(output, actuators)
     if isinstance(output, Trajectory) and (
         len(output.times) < 2 or np.any(np.diff(output.times) <= 0)
     ):
         return "returned a trajectory whose times do not increase strictly over two samples or more"
+    return None
+
+
+def _reading_problem(output: Any, measures: str | None) -> str | None:
+    """What is wrong with a sensor model's reading for its slot, or None."""
+    if measures not in SENSOR_READINGS:
+        return f"measures {measures!r}, which is not a sensor slot"
+    reading, many = SENSOR_READINGS[measures]
+    if many:
+        return (
+            _items_problem(output, reading)
+            if isinstance(output, tuple)
+            else (f"returned {type(output).__name__}")
+        )
+    if output is None:
+        return None
+    if not isinstance(output, reading):
+        return f"returned {type(output).__name__}"
+    return _non_finite(output)
+
+
+def _items_problem(items: tuple[Any, ...], item_type: type) -> str | None:
+    """What is wrong with a tuple of messages of ``item_type``, or None."""
+    for index, item in enumerate(items):
+        if not isinstance(item, item_type):
+            return f"returned a tuple holding a {type(item).__name__} at [{index}]"
+        problem = _non_finite(item)
+        if problem is not None:
+            return f"{problem} in [{index}]"
+    return None
+
+
+def _non_finite(message: Any) -> str | None:
+    """The first non-finite number of a message, in words, or None."""
+    if math.isfinite(_sum_of_numbers(message)):  # NaN and ±inf survive a sum
+        return None
+    for name, value in _numbers(message):
+        if not _finite(value):
+            return f"returned non-finite numbers: {name} {_show(value)}"
     return None
 
 

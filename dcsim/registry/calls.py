@@ -93,7 +93,9 @@ def call_plugin(
         answer = getattr(plugin, method)(*args)
     except Exception as error:  # a plugin's own bug ends the run, recorded
         raise PluginFailure(role, plugin.name, method, error) from error
-    problem = output_problem(plugin.kind, method, answer, actuators)
+    problem = output_problem(
+        plugin.kind, method, answer, actuators, getattr(plugin, "measures", None)
+    )
     if problem is not None:
         expected = ANSWERS[plugin.kind].expected
         raise PluginFailure(role, plugin.name, method, problem=f"{problem}; expected {expected}")

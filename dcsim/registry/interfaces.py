@@ -1,7 +1,8 @@
-"""The four plugin kinds: abstract base classes a plugin class derives from.
+"""The plugin kinds: abstract base classes a plugin class derives from.
 
-A plugin is a class deriving from one of :class:`Localiser`, :class:`TaskPlanner`,
-:class:`PathPlanner` or :class:`Controller`. It declares
+A plugin is a class deriving from one of :class:`SensorModel`, :class:`Tracker`,
+:class:`Localiser`, :class:`TaskPlanner`, :class:`PathPlanner` or :class:`Controller`.
+It declares
 
 - ``name``: unique within its kind, lower case (``"pd"``, ``"straight-line"``);
 - ``summary``: one line saying what it is;
@@ -11,7 +12,8 @@ A plugin is a class deriving from one of :class:`Localiser`, :class:`TaskPlanner
 and implements its kind's abstract methods. The framework constructs it with validated
 parameters and its own random generator, spawned from the scenario seed, so that a
 scenario and seed always give the same result. A plugin never sees ground truth, never
-mutates its inputs, and returns within its time budget.
+mutates its inputs, and returns within its time budget. The one exception is a sensor
+model: it is part of the world, and turns the truth into what a sensor reports.
 """
 
 from __future__ import annotations
@@ -23,15 +25,22 @@ from typing import Any, ClassVar
 import numpy as np
 
 from dcsim.messages import (
+    AttitudeReading,
     BeaconRange,
     Command,
+    Detection,
+    FrameDynamics,
     MotionInput,
     NoPath,
+    ObjectTrack,
     PathProblem,
     Plan,
     Prior,
+    RateReading,
     Reference,
     RobotSpec,
+    SensedTruth,
+    SensorSetup,
     StateEstimate,
     Surroundings,
     TaskRequest,
@@ -85,17 +94,95 @@ class Plugin(ABC):
         self.rng = rng if rng is not None else np.random.default_rng(0)
 
 
+SENSOR_SLOTS: dict[str, str] = {
+    "beacon_ranges": "a tuple of BeaconRange (possibly empty)",
+    "star_tracker": "an AttitudeReading, or None when it gives no reading now",
+    "gyros": "a RateReading, or None when they give no reading now",
+    "objects": "a tuple of Detection (possibly empty)",
+}
+"""The sensors a robot carries (the keys of a scenario's ``sensors:`` section), each with
+what its model's :meth:`SensorModel.measure` gives."""
+
+
+class SensorModel(Plugin):
+    """A model of one of the robot's sensors: what it reports, given the truth.
+
+    A sensor model is part of the world: it is the one kind that reads the true state
+    (:class:`~dcsim.messages.SensedTruth`) and it draws its errors from its own
+    generator. The world calls :meth:`measure` once per control tick; a sensor slower
+    than that gives nothing (None, or no detections) between its readings.
+
+    Attributes
+    ----------
+    measures : str
+        The sensor it models, one of :data:`SENSOR_SLOTS`: ``beacon_ranges``,
+        ``star_tracker``, ``gyros`` or ``objects``.
+    """
+
+    kind = "sensor"
+    measures: ClassVar[str]
+    robots: ClassVar[tuple[str, ...]] = ("free-flyer", "manipulator")
+
+    @abstractmethod
+    def reset(self, setup: SensorSetup) -> None:
+        """Prepare for a run in the world ``setup`` describes (time starts at 0)."""
+
+    @abstractmethod
+    def measure(
+        self, truth: SensedTruth
+    ) -> tuple[BeaconRange, ...] | AttitudeReading | RateReading | tuple[Detection, ...] | None:
+        """What the sensor reports at ``truth.time``: the answer :data:`SENSOR_SLOTS`
+        names for its ``measures``."""
+
+
+class Tracker(Plugin):
+    """Turns an object sensor's detections into tracks of the objects around the robot.
+
+    Per control tick, after the localiser, the framework calls :meth:`update` with the
+    detections made now (possibly none) and the robot's estimate (detections are
+    relative to the robot). The tracks it returns are what the mission, the planners
+    and the controller see. It runs only when the scenario has an object sensor model
+    (``sensors.objects``); under ideal object sensing the tracks are the truth.
+    """
+
+    kind = "tracker"
+
+    @abstractmethod
+    def reset(self, frame: FrameDynamics, time: float) -> None:
+        """Start with no tracks at scenario time ``time`` (s), in a frame whose free
+        motion is ``frame`` (to predict the objects with)."""
+
+    @abstractmethod
+    def update(
+        self, time: float, detections: Sequence[Detection], robot: StateEstimate
+    ) -> tuple[ObjectTrack, ...]:
+        """Fold in ``detections`` made at ``time`` (s) from the robot at ``robot``; return
+        every live track, predicted to ``time``, each with its covariance."""
+
+
 class Localiser(Plugin):
     """Estimates the robot's position and velocity from beacon ranges.
 
     Per control tick the framework calls :meth:`predict` with the motion commanded over
     the last period, then :meth:`update` with the ranges measured now (possibly none),
-    then reads :meth:`estimate`. The estimate's attitude, angular velocity and joint
-    states are the attitude sensors' and encoders' readings: the runner puts them in
-    before the mission and the controller see the estimate.
+    then reads :meth:`estimate`. The estimate's joint states are the encoders'
+    readings, and its attitude and angular velocity are the attitude sensors' (the
+    truth under ideal sensing, else the star tracker's and the gyros' latest readings,
+    :attr:`~dcsim.messages.Observations.attitude`): the runner puts them in before the
+    mission and the controller see the estimate, unless the localiser estimates
+    attitude itself.
+
+    Attributes
+    ----------
+    estimates_attitude : bool
+        Whether the localiser estimates attitude and angular velocity from the star
+        tracker's and the gyros' readings (:meth:`update_attitude`); False by default.
+        When True and sensing is not ideal, its estimate's attitude and angular
+        velocity are kept.
     """
 
     kind = "localiser"
+    estimates_attitude: ClassVar[bool] = False
 
     @abstractmethod
     def reset(self, prior: Prior, time: float) -> None:
@@ -112,6 +199,11 @@ class Localiser(Plugin):
     @abstractmethod
     def estimate(self) -> StateEstimate:
         """Return the current estimate; ``converged`` says whether to trust it."""
+
+    def update_attitude(self, attitude: AttitudeReading | None, rate: RateReading | None) -> None:  # noqa: B027 - a hook a localiser may leave alone
+        """Correct the attitude belief with the star tracker's and the gyros' readings
+        made now (None when a sensor gave none). Called each tick after :meth:`update`
+        when sensing is not ideal; ignored unless :attr:`estimates_attitude`."""
 
 
 class TaskPlanner(Plugin):
@@ -210,6 +302,6 @@ class Controller(Plugin):
 
 
 PLUGIN_KINDS: dict[str, type[Plugin]] = {
-    cls.kind: cls for cls in (Localiser, TaskPlanner, PathPlanner, Controller)
+    cls.kind: cls for cls in (SensorModel, Tracker, Localiser, TaskPlanner, PathPlanner, Controller)
 }
 """Every plugin kind by its name, in data-flow order."""

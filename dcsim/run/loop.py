@@ -30,7 +30,7 @@ import time as wallclock
 import warnings
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, TypedDict
+from typing import Any, TypedDict, cast
 
 import numpy as np
 
@@ -41,6 +41,7 @@ from dcsim.missions import Mission, mission_class
 from dcsim.registry.answers import ActuatorCounts
 from dcsim.registry.calls import PluginFailure, call_plugin
 from dcsim.registry.hookspecs import RunInfo
+from dcsim.registry.interfaces import Localiser
 from dcsim.run.recording import (
     SIGMA_COLUMNS,
     Recorder,
@@ -270,7 +271,11 @@ class Runner:
     def open(self) -> None:
         """Build the world, reset the plugins and decide the first control period."""
         self._started = wallclock.perf_counter()
-        self.world = World(self.scenario, component_rng(self.scenario.world.seed, "world"))
+        self.world = World(
+            self.scenario,
+            component_rng(self.scenario.world.seed, "world"),
+            self.setup.registry,
+        )
         self._guarded(self._start)
 
     def advance(
@@ -406,6 +411,8 @@ class Runner:
         self._step_observed = bool(self.setup.registry.hook.dcsim_run_step.get_hookimpls())
         if "localiser" in self.plugins:
             call_plugin(self.plugins, "localiser", "reset", self._prior(), 0.0)
+        if "tracker" in self.plugins:
+            call_plugin(self.plugins, "tracker", "reset", self.scenario.frame_dynamics, 0.0)
         call_plugin(self.plugins, "controller", "reset", world.robot_spec())
         self._robot_changes = world.robot_changes
         self.laps.start()
@@ -444,8 +451,11 @@ class Runner:
         t = world.time
         observations = world.observations()
         laps.lap("sensors")
-        estimate = self.estimate = _with_readings(self._localise(observations), observations)
+        estimate = self.estimate = self._localise(observations)
         laps.lap("localiser")
+        if "tracker" in plugins:
+            observations = self._tracked(t, observations, estimate)
+            laps.lap("tracker")
         reference = self._reference = mission.tick(t, estimate, observations)
         laps.lap("mission")
         if world.robot_changes != self._robot_changes:  # a grab or a release
@@ -468,17 +478,36 @@ class Runner:
         laps.lap("recording")
 
     def _localise(self, observations: Observations) -> StateEstimate:
-        """The localiser's estimate now, or the true state when the mission flies without one."""
+        """The localiser's estimate now, or the true state when the mission flies without
+        one; its attitude and rates are the sensors' readings (:func:`_with_readings`)
+        unless the localiser estimates attitude from the star tracker and the gyros."""
         world, plugins = self._opened_world, self.plugins
         if "localiser" not in plugins:
             position, velocity, _, _ = world.base_state()
-            return StateEstimate(
+            truth = StateEstimate(
                 world.time, position, velocity=velocity, covariance=_NO_SPREAD, converged=True
             )
+            return _with_readings(truth, observations)
         if world.time > 0:
             call_plugin(plugins, "localiser", "predict", world.motion_input(), world.control_period)
         call_plugin(plugins, "localiser", "update", list(observations.ranges))
-        return call_plugin(plugins, "localiser", "estimate")
+        localiser = cast(Localiser, plugins["localiser"])
+        if observations.star_tracker is None and observations.gyros is None:
+            return _with_readings(call_plugin(plugins, "localiser", "estimate"), observations)
+        call_plugin(
+            plugins, "localiser", "update_attitude", observations.star_tracker, observations.gyros
+        )
+        estimate = call_plugin(plugins, "localiser", "estimate")
+        return estimate if localiser.estimates_attitude else _with_readings(estimate, observations)
+
+    def _tracked(
+        self, t: float, observations: Observations, estimate: StateEstimate
+    ) -> Observations:
+        """``observations`` with the tracker's tracks, from its detections and ``estimate``."""
+        tracks = call_plugin(
+            self.plugins, "tracker", "update", t, observations.detections, estimate
+        )
+        return Observations.trusted(**{**observations.__dict__, "tracks": tracks})
 
     def _advance(self, disturbance_force: np.ndarray, disturbance_torque: np.ndarray) -> None:
         command = self._command

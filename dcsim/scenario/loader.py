@@ -39,8 +39,11 @@ from dcsim.scenario.model import (
     MissionSettings,
     OrbitSpec,
     Scenario,
+    SensorChoice,
+    SensorsSection,
     scenario_model,
 )
+from dcsim.scenario.sensors import sensor_choices
 
 DEFAULT_SCENARIO = "default.yaml"
 
@@ -249,9 +252,46 @@ def resolve_plugins(
             )
             continue
         resolved[role] = choice.model_copy(update={"params": params.model_dump(mode="json")})
+    sensors, sensor_problems = _resolve_sensors(doc, scenario, registry)
+    problems += sensor_problems
     if problems:
         raise ScenarioError(doc.filename, problems)
-    return scenario.model_copy(update=resolved)
+    return scenario.model_copy(update={**resolved, "sensors": sensors})
+
+
+def _resolve_sensors(
+    doc: ScenarioDocument, scenario: Scenario, registry: PluginRegistry
+) -> tuple[SensorsSection, list[Problem]]:
+    """Each sensor's model checked (registered, measuring that sensor, valid parameters)
+    and written out with every parameter, the profile's choices included."""
+    problems: list[Problem] = []
+    resolved: dict[str, SensorChoice | None] = {}
+    for slot, choice in sensor_choices(scenario.sensors).items():
+        resolved[slot] = choice
+        if choice is None:
+            continue
+        try:
+            cls = registry.get("sensor", choice.model).cls
+            params = cls.Params.parse(choice.model, choice.params)
+        except PluginParameterError as exc:
+            problems += [
+                doc.problem(("sensors", slot, "params", p.path), p.message) for p in exc.problems
+            ]
+            continue
+        except DcsimError as exc:
+            problems.append(doc.problem(("sensors", slot, "model"), str(exc)))
+            continue
+        measures = getattr(cls, "measures", None)
+        if measures != slot:
+            problems.append(
+                doc.problem(
+                    ("sensors", slot, "model"),
+                    f"sensor model '{choice.model}' measures {measures}, not {slot}",
+                )
+            )
+            continue
+        resolved[slot] = choice.model_copy(update={"params": params.model_dump(mode="json")})
+    return scenario.sensors.model_copy(update=resolved), problems
 
 
 def dump_scenario(scenario: Scenario) -> str:

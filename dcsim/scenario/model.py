@@ -1001,6 +1001,47 @@ class PluginChoice(Section):
     )
 
 
+class SensorChoice(Section):
+    """Which sensor model a sensor has, and its parameters."""
+
+    model: str = Field(description="Registered sensor model name (see `dcsim plugins sensor`).")
+    params: dict[str, Any] = Field(
+        default_factory=dict, description="The model's parameters (see its docs)."
+    )
+
+
+SensingProfile = Literal["ideal", "realistic"]
+
+
+class SensorsSection(Section):
+    """The robot's sensors: a profile gives every sensor's model, and a sensor given here
+    replaces its profile's.
+
+    Under the ``ideal`` profile (the default) the beacon ranges have white noise
+    (``beacons.noise_sigma``) and nothing else, and the star tracker, the gyros and the
+    object sensor report the truth (no model: the tracks are exact and no tracker runs).
+    Under ``realistic`` each sensor has the model and the numbers of
+    :data:`dcsim.world.sensors.profiles.REALISTIC` (their sources are named there and in
+    docs/sensors.md).
+    """
+
+    profile: SensingProfile = Field(
+        "ideal", description="`ideal` (the truth, as before) or `realistic`."
+    )
+    beacon_ranges: SensorChoice | None = Field(
+        None, description="The beacon range sensor's model; null for the profile's."
+    )
+    star_tracker: SensorChoice | None = Field(
+        None, description="The star tracker's model; null for the profile's."
+    )
+    gyros: SensorChoice | None = Field(
+        None, description="The gyros' model; null for the profile's."
+    )
+    objects: SensorChoice | None = Field(
+        None, description="The object sensor's model (lidar, camera); null for the profile's."
+    )
+
+
 class MissionSettings(Section):
     """Base of every mission type's section: ``type`` selects the mission.
 
@@ -1076,6 +1117,15 @@ class Scenario(Section):
     )
     controller: PluginChoice = Field(
         default_factory=lambda: PluginChoice(plugin="pd"), description="Controller plugin."
+    )
+    sensors: SensorsSection = Field(
+        default_factory=SensorsSection,
+        description="Sensor models: a profile (`ideal` or `realistic`) and any sensor's own.",
+    )
+    tracker: PluginChoice = Field(
+        default_factory=lambda: PluginChoice(plugin="kalman"),
+        description="Tracker plugin: turns the object sensor's detections into tracks "
+        "(used when `sensors` has an object sensor model).",
     )
     mission: MissionSettings = Field(
         default_factory=MissionSettings,

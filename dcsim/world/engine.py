@@ -46,6 +46,7 @@ from dcsim.messages import (
     RobotSpec,
     RobotState,
 )
+from dcsim.registry.discovery import PluginRegistry
 from dcsim.scenario.model import ManipulatorSection, RobotSection, Scenario
 from dcsim.world.actuators import Actuators, ThrustProfile
 from dcsim.world.bodies import ObjectBodies, surface_gap
@@ -63,7 +64,7 @@ from dcsim.world.orbit.forces import ExactOrbitalForces
 from dcsim.world.payload import Payload
 from dcsim.world.pybullet_client import connect_direct, pb
 from dcsim.world.robot_body import RobotBody
-from dcsim.world.sensors import Sensors
+from dcsim.world.sensors import Sensing, build_sensor_models
 from dcsim.world.vector3 import turn
 
 _BROAD_PHASE_SLACK = 1e-3  # m added to the swept reach of each control period
@@ -154,7 +155,11 @@ class World:
     scenario : Scenario
         The validated scenario.
     rng : numpy.random.Generator
-        The world's generator (sensor noise).
+        The world's generator (beacon range noise; the other sensor models draw from
+        their own, :func:`~dcsim.world.sensors.build_sensor_models`).
+    registry : PluginRegistry, optional
+        Where the scenario's sensor models are found; discovered from the installed
+        packages if None.
 
     Attributes
     ----------
@@ -175,7 +180,12 @@ class World:
         The free flyer's reaction wheels; None for ideal (or thrusters') torque.
     """
 
-    def __init__(self, scenario: Scenario, rng: np.random.Generator) -> None:
+    def __init__(
+        self,
+        scenario: Scenario,
+        rng: np.random.Generator,
+        registry: PluginRegistry | None = None,
+    ) -> None:
         self.scenario = scenario
         self.physics_step = scenario.world.physics_step
         self.steps_per_control = round(scenario.world.control_period / self.physics_step)
@@ -193,7 +203,7 @@ class World:
         self._mean_motion = scenario.mean_motion if lvlh and orbit.model == "cw" else None
         dynamics = relative_dynamics(orbit) if lvlh and orbit.model != "cw" else None
         self.field = ObjectField(build_objects(scenario, dynamics))
-        self._sensors = Sensors(scenario.beacons, robot.sensor_range, self.field, rng)
+        self.sensing = Sensing(scenario, self.field, build_sensor_models(scenario, rng, registry))
         self._client = connect_direct()
         # A world dropped without close() (an FMU reset does that) still disconnects.
         self._disconnect = weakref.finalize(self, pb.disconnect, physicsClientId=self._client)
@@ -234,7 +244,7 @@ class World:
     @property
     def beacons(self) -> np.ndarray:
         """Beacon positions (B, 3), world frame, m."""
-        return self._sensors.beacons
+        return self.sensing.beacons
 
     @property
     def propellant(self) -> float:
@@ -725,21 +735,24 @@ class World:
         return started
 
     # ------------------------------------------------------------------ sensors
-    def beacon_ranges(self) -> list[BeaconRange]:
-        """Noisy ranges to the nearest beacons within range (the thesis's Beacon topic)."""
-        return self._sensors.beacon_ranges(self.base_state()[0])
+    def beacon_ranges(self) -> tuple[BeaconRange, ...]:
+        """The beacon range sensor's reading now (the thesis's Beacon topic)."""
+        position, velocity, attitude, angular_velocity = self.base_state()
+        truth = self.sensing.truth(self.time, position, velocity, attitude, angular_velocity)
+        return self.sensing.beacon_ranges(truth)
 
     def object_tracks(self) -> list[ObjectTrack]:
-        """Tracks of the free objects within sensor range (the thesis's Objects topic)."""
-        return self._sensors.object_tracks(self.time, self.base_state()[0])
+        """Exact tracks of the free objects within sensor range (the thesis's Objects
+        topic), whatever the sensors: what ideal object sensing reports."""
+        return self.sensing.object_tracks(self.time, self.base_state()[0])
 
     def observations(self) -> Observations:
-        """Every sensor's reading now: beacon ranges, object tracks, attitude and rate.
-
-        The star tracker and the gyros are noise-free.
-        """
-        position, _, attitude, angular_velocity = self.base_state()
-        observed = self._sensors.observations(self.time, position, attitude, angular_velocity)
+        """Every sensor's reading now (:class:`~dcsim.world.sensors.Sensing`): beacon
+        ranges, object tracks or detections, attitude and rate, joint encoders."""
+        position, velocity, attitude, angular_velocity = self.base_state()
+        observed = self.sensing.observations(
+            self.time, position, velocity, attitude, angular_velocity
+        )
         if not self._robot.n_joints:
             return observed
         angles, rates = self._robot.joint_state()  # noise-free encoders
