@@ -1,0 +1,186 @@
+"""``object-sensor``: a lidar or camera that measures range and bearing to the objects.
+
+The sensor sees the free objects (not held, not delivered) whose centre lies within
+``robot.sensor_range`` of the robot and inside its field of view, a cone of full angle
+``field_of_view`` about the body axis ``boresight`` (360° sees all round). It detects
+each with probability ``detection_probability`` and recognises it: a detection carries
+the object's catalogue id, kind and mass, its bounding radius and, when the sensor
+``sees_shapes``, its true shape.
+
+It measures the object's centre relative to the robot's base, ``p = c − x``, in the
+body frame, as a range and two bearing angles in the spherical coordinates of
+:mod:`dcsim.geometry` (polar angle θ from body +z, azimuth φ from body +x towards +y):
+
+    r_m = r + σ_r N_r,   θ_m = θ + σ_b N_θ,   φ_m = φ + σ_b N_φ,
+
+with ``σ_r`` the ``range_noise`` and ``σ_b`` the ``bearing_noise``, and independent
+standard normal draws. The measured point ``p_b = r_m [sin θ_m cos φ_m,
+sin θ_m sin φ_m, cos θ_m]`` is turned into the world's axes by the robot's true
+attitude ``R``: the star tracker's error (arcseconds) is far below the bearing noise
+(tenths of a degree), so the sensor's pointing is taken as known. Its covariance is the
+first-order one at the measured point,
+
+    P = R J diag(σ_r², σ_b², σ_b²) Jᵀ Rᵀ,   J = ∂p_b/∂(r, θ, φ) at (r_m, θ_m, φ_m),
+
+so the cross-range spread is ``σ_b r`` along θ and ``σ_b r sin θ`` along φ (an
+azimuth's error moves a point near the body z axis little).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from pydantic import field_validator
+
+from dcsim.api import (
+    Detection,
+    PluginParams,
+    SensedTruth,
+    SensorModel,
+    SensorSetup,
+    hookimpl,
+    quantity,
+)
+from dcsim.geometry import rotate, row_lengths
+from dcsim.world.sensors.sampling import SampleClock, rate_field
+
+_NONE: tuple[Detection, ...] = ()
+
+
+class ObjectSensorParams(PluginParams):
+    """Parameters of :class:`ObjectSensor`."""
+
+    range_noise: float = quantity(0.05, unit="m", ge=0, description="1σ of the range noise.")
+    bearing_noise: float = quantity(
+        0.2, unit="deg", ge=0, description="1σ of the noise of each bearing angle."
+    )
+    detection_probability: float = quantity(
+        0.95, ge=0, le=1, description="Probability that a visible object is detected."
+    )
+    rate: float | None = rate_field(10.0)
+    field_of_view: float = quantity(
+        360.0,
+        unit="deg",
+        gt=0,
+        le=360,
+        description="Full angle of the cone about the boresight in which objects are "
+        "seen; 360 sees all round.",
+    )
+    boresight: tuple[float, float, float] = quantity(
+        (1.0, 0.0, 0.0), description="Axis of the field of view, body frame (any length)."
+    )
+    sees_shapes: bool = quantity(
+        False, description="Whether a detection carries the object's true shape."
+    )
+
+    @field_validator("boresight")
+    @classmethod
+    def _pointing(cls, value: tuple[float, float, float]) -> tuple[float, float, float]:
+        """The boresight must have a direction."""
+        if math.hypot(*value) == 0.0:
+            raise ValueError("the boresight must not be zero: give a body axis like [1, 0, 0]")
+        return value
+
+
+class ObjectSensor(SensorModel):
+    """Range and bearings to the objects in view, with their first-order covariance."""
+
+    name = "object-sensor"
+    summary = "Range and bearing detections of the objects in view (lidar, camera)"
+    measures = "objects"
+    Params = ObjectSensorParams
+    params: ObjectSensorParams
+
+    def reset(self, setup: SensorSetup) -> None:
+        """Learn the catalogue of objects and the sensor's reach; start the clock."""
+        params = self.params
+        self._clock = SampleClock(params.rate)
+        self._reach = setup.object_range
+        self._objects = setup.objects
+        self._radii = [o.shape.bounding_radius for o in setup.objects]
+        self._boresight = np.array(params.boresight, dtype=float) / math.hypot(*params.boresight)
+        half = math.radians(params.field_of_view) / 2.0
+        self._cos_half = None if params.field_of_view >= 360.0 else math.cos(half)
+        self._sigmas = np.array(
+            [
+                params.range_noise,
+                math.radians(params.bearing_noise),
+                math.radians(params.bearing_noise),
+            ]
+        )
+
+    def measure(self, truth: SensedTruth) -> tuple[Detection, ...]:
+        """The detections now, in the order of the setup's objects; none between
+        readings."""
+        if len(truth.object_positions) == 0 or not self._clock.due(truth.time):
+            return _NONE
+        world_to_body = rotate(truth.attitude, np.eye(3))  # rows: body axes in world
+        relative = truth.object_positions - truth.position
+        body = relative @ world_to_body.T
+        seen = self._detected(body, row_lengths(relative), truth.free)
+        if len(seen) == 0:
+            return _NONE
+        positions, covariances = self._measured(body[seen], world_to_body)
+        see_shapes = self.params.sees_shapes
+        objects, radii = self._objects, self._radii
+        return tuple(
+            Detection.trusted(
+                time=truth.time,
+                id=obj.id,
+                kind=obj.kind,
+                relative_position=positions[j],
+                covariance=covariances[j],
+                radius=radii[i],
+                mass=obj.mass,
+                shape=obj.shape if see_shapes else None,
+            )
+            for j, i in enumerate(seen.tolist())
+            for obj in (objects[i],)
+        )
+
+    def _detected(self, body: np.ndarray, distances: np.ndarray, free: np.ndarray) -> np.ndarray:
+        """Indices of the objects detected now: free, in reach, in view and not missed.
+
+        ``body`` (N, 3) holds their positions relative to the robot in the body frame
+        (m), ``distances`` (N,) their lengths (m).
+        """
+        visible = free & (distances <= self._reach)
+        if self._cos_half is not None:
+            visible &= body @ self._boresight >= self._cos_half * distances
+        seen = np.flatnonzero(visible)
+        probability = self.params.detection_probability
+        if probability < 1.0:
+            seen = seen[self.rng.random(len(seen)) < probability]
+        return seen
+
+    def _measured(
+        self, body: np.ndarray, world_to_body: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Measured relative positions (K, 3) along the world axes (m) of the objects at
+        body-frame positions ``body`` (K, 3), and their covariances (K, 3, 3) (m²);
+        both read-only."""
+        x, y, z = body.T
+        spherical = np.column_stack(
+            [row_lengths(body), np.arctan2(np.hypot(x, y), z), np.arctan2(y, x)]
+        )
+        r, theta, phi = (spherical + self.rng.standard_normal(body.shape) * self._sigmas).T
+        sin_t, cos_t, sin_p, cos_p = np.sin(theta), np.cos(theta), np.sin(phi), np.cos(phi)
+        along = np.column_stack([sin_t * cos_p, sin_t * sin_p, cos_t])
+        across_theta = r[:, None] * np.column_stack([cos_t * cos_p, cos_t * sin_p, -sin_t])
+        across_phi = (r * sin_t)[:, None] * np.column_stack([-sin_p, cos_p, np.zeros_like(r)])
+        # Columns of J diag(σ) in the body frame, then along the world axes.
+        scaled = np.stack([along, across_theta, across_phi], axis=2) * self._sigmas
+        world = np.einsum("ji,kjl->kil", world_to_body, scaled)
+        covariances = world @ world.transpose(0, 2, 1)
+        covariances = 0.5 * (covariances + covariances.transpose(0, 2, 1))
+        positions = (r[:, None] * along) @ world_to_body
+        positions.setflags(write=False)
+        covariances.setflags(write=False)
+        return positions, covariances
+
+
+@hookimpl
+def dcsim_plugin_classes() -> list[type]:
+    """Register the object sensor model."""
+    return [ObjectSensor]
