@@ -42,7 +42,7 @@ from dcsim.api import (
     hookimpl,
     quantity,
 )
-from dcsim.geometry import rotate, row_lengths
+from dcsim.geometry import row_lengths
 from dcsim.world.sensors.sampling import SampleClock, rate_field
 
 _NONE: tuple[Detection, ...] = ()
@@ -97,8 +97,10 @@ class ObjectSensor(SensorModel):
         params = self.params
         self._clock = SampleClock(params.rate)
         self._reach = setup.object_range
-        self._objects = setup.objects
-        self._radii = [o.shape.bounding_radius for o in setup.objects]
+        self._catalogue = [
+            (o.id, o.kind, o.shape.bounding_radius, o.mass, o.shape if params.sees_shapes else None)
+            for o in setup.objects
+        ]
         self._boresight = np.array(params.boresight, dtype=float) / math.hypot(*params.boresight)
         half = math.radians(params.field_of_view) / 2.0
         self._cos_half = None if params.field_of_view >= 360.0 else math.cos(half)
@@ -115,28 +117,28 @@ class ObjectSensor(SensorModel):
         readings."""
         if len(truth.object_positions) == 0 or not self._clock.due(truth.time):
             return _NONE
-        world_to_body = rotate(truth.attitude, np.eye(3))  # rows: body axes in world
+        world_to_body = _body_axes(truth.attitude)
         relative = truth.object_positions - truth.position
         body = relative @ world_to_body.T
         seen = self._detected(body, row_lengths(relative), truth.free)
         if len(seen) == 0:
             return _NONE
         positions, covariances = self._measured(body[seen], world_to_body)
-        see_shapes = self.params.sees_shapes
-        objects, radii = self._objects, self._radii
+        catalogue, time = self._catalogue, truth.time
         return tuple(
             Detection.trusted(
-                time=truth.time,
-                id=obj.id,
-                kind=obj.kind,
-                relative_position=positions[j],
-                covariance=covariances[j],
-                radius=radii[i],
-                mass=obj.mass,
-                shape=obj.shape if see_shapes else None,
+                time=time,
+                id=id_,
+                kind=kind,
+                relative_position=position,
+                covariance=covariance,
+                radius=radius,
+                mass=mass,
+                shape=shape,
             )
-            for j, i in enumerate(seen.tolist())
-            for obj in (objects[i],)
+            for (id_, kind, radius, mass, shape), position, covariance in zip(
+                (catalogue[i] for i in seen.tolist()), positions, covariances, strict=True
+            )
         )
 
     def _detected(self, body: np.ndarray, distances: np.ndarray, free: np.ndarray) -> np.ndarray:
@@ -161,23 +163,43 @@ class ObjectSensor(SensorModel):
         body-frame positions ``body`` (K, 3), and their covariances (K, 3, 3) (m²);
         both read-only."""
         x, y, z = body.T
-        spherical = np.column_stack(
-            [row_lengths(body), np.arctan2(np.hypot(x, y), z), np.arctan2(y, x)]
-        )
-        r, theta, phi = (spherical + self.rng.standard_normal(body.shape) * self._sigmas).T
+        noise = self.rng.standard_normal(body.shape) * self._sigmas
+        r = row_lengths(body) + noise[:, 0]
+        theta = np.arctan2(np.hypot(x, y), z) + noise[:, 1]
+        phi = np.arctan2(y, x) + noise[:, 2]
         sin_t, cos_t, sin_p, cos_p = np.sin(theta), np.cos(theta), np.sin(phi), np.cos(phi)
-        along = np.column_stack([sin_t * cos_p, sin_t * sin_p, cos_t])
-        across_theta = r[:, None] * np.column_stack([cos_t * cos_p, cos_t * sin_p, -sin_t])
-        across_phi = (r * sin_t)[:, None] * np.column_stack([-sin_p, cos_p, np.zeros_like(r)])
-        # Columns of J diag(σ) in the body frame, then along the world axes.
-        scaled = np.stack([along, across_theta, across_phi], axis=2) * self._sigmas
-        world = np.einsum("ji,kjl->kil", world_to_body, scaled)
-        covariances = world @ world.transpose(0, 2, 1)
-        covariances = 0.5 * (covariances + covariances.transpose(0, 2, 1))
-        positions = (r[:, None] * along) @ world_to_body
+        # The unit vectors along r, θ and φ at the measured point, body frame.
+        axes = np.empty((3, len(r), 3))
+        axes[0, :, 0], axes[0, :, 1], axes[0, :, 2] = sin_t * cos_p, sin_t * sin_p, cos_t
+        axes[1, :, 0], axes[1, :, 1], axes[1, :, 2] = cos_t * cos_p, cos_t * sin_p, -sin_t
+        axes[2, :, 0], axes[2, :, 1], axes[2, :, 2] = -sin_p, cos_p, 0.0
+        along, across_theta, across_phi = axes @ world_to_body  # along the world axes
+        # The columns of J diag(σ_r, σ_b, σ_b); P is the sum of their outer products.
+        spread = self._sigmas[1] * r
+        columns = (
+            along * self._sigmas[0],
+            across_theta * spread[:, None],
+            across_phi * (spread * sin_t)[:, None],
+        )
+        covariances = sum(c[:, :, None] * c[:, None, :] for c in columns)
+        positions = r[:, None] * along
         positions.setflags(write=False)
         covariances.setflags(write=False)
         return positions, covariances
+
+
+def _body_axes(q: np.ndarray) -> np.ndarray:
+    """The body axes along the world's, one per row, of a body with attitude ``q``
+    ``[x, y, z, w]`` (a unit quaternion): the transpose of its rotation matrix, which
+    turns world vectors into the body frame."""
+    x, y, z, w = q.tolist()
+    return np.array(
+        [
+            [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y + z * w), 2.0 * (x * z - y * w)],
+            [2.0 * (x * y - z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z + x * w)],
+            [2.0 * (x * z + y * w), 2.0 * (y * z - x * w), 1.0 - 2.0 * (x * x + y * y)],
+        ]
+    )
 
 
 @hookimpl
