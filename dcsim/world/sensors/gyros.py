@@ -1,8 +1,8 @@
 """``gyros``: the base's angular velocity with angle random walk and a drifting bias.
 
 Farrenkopf's gyro model in its discrete form (Crassidis & Junkins, *Optimal Estimation
-of Dynamic Systems*, 2nd ed., §7.2.1): over a sampling interval ``Δt`` (s) each axis
-reads
+of Dynamic Systems*, 2nd ed., 2011, the gyro model of its attitude estimation): over a
+sampling interval ``Δt`` (s) each axis reads
 
     ω_meas = ω_true + ½(β_k+1 + β_k) + √(σ_v²/Δt + σ_u²Δt/12) · N_v,
     β_k+1  = β_k + σ_u √Δt · N_u,
