@@ -10,8 +10,9 @@ and measures, on that same world:
 
 Both are reported as wall time per simulated second, and the closed loop is split by
 phase of the run loop (the runner's lap timer): the world's control-period step
-(physics included), sensors, localiser, mission (planners included), controller and
-recording.
+(physics included), sensors, localiser, tracker (under an object sensor model), mission
+(planners included), controller and recording. ``--sensors realistic`` flies every world
+with the realistic sensing profile (sensor errors, detections tracked by the tracker).
 
 Then the default scenario is flown, and the floor under its real-time factor measured:
 what any run of it pays whatever the framework does around it, for the span it flew
@@ -46,7 +47,7 @@ _TARGETS = ([15.0, 30.0, 5.0], [-10.0, 45.0, -5.0], [20.0, -35.0, 0.0], [-15.0, 
 _BEACONS = [[100, 100, 100], [100, -100, -100], [-100, 100, -100], [-100, -100, 100]]
 
 
-PHASES = ("world", "sensors", "localiser", "mission", "controller", "recording")
+PHASES = ("world", "sensors", "localiser", "tracker", "mission", "controller", "recording")
 """Phases of the run loop the closed-loop time is split into (see ``LapTimer``)."""
 
 
@@ -78,10 +79,15 @@ class WorldBenchRow:
 
 
 def field_scenario(
-    objects: int, duration: float, seed: int = 0, orbit_model: str = "cw"
+    objects: int,
+    duration: float,
+    seed: int = 0,
+    orbit_model: str = "cw",
+    sensing: str = "ideal",
 ) -> Scenario:
     """The synthetic benchmark scenario with ``objects`` targets and obstacles in all,
-    in a world of orbit model ``orbit_model`` (``cw``, ``two-body`` or ``j2``)."""
+    in a world of orbit model ``orbit_model`` (``cw``, ``two-body`` or ``j2``), sensed
+    with the profile ``sensing`` (``ideal`` or ``realistic``)."""
     rng = np.random.default_rng(seed)
     n = mean_motion(ORBIT_RADIUS)
 
@@ -116,6 +122,7 @@ def field_scenario(
                 "stop_on_all_delivered": False,
             },
             "stop": {"on_collision": False},
+            "sensors": {"profile": sensing},
         }
     )
 
@@ -144,14 +151,16 @@ def bench_world(
     duration: float,
     progress: Callable[[str], None] = print,
     orbit_model: str = "cw",
+    sensing: str = "ideal",
 ) -> list[WorldBenchRow]:
-    """Measure every field size in worlds of ``orbit_model``; ``progress`` receives a
-    line per finished size."""
+    """Measure every field size in worlds of ``orbit_model`` sensed with the profile
+    ``sensing``; ``progress`` receives a line per finished size."""
     registry = PluginRegistry.discover()
-    closed_loop(field_scenario(4, 5.0, orbit_model=orbit_model), registry)  # warm up
+    warm_up = field_scenario(4, 5.0, orbit_model=orbit_model, sensing=sensing)
+    closed_loop(warm_up, registry)
     rows = []
     for objects in sizes:
-        scenario = field_scenario(objects, duration, orbit_model=orbit_model)
+        scenario = field_scenario(objects, duration, orbit_model=orbit_model, sensing=sensing)
         bare = bare_stepping(scenario)
         loop, phases = closed_loop(scenario, registry)
         rows.append(WorldBenchRow(objects, bare, loop, phases))

@@ -40,7 +40,15 @@ from dcsim.run.setup import setup_run
     show_default=True,
     help="world.orbit.model of the synthetic scenarios and the default scenario's run.",
 )
-def bench_world_command(objects: str, duration: float, orbit_model: str) -> None:
+@click.option(
+    "--sensors",
+    "sensing",
+    type=click.Choice(["ideal", "realistic"]),
+    default="ideal",
+    show_default=True,
+    help="sensors.profile of the synthetic scenarios and the default scenario's run.",
+)
+def bench_world_command(objects: str, duration: float, orbit_model: str, sensing: str) -> None:
     """Closed-loop wall time per simulated second against PyBullet stepping alone.
 
     For each field size, one synthetic LVLH scenario is stepped bare (stepSimulation
@@ -48,7 +56,7 @@ def bench_world_command(objects: str, duration: float, orbit_model: str) -> None
     loop. Then the default scenario is flown once for its real-time factor. Prints a
     Markdown table for docs/benchmarks.md, and the floor under the default scenario's
     real-time factor: stepping, the per-step force calls and the localiser plugin alone.
-    Every world moves by ORBIT_MODEL's dynamics.
+    Every world moves by ORBIT_MODEL's dynamics and is sensed with the SENSING profile.
     """
     from dcsim.bench.world import bench_world, floor_line, loop_floor, markdown_table
     from dcsim.run.loop import Runner
@@ -60,10 +68,14 @@ def bench_world_command(objects: str, duration: float, orbit_model: str) -> None
         )
     sizes = [int(word) for word in words]
     overrides = [] if orbit_model == "cw" else [f"world.orbit.model={orbit_model}"]
+    if sensing != "ideal":
+        overrides.append(f"sensors.profile={sensing}")
     registry = plugin_registry()
     with warnings.catch_warnings():  # the planners model cw only: expected in other worlds
         warnings.simplefilter("ignore", PlannerModelWarning)
-        rows = bench_world(sizes, duration, progress=progress, orbit_model=orbit_model)
+        rows = bench_world(
+            sizes, duration, progress=progress, orbit_model=orbit_model, sensing=sensing
+        )
         click.echo(markdown_table(rows))
         summary = Runner(setup_run(overrides=overrides, registry=registry)).run()
     click.echo(
