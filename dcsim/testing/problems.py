@@ -436,7 +436,9 @@ SENSING_PERIOD = 0.1
 
 SENSED_OBJECTS = (
     KnownObject(3, ObjectKind.TARGET, 5.0, Shape(ShapeKind.SPHERE, radius=0.3)),
-    KnownObject(8, ObjectKind.OBSTACLE, 80.0, Shape(ShapeKind.BOX, half_extents=(1.0, 0.5, 0.4))),
+    KnownObject(
+        8, ObjectKind.OBSTACLE, 80.0, Shape(ShapeKind.BOX, half_extents=np.array([1.0, 0.5, 0.4]))
+    ),
     KnownObject(11, ObjectKind.OBSTACLE, 40.0, Shape(ShapeKind.CYLINDER, radius=0.4, height=2.0)),
     KnownObject(20, ObjectKind.TARGET, 8.0, Shape(ShapeKind.SPHERE, radius=0.5)),
     KnownObject(42, ObjectKind.OBSTACLE, 60.0, Shape(ShapeKind.SPHERE, radius=1.0)),
