@@ -14,13 +14,16 @@ from dcsim.api import (
     FrameKind,
     LinearMotion,
     ObjectKind,
+    PluginRegistry,
     Shape,
     ShapeKind,
     StateEstimate,
     mean_motion,
+    run,
 )
 from dcsim.motion import MotionSet
 from dcsim.testing import TrackerContract
+from tests.conftest import make_distribution
 
 N_400_KM = mean_motion(6_778_137.0)
 """Mean motion of a 400 km circular orbit, rad/s."""
@@ -265,3 +268,52 @@ def test_a_track_unseen_for_longer_than_lose_after_is_dropped_and_starts_again()
     assert ids[14.0] == [0, 2]  # 4.5 s unseen: dropped
     (_, restarted, _) = plugin.update(20.0, *sky.detections(20.0))
     np.testing.assert_array_equal(restarted.velocity, np.zeros(3))  # a new track
+
+
+NOISY_OBJECT_SENSOR = """
+    import numpy as np
+    from dcsim.api import Detection, PluginParams, SensorModel, hookimpl
+
+    class NoisyObjects(SensorModel):
+        name = "noisy-objects"
+        summary = "Free objects in range with 5 cm of white noise"
+        measures = "objects"
+        Params = PluginParams
+
+        def reset(self, setup):
+            self.setup = setup
+
+        def measure(self, truth):
+            offsets = truth.object_positions - truth.position
+            return tuple(
+                Detection(
+                    time=truth.time, id=obj.id, kind=obj.kind,
+                    relative_position=offset + self.rng.normal(0.0, 0.05, 3),
+                    covariance=np.eye(3) * 0.05**2, radius=obj.shape.bounding_radius,
+                    mass=obj.mass,
+                )
+                for obj, offset, free in zip(self.setup.objects, offsets, truth.free)
+                if free and np.linalg.norm(offset) <= self.setup.object_range
+            )
+
+    @hookimpl
+    def dcsim_plugin_classes():
+        return [NoisyObjects]
+"""
+
+
+def test_a_run_with_an_object_sensor_model_flies_the_kalman_tracker(tmp_path, monkeypatch):
+    site = make_distribution(
+        tmp_path / "site",
+        "noisy-objects",
+        "0.1",
+        {"noisy_objects": NOISY_OBJECT_SENSOR},
+        {"noisy-objects": "noisy_objects"},
+        group="dcsim.sensors",
+    )
+    monkeypatch.syspath_prepend(str(site))
+    overrides = {"world.duration": 10.0, "sensors.objects": {"model": "noisy-objects"}}
+    result = run(None, overrides, tmp_path / "run", plots=False, registry=PluginRegistry.discover())
+    assert result.summary["status"] == "completed", result.summary["reason"]
+    assert result.summary["plugins"]["tracker"]["name"] == "kalman"
+    assert result.summary["wall_time_by_phase_s"]["tracker"] > 0.0
