@@ -1,12 +1,16 @@
-"""A third-party sensor model, written by ``dcsim new-plugin sensor`` and installed by pip
-as a distribution of its own, is flown in a run: its readings reach the observations."""
+"""Third-party sensor models and trackers, written by ``dcsim new-plugin`` and installed by
+pip as distributions of their own: they register in their kinds' groups, pass their
+conformance suites as written, and a sensor model is flown in a run, its readings
+reaching the observations."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from dcsim.api import (
     PluginRegistry,
@@ -17,6 +21,7 @@ from dcsim.api import (
     rotation_vector,
 )
 from dcsim.registry.scaffold import new_plugin
+from dcsim.testing import checks_for
 
 NOISE = 60.0
 """The star tracker's noise in the run, arcsec (1 sigma per axis)."""
@@ -41,6 +46,35 @@ def install(root, site) -> None:
         timeout=300,
     )
     assert done.returncode == 0, done.stderr
+
+
+@pytest.mark.parametrize("kind", ["sensor", "tracker"])
+def test_a_scaffolded_package_installs_registers_and_passes_its_tests_as_written(kind, tmp_path):
+    name = f"own-{kind}"
+    root = new_plugin(kind, name, tmp_path)
+    site = tmp_path / "site"
+    install(root, site)
+    environment = {**os.environ, "PYTHONPATH": str(site)}
+    listed = subprocess.run(
+        [sys.executable, "-m", "dcsim", "plugins", "--json", "--kind", kind],
+        capture_output=True,
+        text=True,
+        env=environment,
+        timeout=120,
+    )
+    assert listed.returncode == 0, listed.stderr
+    assert f'"distribution": "dcsim-{name}"' in listed.stdout
+    # the package's own tests, as written, against the installed package
+    tested = subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(root / "tests")],
+        capture_output=True,
+        text=True,
+        env=environment,
+        cwd=tmp_path,
+        timeout=300,
+    )
+    assert tested.returncode == 0, tested.stdout
+    assert f"{len(checks_for(kind))} passed" in tested.stdout
 
 
 def turn_between(a: np.ndarray, b: np.ndarray) -> float:
