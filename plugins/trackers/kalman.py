@@ -184,9 +184,9 @@ class KalmanTracker(Tracker):
         a[:3, 3:] = np.eye(3)
         a[3, 0], a[5, 2] = 3.0 * n**2, -(n**2)
         a[3, 4], a[4, 3] = 2.0 * n, -2.0 * n
-        blocks = np.zeros((12, 12))
+        blocks = np.zeros((12, 12))  # [[-A, G q Gᵀ], [0, Aᵀ]], G the velocity rows
         blocks[:6, :6] = -a
-        blocks[9:, 9:] = self.params.acceleration_noise**2 * np.eye(3)
+        blocks[3:6, 9:12] = self.params.acceleration_noise**2 * np.eye(3)
         blocks[6:, 6:] = a.T
         exponential = expm(blocks * dt)
         phi = exponential[6:, 6:].T

@@ -147,6 +147,68 @@ def test_the_covariance_is_not_wildly_conservative_either():
     assert 2.0 < np.mean(nees) < 4.0, np.mean(nees)
 
 
+def white_acceleration_noise(dt: float, density: float) -> np.ndarray:
+    """The exact covariance (6, 6) a white acceleration of spectral density ``density``
+    (m²/s³ per axis) adds to ``[position, velocity]`` over ``dt`` (s) in straight-line motion."""
+    block = np.array([[dt**3 / 3.0, dt**2 / 2.0], [dt**2 / 2.0, dt]])
+    return np.kron(block, np.eye(3)) * density
+
+
+def test_the_prediction_adds_the_white_acceleration_noise():
+    plugin = tracker(INERTIAL_FRAME, acceleration_noise=0.02, initial_velocity_sigma=0.3)
+    robot = StateEstimate(
+        time=0.0, position=np.zeros(3), covariance=np.zeros((6, 6)), converged=True
+    )
+    seen = Detection(
+        time=0.0,
+        id=4,
+        kind=ObjectKind.TARGET,
+        relative_position=[1.0, 2.0, 3.0],
+        covariance=np.eye(3) * 0.01,
+    )
+    (start,) = plugin.update(0.0, [seen], robot)
+    (later,) = plugin.update(2.5, [], robot)
+    transition = np.eye(6) + np.kron([[0.0, 2.5], [0.0, 0.0]], np.eye(3))
+    expected = transition @ start.covariance @ transition.T + white_acceleration_noise(2.5, 0.02**2)
+    np.testing.assert_allclose(later.covariance, expected, rtol=1e-9, atol=1e-15)
+
+
+def test_objects_driven_by_white_acceleration_are_followed_within_three_sigma():
+    rng, dt, density, count = np.random.default_rng(11), 0.5, 0.01**2, 40
+    plugin = tracker(INERTIAL_FRAME, acceleration_noise=0.01)
+    transition = np.eye(6) + np.kron([[0.0, dt], [0.0, 0.0]], np.eye(3))
+    kick = np.linalg.cholesky(white_acceleration_noise(dt, density))
+    states = np.hstack([rng.normal(0.0, 30.0, (count, 3)), rng.normal(0.0, 0.03, (count, 3))])
+    robot = StateEstimate(
+        time=0.0, position=np.zeros(3), covariance=np.zeros((6, 6)), converged=True
+    )
+    covariance = np.eye(3) * 0.05**2
+    inside = []
+    for k in range(600):
+        t = k * dt
+        if k:
+            states = states @ transition.T + rng.normal(size=(count, 6)) @ kick.T
+        detections = [
+            Detection(
+                time=t,
+                id=i,
+                kind=ObjectKind.OBSTACLE,
+                covariance=covariance,
+                relative_position=states[i, :3] + rng.normal(0.0, 0.05, 3),
+            )
+            for i in range(count)
+        ]
+        tracks = plugin.update(t, detections, robot)
+        if t >= 20.0:
+            errors = np.array([track.position for track in tracks]) - states[:, :3]
+            spreads = np.array([track.covariance[:3, :3] for track in tracks])
+            distances = np.einsum(
+                "ni,ni->n", errors, np.linalg.solve(spreads, errors[..., None])[..., 0]
+            )
+            inside.extend(distances <= THREE_SIGMA)
+    assert np.mean(inside) >= 0.99, np.mean(inside)
+
+
 def test_a_tick_without_detections_predicts_every_track_by_the_frame_s_motion():
     # Little process noise, so that 300 s of coasting tell the orbit's motion (metres off
     # a straight line at these distances) from anything else.
