@@ -28,6 +28,8 @@ KINDS = (*PLUGIN_KINDS, MISSION)
 
 _NAME = re.compile(r"^[a-z][a-z0-9_-]*$")
 _SUMMARIES = {
+    "sensor": "A star tracker with white noise",
+    "tracker": "Constant-velocity Kalman filter per object, by identity",
     "localiser": "Gauss-Newton multilateration on beacon ranges",
     "task_planner": "Targets in order of distance, drop visits when full",
     "path_planner": "Straight segment, trapezoidal speed, obstacle-checked",
@@ -35,6 +37,8 @@ _SUMMARIES = {
     MISSION: "Fly to a point and hold it there",
 }
 _SUFFIXES = {
+    "sensor": "Sensor",
+    "tracker": "Tracker",
     "localiser": "Localiser",
     "task_planner": "TaskPlanner",
     "path_planner": "PathPlanner",
@@ -42,6 +46,8 @@ _SUFFIXES = {
     MISSION: "Mission",
 }
 _CONTRACTS = {
+    "sensor": "SensorModelContract",
+    "tracker": "TrackerContract",
     "localiser": "LocaliserContract",
     "task_planner": "TaskPlannerContract",
     "path_planner": "PathPlannerContract",
@@ -106,6 +112,7 @@ def new_plugin(
         "summary": _SUMMARIES[kind],
         "dcsim_version": __version__,
         "entry_point": _entry_point(kind, name, module, class_name),
+        "usage": _usage(kind, name),
     }
     root = directory / values["distribution"]
     if root.exists():
@@ -142,6 +149,15 @@ def _entry_point(kind: str, name: str, module: str, class_name: str) -> str:
     if kind == MISSION:
         return f'[project.entry-points."dcsim.missions"]\n{name} = "{module}:{class_name}"'
     return f'[project.entry-points."{kind_group(kind)}"]\n{name} = "{module}"'
+
+
+def _usage(kind: str, name: str) -> str:
+    """The scenario lines that fly the plugin: a sensor model is given to its sensor
+    under ``sensors:`` (the template's is a star tracker), any other plugin fills its
+    kind's role."""
+    if kind == "sensor":
+        return f"sensors:\n  star_tracker:\n    model: {name}\n    params: {{}}"
+    return f"{kind}:\n  plugin: {name}\n  params: {{}}"
 
 
 def _files(kind: str, module: str) -> dict[str, str]:

@@ -1,4 +1,5 @@
-"""The plugin conformance suite: is a localiser, planner or controller a good citizen?
+"""The plugin conformance suite: is a sensor model, tracker, localiser, planner or
+controller a good citizen?
 
 Three ways to use it:
 
@@ -127,6 +128,18 @@ def _test_method(check: Check):
     return test
 
 
+class SensorModelContract(_Contract):
+    """Subclass as ``Test...`` with ``plugin = YourSensorModel`` to run the sensor contract."""
+
+    kind = "sensor"
+
+
+class TrackerContract(_Contract):
+    """Subclass as ``Test...`` with ``plugin = YourTracker`` to run the tracker contract."""
+
+    kind = "tracker"
+
+
 class LocaliserContract(_Contract):
     """Subclass as ``Test...`` with ``plugin = YourLocaliser`` to run the localiser contract."""
 
@@ -158,7 +171,9 @@ __all__ = [
     "ControllerContract",
     "LocaliserContract",
     "PathPlannerContract",
+    "SensorModelContract",
     "TaskPlannerContract",
+    "TrackerContract",
     "check_plugin",
     "checks_for",
     "resolve_plugin",

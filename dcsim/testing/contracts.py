@@ -28,7 +28,14 @@ from dcsim.messages import (
 )
 from dcsim.registry.answers import ANSWERS, ActuatorCounts, output_problem
 from dcsim.registry.discovery import check_plugin_class
-from dcsim.registry.interfaces import PLUGIN_KINDS, Controller, Localiser, Plugin
+from dcsim.registry.interfaces import (
+    PLUGIN_KINDS,
+    Controller,
+    Localiser,
+    Plugin,
+    SensorModel,
+    Tracker,
+)
 from dcsim.testing import problems
 
 SEED = 1234
@@ -205,13 +212,35 @@ def _path_inputs(empty: bool, plugin_class: type[Plugin] | None) -> list:
     return [problem]
 
 
+def _feed_sensor(plugin: SensorModel, inputs: list) -> list:
+    setup, truths = inputs
+    plugin.reset(setup)
+    return [plugin.measure(truth) for truth in truths]
+
+
+def _tracker_inputs(empty: bool) -> list:
+    problem = problems.tracker_problem(empty=empty)
+    ticks = [(tick.time, tick.detections, tick.robot) for tick in problem.ticks]
+    return [problem.frame, problem.start_time, ticks]
+
+
+def _feed_tracker(plugin: Tracker, inputs: list) -> list:
+    frame, start, ticks = inputs
+    plugin.reset(frame, start)
+    return [plugin.update(*tick) for tick in ticks]
+
+
 _INPUTS: dict[str, Callable[[bool, Any], list]] = {
+    "sensor": lambda empty, _: [problems.sensor_setup(empty), problems.sensed_truths(empty=empty)],
+    "tracker": lambda empty, _: _tracker_inputs(empty),
     "localiser": lambda empty, _: _localiser_inputs(empty),
     "task_planner": lambda empty, _: [problems.task_request(targets=0 if empty else 6)],
     "path_planner": _path_inputs,
     "controller": _controller_inputs,
 }
 _FEEDS: dict[str, Callable[[Any, list], list]] = {
+    "sensor": _feed_sensor,
+    "tracker": _feed_tracker,
     "localiser": _feed_localiser,
     "task_planner": lambda plugin, inputs: [plugin.plan(request) for request in inputs],
     "path_planner": lambda plugin, inputs: [plugin.plan(problem) for problem in inputs],
@@ -281,19 +310,25 @@ def run_plugin(plugin_class: type[Plugin], inputs: list, what: str) -> list:
         outputs = feed(make(plugin_class), inputs)
     except Exception as error:  # a plugin's own failure: name it, with the problem posed
         raise ContractViolation(f"raised {type(error).__name__}: {error} on {what}") from error
+    measures = getattr(plugin_class, "measures", None)
     for index, output in enumerate(outputs):
-        checked_answer(plugin_class.kind, output, f"{what} (answer {index})")
+        checked_answer(plugin_class.kind, output, f"{what} (answer {index})", measures=measures)
     return outputs
 
 
 def checked_answer(
-    kind: str, output: Any, what: str, actuators: ActuatorCounts | None = None
+    kind: str,
+    output: Any,
+    what: str,
+    actuators: ActuatorCounts | None = None,
+    measures: str | None = None,
 ) -> Any:
     """``output`` when it is an answer a plugin of ``kind`` may give (the check a run makes
-    at the plugin boundary, :func:`dcsim.registry.answers.output_problem`); otherwise a
-    violation saying what was wrong on ``what`` and what was expected."""
+    at the plugin boundary, :func:`dcsim.registry.answers.output_problem`; ``measures``:
+    a sensor model's slot); otherwise a violation saying what was wrong on ``what`` and
+    what was expected."""
     answer = ANSWERS[kind]
-    problem = output_problem(kind, answer.method, output, actuators)
+    problem = output_problem(kind, answer.method, output, actuators, measures)
     if problem is not None:
         fail(f"{problem} on {what}; expected {answer.expected}")
     return output
@@ -406,10 +441,11 @@ def check_no_mutation(plugin_class: type[Plugin]) -> None:
         fail(f"an input was changed: it is now {given[i]!r}, it was given as {kept[i]!r}")
 
 
-def _check_output(kind: str, output: Any) -> str | None:
+def _check_output(kind: str, output: Any, measures: str | None = None) -> str | None:
     """Why an output is not of the documented type, shape and finiteness, or (for an
-    estimate) its covariance not symmetric (None if fine)."""
-    problem = output_problem(kind, ANSWERS[kind].method, output)
+    estimate) its covariance not symmetric (None if fine); ``measures``: a sensor
+    model's slot."""
+    problem = output_problem(kind, ANSWERS[kind].method, output, None, measures)
     if problem is not None:
         return problem
     if isinstance(output, StateEstimate):
@@ -429,7 +465,7 @@ def check_outputs(plugin_class: type[Plugin]) -> None:
         standard_inputs(plugin_class.kind, plugin_class=plugin_class),
         "the standard problem",
     ):
-        problem = _check_output(plugin_class.kind, output)
+        problem = _check_output(plugin_class.kind, output, getattr(plugin_class, "measures", None))
         if problem:
             fail(problem)
 
@@ -437,7 +473,9 @@ def check_outputs(plugin_class: type[Plugin]) -> None:
 @contract(
     "uses_only_the_public_api",
     "the plugin's module imports nothing of dcsim but dcsim.api, so it cannot reach ground "
-    "truth: it works from its inputs alone",
+    "truth: it works from its inputs alone (not asked of sensor models, which are part of "
+    "the world and are given the truth)",
+    kinds=tuple(kind for kind in PLUGIN_KINDS if kind != "sensor"),
 )
 def check_public_api(plugin_class: type[Plugin]) -> None:
     module = inspect.getmodule(plugin_class)
@@ -460,8 +498,9 @@ def check_public_api(plugin_class: type[Plugin]) -> None:
 
 @contract(
     "handles_empty_inputs",
-    "with no beacons in view, no targets or no obstacles the plugin returns its documented "
-    "empty answer (an unconverged estimate, an empty plan, a path, a command) instead of raising",
+    "with no beacons in view, no targets, no obstacles, no objects to sense or no detections "
+    "the plugin returns its documented empty answer (an unconverged estimate, an empty plan, "
+    "a path, a command, no reading, no tracks) instead of raising",
 )
 def check_empty_inputs(plugin_class: type[Plugin]) -> None:
     outputs = run_plugin(
@@ -470,7 +509,7 @@ def check_empty_inputs(plugin_class: type[Plugin]) -> None:
         "empty inputs",
     )
     for output in outputs:
-        problem = _check_output(plugin_class.kind, output)
+        problem = _check_output(plugin_class.kind, output, getattr(plugin_class, "measures", None))
         if problem:
             fail(f"on empty inputs {problem}")
     if plugin_class.kind == "task_planner" and (outputs[0].tasks or outputs[0].drop_visits):

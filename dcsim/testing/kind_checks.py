@@ -1,4 +1,5 @@
-"""Checks specific to each plugin kind (localiser, task planner, path planner, controller)."""
+"""Checks specific to each plugin kind (sensor model, tracker, localiser, task planner, path
+planner, controller)."""
 
 from __future__ import annotations
 
@@ -16,16 +17,23 @@ from dcsim.geometry import (
     rotation_vector,
 )
 from dcsim.messages import (
+    AttitudeReading,
+    BeaconRange,
+    Detection,
     NoPath,
+    ObjectTrack,
     PathProblem,
+    RateReading,
     Reference,
     RobotState,
+    SensedTruth,
+    SensorSetup,
     StateEstimate,
     Surroundings,
     Trajectory,
 )
 from dcsim.registry.answers import ActuatorCounts
-from dcsim.registry.interfaces import Controller, PathPlanner, Plugin, TaskPlanner
+from dcsim.registry.interfaces import SENSOR_SLOTS, Controller, PathPlanner, Plugin, TaskPlanner
 from dcsim.testing import problems
 from dcsim.testing.contracts import (
     LOCALISER_ERROR_BOUND,
@@ -50,6 +58,186 @@ _START_TEXT = "{:g} µm, {:g} ns and, when it gives attitudes, {:g} µrad".forma
 
 ACCELERATION_TOLERANCE = 0.01
 """Fraction by which the sampled acceleration may exceed ``max_acceleration``."""
+
+# --------------------------------------------------------------------- sensor model
+
+
+@contract(
+    "measures_a_sensor_slot",
+    f"`measures` names one of the robot's sensors ({', '.join(SENSOR_SLOTS)}), the slot "
+    "a scenario gives the model under `sensors:`",
+    kinds=("sensor",),
+)
+def check_sensor_slot(plugin_class: type[Plugin]) -> None:
+    measures = getattr(plugin_class, "measures", None)
+    if measures not in SENSOR_SLOTS:
+        fail(f"measures {measures!r}; a sensor model measures one of {', '.join(SENSOR_SLOTS)}")
+
+
+def _reading_times(
+    reading: BeaconRange | AttitudeReading | RateReading | tuple | None,
+) -> list[float]:
+    """The times a reading says it was made (beacon ranges carry none)."""
+    items = reading if isinstance(reading, tuple) else (reading,)
+    return [
+        item.time for item in items if isinstance(item, (AttitudeReading, RateReading, Detection))
+    ]
+
+
+def _unseen(reading: object, setup: SensorSetup, truth: SensedTruth) -> str | None:
+    """What a reading reports that its sensor cannot see, in words, or None: a beacon
+    that is not one of the setup's, an object that is not known, not free, or beyond the
+    object sensor's range."""
+    items = reading if isinstance(reading, tuple) else ()
+    known = {obj.id: index for index, obj in enumerate(setup.objects)}
+    for item in items:
+        if isinstance(item, BeaconRange) and not 0 <= item.beacon_id < len(setup.beacons):
+            return f"a range to beacon {item.beacon_id}; the setup has {len(setup.beacons)}"
+        if isinstance(item, Detection):
+            index = known.get(item.id)
+            if index is None:
+                return f"object {item.id}, which is not one of the setup's objects"
+            if not truth.free[index]:
+                return f"object {item.id}, which is not free (held or delivered)"
+            distance = float(np.linalg.norm(truth.object_positions[index] - truth.position))
+            if distance > setup.object_range:
+                return f"object {item.id} {distance:.1f} m away, beyond {setup.object_range:g} m"
+    return None
+
+
+@contract(
+    "reads_its_sensor",
+    "over 20 s of the standard sensing problem (10 Hz; five beacons; four objects within "
+    "the object sensor's 30 m, one of them held after 10 s, and one 55 m off) every "
+    "`measure` answer is what its slot says (`dcsim.api.SENSOR_SLOTS`), made no later "
+    "than the truth's time, and reports only what the sensor can see (the setup's "
+    "beacons; known, free objects within range); and the sensor gives at least one reading",
+    kinds=("sensor",),
+)
+def check_sensor_readings(plugin_class: type[Plugin]) -> None:
+    setup, truths = problems.sensor_setup(), problems.sensed_truths()
+    readings = run_plugin(plugin_class, [setup, truths], "the standard sensing problem")
+    for truth, reading in zip(truths, readings, strict=True):
+        late = [t for t in _reading_times(reading) if t > truth.time]
+        if late:
+            fail(f"at t = {truth.time:g} s it gave a reading made at {late[0]:g} s, in the future")
+        unseen = _unseen(reading, setup, truth)
+        if unseen is not None:
+            fail(f"at t = {truth.time:g} s it reported {unseen}")
+    if all(reading is None or reading == () for reading in readings):
+        fail(f"it gave no reading in {len(truths)} ticks ({truths[-1].time:g} s)")
+
+
+# --------------------------------------------------------------------- tracker
+
+TRACK_GATE = 14.16
+"""Squared Mahalanobis distance within which a 3-dof Gaussian error lies 99.73 % of the
+time (three standard deviations)."""
+
+TRACK_INSIDE = 0.95
+"""Fraction of a tracker's position errors after start-up that must lie within
+:data:`TRACK_GATE` of their covariance."""
+
+TRACK_START = 5.0
+"""Start-up time of the standard tracking problem not scored, s."""
+
+
+def _track(
+    plugin_class: type[Plugin],
+) -> tuple[list[tuple[ObjectTrack, ...]], problems.TrackerProblem]:
+    problem = problems.tracker_problem()
+    inputs = [
+        problem.frame,
+        problem.start_time,
+        [(tick.time, tick.detections, tick.robot) for tick in problem.ticks],
+    ]
+    return run_plugin(plugin_class, inputs, "the standard tracking problem"), problem
+
+
+def _covariance_problem(track: ObjectTrack) -> str | None:
+    """What is wrong with a track's covariance, or None."""
+    c = track.covariance
+    if c is None:
+        return "has no covariance"
+    scale = max(float(np.abs(c).max()), 1e-300)
+    if np.abs(c - c.T).max() > 1e-9 * scale:
+        return f"has a covariance that is not symmetric:\n{c}"
+    if np.linalg.eigvalsh(0.5 * (c + c.T)).min() < -1e-9 * scale:
+        return f"has a covariance with a negative eigenvalue:\n{c}"
+    return None
+
+
+@contract(
+    "keeps_the_detected_objects",
+    "on the standard tracking problem (five objects drifting in an orbit's LVLH frame, "
+    "detected at 10 Hz for 30 s, one of them for 15 s only), each answer holds one track "
+    "of every object detected at that tick, tracks of detected objects only, each with a "
+    "symmetric positive semi-definite 6×6 covariance and the tick's time",
+    kinds=("tracker",),
+)
+def check_detected_kept(plugin_class: type[Plugin]) -> None:
+    answers, problem = _track(plugin_class)
+    ever: set[int] = set()
+    for tick, tracks in zip(problem.ticks, answers, strict=True):
+        ever |= set(tick.truth)
+        ids = [track.id for track in tracks]
+        if len(ids) != len(set(ids)):
+            fail(f"at t = {tick.time:g} s it gave two tracks of one object: ids {ids}")
+        if set(tick.truth) - set(ids) or set(ids) - ever:
+            fail(
+                f"at t = {tick.time:g} s it gave tracks of {sorted(ids)} for detections of "
+                f"{sorted(tick.truth)} (objects detected so far: {sorted(ever)})"
+            )
+        for track in tracks:
+            problem_text = _covariance_problem(track)
+            if problem_text is not None:
+                fail(f"at t = {tick.time:g} s the track of object {track.id} {problem_text}")
+            if track.time != tick.time:
+                fail(
+                    f"at t = {tick.time:g} s the track of object {track.id} is for "
+                    f"t = {track.time:g} s"
+                )
+
+
+@contract(
+    "follows_within_its_covariance",
+    f"on the standard tracking problem (5 cm detection noise, 2 cm on the robot's "
+    f"position), after {TRACK_START:g} s at least {100 * TRACK_INSIDE:g} % of the detected "
+    "objects' tracks are within three standard deviations of the true position by their "
+    f"own position covariance (squared Mahalanobis distance ≤ {TRACK_GATE}, chi-square "
+    "with 3 degrees of freedom), and none is more than 0.5 m off",
+    kinds=("tracker",),
+)
+def check_tracks_follow(plugin_class: type[Plugin]) -> None:
+    answers, problem = _track(plugin_class)
+    inside, scored = 0, 0
+    for tick, tracks in zip(problem.ticks, answers, strict=True):
+        if tick.time < TRACK_START:
+            continue
+        for track in tracks:
+            truth = tick.truth.get(track.id)
+            if truth is None or track.covariance is None:
+                continue
+            error = track.position - truth
+            miss = float(np.linalg.norm(error))
+            if miss > 0.5:
+                fail(f"at t = {tick.time:g} s the track of object {track.id} is {miss:.3f} m off")
+            try:
+                distance = float(error @ np.linalg.solve(track.covariance[:3, :3], error))
+            except np.linalg.LinAlgError:
+                fail(
+                    f"at t = {tick.time:g} s the track of object {track.id} has a singular "
+                    "position covariance"
+                )
+            inside += distance <= TRACK_GATE
+            scored += 1
+    if scored == 0 or inside < TRACK_INSIDE * scored:
+        fail(
+            f"{inside} of {scored} position errors after {TRACK_START:g} s are within three "
+            f"standard deviations of the tracks' covariances; at least {100 * TRACK_INSIDE:g} % "
+            "must be"
+        )
+
 
 # --------------------------------------------------------------------- localiser
 

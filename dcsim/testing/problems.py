@@ -13,12 +13,16 @@ from typing import Any
 
 import numpy as np
 
-from dcsim.geometry import quaternion_from_rotation_vector
+from dcsim.geometry import quaternion_from_rotation_vector, quaternion_multiply
 from dcsim.messages import (
     BeaconRange,
     Bounds,
+    Detection,
     DropPoint,
+    FrameDynamics,
+    FrameKind,
     GoalRegion,
+    KnownObject,
     MotionInput,
     ObjectKind,
     ObjectTrack,
@@ -27,13 +31,15 @@ from dcsim.messages import (
     Reference,
     RobotSpec,
     RobotState,
+    SensedTruth,
+    SensorSetup,
     Shape,
     ShapeKind,
     StateEstimate,
     Surroundings,
     TaskRequest,
 )
-from dcsim.motion import LinearMotion, StaticMotion
+from dcsim.motion import ClohessyWiltshireMotion, LinearMotion, MotionSet, StaticMotion, mean_motion
 from dcsim.registry.interfaces import Plugin
 from dcsim.scenario.loader import packaged_scenario_path
 from dcsim.testing.manipulator import thesis_robot
@@ -421,3 +427,171 @@ def hardware_scenario(
         "robot": robot,
         "mission": {"type": "hold"},
     }
+
+
+# --------------------------------------------------------------------- sensing
+
+SENSING_PERIOD = 0.1
+"""Control period of the standard sensing problems, s."""
+
+SENSED_OBJECTS = (
+    KnownObject(3, ObjectKind.TARGET, 5.0, Shape(ShapeKind.SPHERE, radius=0.3)),
+    KnownObject(
+        8, ObjectKind.OBSTACLE, 80.0, Shape(ShapeKind.BOX, half_extents=np.array([1.0, 0.5, 0.4]))
+    ),
+    KnownObject(11, ObjectKind.OBSTACLE, 40.0, Shape(ShapeKind.CYLINDER, radius=0.4, height=2.0)),
+    KnownObject(20, ObjectKind.TARGET, 8.0, Shape(ShapeKind.SPHERE, radius=0.5)),
+    KnownObject(42, ObjectKind.OBSTACLE, 60.0, Shape(ShapeKind.SPHERE, radius=1.0)),
+)
+"""The objects of the standard sensing problem: the first four within the object
+sensor's 30 m, the last 55 m off; object 20 is held by the robot (not free) after 10 s."""
+
+_OBJECT_STARTS = np.array(
+    [
+        [12.0, -5.0, 3.0],
+        [-8.0, 10.0, -4.0],
+        [4.0, 15.0, 9.0],
+        [-15.0, -6.0, 2.0],
+        [45.0, 30.0, 10.0],
+    ]
+)
+_OBJECT_VELOCITIES = np.array(
+    [
+        [-0.02, 0.01, 0.0],
+        [0.03, -0.01, 0.005],
+        [0.0, -0.02, 0.01],
+        [0.01, 0.02, -0.01],
+        [0.0, 0.0, 0.0],
+    ]
+)
+
+
+def sensor_setup(empty: bool = False) -> SensorSetup:
+    """What the standard sensing problem tells a sensor model: the five beacons of the
+    beacon problem (5 cm noise, the nearest 3 reported) and :data:`SENSED_OBJECTS` within
+    an object sensor's 30 m, at 10 Hz; with ``empty``, no beacons and no objects."""
+    return SensorSetup(
+        control_period=SENSING_PERIOD,
+        beacons=np.zeros((0, 3)) if empty else BEACONS,
+        beacon_noise=0.05,
+        beacon_report_nearest=3,
+        object_range=30.0,
+        objects=() if empty else SENSED_OBJECTS,
+    )
+
+
+def sensed_truths(steps: int = 200, empty: bool = False) -> list[SensedTruth]:
+    """The true states of the standard sensing problem, one per control tick (10 Hz): a
+    robot drifting at 5 cm/s and turning at about 1.5 °/s, and the objects of
+    :func:`sensor_setup` drifting in straight lines (none with ``empty``)."""
+    rate = np.array([0.01, -0.02, 0.015])  # world frame, rad/s
+    start = quaternion_from_rotation_vector([0.3, -0.2, 0.5])
+    truths = []
+    for k in range(steps):
+        t = k * SENSING_PERIOD
+        count = 0 if empty else len(SENSED_OBJECTS)
+        free = np.ones(count, dtype=bool)
+        if count:
+            free[3] = t < 10.0
+        truths.append(
+            SensedTruth(
+                time=t,
+                position=np.array([5.0, -3.0, 2.0]) + np.array([0.05, 0.02, 0.0]) * t,
+                velocity=np.array([0.05, 0.02, 0.0]),
+                attitude=quaternion_multiply(quaternion_from_rotation_vector(rate * t), start),
+                angular_velocity=rate,
+                object_positions=(_OBJECT_STARTS + _OBJECT_VELOCITIES * t)[:count],
+                object_velocities=_OBJECT_VELOCITIES[:count],
+                free=free,
+            )
+        )
+    return truths
+
+
+@dataclass(frozen=True)
+class TrackerTick:
+    """One control tick of the standard tracking problem.
+
+    Attributes
+    ----------
+    time : float
+        s.
+    detections : tuple of Detection
+        The object sensor's detections now.
+    robot : StateEstimate
+        The robot's estimate (position within its covariance of the truth).
+    truth : dict of int to ndarray (3,)
+        The true position of every object detected now, by id (for scoring only).
+    """
+
+    time: float
+    detections: tuple[Detection, ...]
+    robot: StateEstimate
+    truth: dict[int, np.ndarray]
+
+
+@dataclass(frozen=True)
+class TrackerProblem:
+    """Detections of objects drifting in an orbit's LVLH frame, as a tracker gets them.
+
+    Attributes
+    ----------
+    frame : FrameDynamics
+        Clohessy–Wiltshire, 400 km circular orbit.
+    start_time : float
+        s.
+    ticks : list of TrackerTick
+        In order, at 10 Hz.
+    """
+
+    frame: FrameDynamics
+    start_time: float
+    ticks: list[TrackerTick]
+
+
+TRACKED_IDS = (3, 8, 11, 20, 42)
+"""Identities of the standard tracking problem's objects; 42 is seen for the first 15 s only."""
+
+
+def tracker_problem(steps: int = 300, empty: bool = False, seed: int = 9) -> TrackerProblem:
+    """The standard tracking problem: five objects on Clohessy–Wiltshire motions within
+    40 m, detected at 10 Hz with 5 cm of Gaussian noise per axis by a robot whose
+    position estimate errs by 2 cm per axis (its covariance says so); object 42 leaves
+    view after 15 s. ``empty``: no detections at all."""
+    rng = np.random.default_rng(seed)
+    frame = FrameDynamics(kind=FrameKind.CLOHESSY_WILTSHIRE, mean_motion=mean_motion(6_778_137.0))
+    objects = MotionSet(
+        [
+            ClohessyWiltshireMotion(p, v, frame.mean_motion)
+            for p, v in zip(_OBJECT_STARTS * 0.8, _OBJECT_VELOCITIES, strict=True)
+        ]
+    )
+    covariance = np.eye(3) * 0.05**2
+    robot_covariance = np.diag([0.02, 0.02, 0.02, 0.001, 0.001, 0.001]) ** 2
+    ticks = []
+    for k in range(steps):
+        t = k * SENSING_PERIOD
+        robot = np.array([0.03 * t, 2.0 * np.sin(0.02 * t), -0.01 * t])
+        estimate = StateEstimate(
+            time=t,
+            position=robot + rng.normal(0.0, 0.02, 3),
+            covariance=robot_covariance,
+            converged=True,
+        )
+        positions = objects.state_at(t)[0]
+        seen = [] if empty else [i for i, n in enumerate(TRACKED_IDS) if n != 42 or t < 15.0]
+        detections = tuple(
+            Detection(
+                time=t,
+                id=TRACKED_IDS[i],
+                kind=SENSED_OBJECTS[i].kind,
+                relative_position=positions[i] - robot + rng.normal(0.0, 0.05, 3),
+                covariance=covariance,
+                radius=SENSED_OBJECTS[i].shape.bounding_radius,
+                mass=SENSED_OBJECTS[i].mass,
+            )
+            for i in seen
+        )
+        truth = {TRACKED_IDS[i]: positions[i] for i in seen}
+        ticks.append(TrackerTick(t, detections, estimate, truth))
+    return TrackerProblem(frame, 0.0, ticks)

@@ -45,7 +45,14 @@ def test_builtin_plugins_keep_every_contract(plugin, check):
 
 
 def test_every_kind_has_builtins_under_test():
-    assert {p.kind for p in BUILTINS} == {"localiser", "task_planner", "path_planner", "controller"}
+    assert {p.kind for p in BUILTINS} == {
+        "sensor",
+        "tracker",
+        "localiser",
+        "task_planner",
+        "path_planner",
+        "controller",
+    }
 
 
 # ----------------------------------------------------------------- broken plugins
