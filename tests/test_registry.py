@@ -89,7 +89,8 @@ def test_unknown_name_suggests_the_closest():
 
 def test_unknown_kind_lists_the_kinds():
     with pytest.raises(
-        PluginNotFoundError, match="kinds: sensor, tracker, localiser, task_planner, path_planner, controller"
+        PluginNotFoundError,
+        match="kinds: sensor, tracker, localiser, task_planner, path_planner, controller",
     ):
         PluginRegistry().plugins("navigator")
 
@@ -122,7 +123,7 @@ class Incomplete(Controller):
         ),
         (
             int,
-            "is not a plugin class: derive it from one of Localiser, TaskPlanner, PathPlanner, Controller",
+            "is not a plugin class: derive it from one of SensorModel, Tracker, Localiser, TaskPlanner, PathPlanner, Controller",
         ),
         (
             type("Nameless", (ThrowAwayController,), {"name": "Bad Name"}),

@@ -1014,19 +1014,23 @@ SensingProfile = Literal["ideal", "realistic"]
 
 
 class SensorsSection(Section):
-    """The robot's sensors: a profile gives every sensor's model, and a sensor given here
-    replaces its profile's.
+    """The robot's sensors: each one's model, from the profile unless given here.
+
+    A sensor given here replaces its profile's model (keeping the profile's parameters
+    it does not set when the model is the same).
 
     Under the ``ideal`` profile (the default) the beacon ranges have white noise
     (``beacons.noise_sigma``) and nothing else, and the star tracker, the gyros and the
     object sensor report the truth (no model: the tracks are exact and no tracker runs).
     Under ``realistic`` each sensor has the model and the numbers of
-    :data:`dcsim.world.sensors.profiles.REALISTIC` (their sources are named there and in
+    :data:`dcsim.scenario.sensors.REALISTIC` (their sources are named there and in
     docs/sensors.md).
     """
 
     profile: SensingProfile = Field(
-        "ideal", description="`ideal` (the truth, as before) or `realistic`."
+        "ideal",
+        description="`ideal` (white-noise beacon ranges, everything else exact) or "
+        "`realistic` (docs/sensors.md).",
     )
     beacon_ranges: SensorChoice | None = Field(
         None, description="The beacon range sensor's model; null for the profile's."
