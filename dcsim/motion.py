@@ -125,7 +125,7 @@ def _stack(models: Sequence[Any], name: str) -> np.ndarray:
 
 
 def _vec3(values: ArrayLike) -> tuple[float, float, float]:
-    x, y, z = (float(v) for v in np.asarray(values, dtype=float).reshape(3))
+    x, y, z = np.asarray(values, dtype=float).reshape(3).tolist()
     return (x, y, z)
 
 

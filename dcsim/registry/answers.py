@@ -176,10 +176,32 @@ def _items_problem(items: tuple[Any, ...], item_type: type) -> str | None:
     for index, item in enumerate(items):
         if not isinstance(item, item_type):
             return f"returned a tuple holding a {type(item).__name__} at [{index}]"
+    if _all_finite(items):
+        return None
+    for index, item in enumerate(items):  # name the first non-finite number
         problem = _non_finite(item)
         if problem is not None:
             return f"{problem} in [{index}]"
     return None
+
+
+def _all_finite(items: tuple[Any, ...]) -> bool:
+    """Whether every number the messages hold is finite, tested in one pass over all of
+    them (a tracker answers a track per object every tick): their arrays joined and
+    tested, their scalars and the numbers of messages in their tuples summed."""
+    total = 0.0
+    arrays = []
+    for item in items:
+        for value in item.__dict__.values():
+            if type(value) is np.ndarray:
+                arrays.append(value.ravel())
+            elif isinstance(value, tuple):
+                total += sum(_sum_of_numbers(v) for v in value if is_dataclass(v))
+            elif isinstance(value, int | float) and type(value) is not bool:
+                total += value
+    if not math.isfinite(total):
+        return False
+    return not arrays or bool(np.isfinite(np.concatenate(arrays)).all())
 
 
 def _non_finite(message: Any) -> str | None:

@@ -214,3 +214,29 @@ def test_a_sensor_given_with_its_profile_s_model_keeps_the_profile_s_numbers():
     other = SensorsSection(profile="realistic", gyros=SensorChoice(model="spinning"))
     assert sensor_choices(other)["gyros"] == SensorChoice(model="spinning")
     assert sensor_choices(SensorsSection())["objects"] is None
+
+
+def test_a_non_finite_number_in_any_track_or_reading_is_named():
+    from dcsim.messages import BeaconRange, ObjectKind, ObjectTrack
+    from dcsim.registry.answers import output_problem
+
+    good = ObjectTrack(1, ObjectKind.OBSTACLE, 0.0, [0, 0, 0], [0, 0, 0], radius=1.0)
+    bad = ObjectTrack(2, ObjectKind.OBSTACLE, 0.0, [0, np.nan, 0], [0, 0, 0], radius=1.0)
+    assert output_problem("tracker", "update", (good, good)) is None
+    assert output_problem("tracker", "update", (good, bad)) == (
+        "returned non-finite numbers: position [0.0, nan, 0.0] in [1]"
+    )
+    far = BeaconRange(0, [1.0, 0.0, 0.0], range=np.inf, sigma=0.1)
+    assert output_problem("sensor", "measure", (far,), measures="beacon_ranges") == (
+        "returned non-finite numbers: range inf in [0]"
+    )
+    assert output_problem("sensor", "measure", [far], measures="beacon_ranges") == ("returned list")
+
+
+def test_sensors_asked_twice_at_one_instant_give_nothing_new():
+    runner = opened("sensors.profile=realistic")
+    world = runner.world
+    again = world.observations()  # the runner read the sensors at t = 0 already
+    assert again.gyros is None and again.star_tracker is None
+    assert np.array_equal(again.attitude, runner.estimate.attitude)
+    runner.close()

@@ -85,9 +85,9 @@ class Gyros(SensorModel):
 
     def measure(self, truth: SensedTruth) -> RateReading | None:
         """The measured body-frame angular velocity now (rad/s), or None between
-        readings."""
+        readings (and when asked again at the instant of the latest reading)."""
         time = truth.time
-        if not self._clock.due(time):
+        if (self._last is not None and time <= self._last) or not self._clock.due(time):
             return None
         dt = self._nominal if self._last is None else time - self._last
         self._last = time
