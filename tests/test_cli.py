@@ -156,6 +156,7 @@ def test_run_default_writes_a_run_directory_and_prints_a_summary(dcsim_cli, tmp_
     (run_dir,) = (tmp_path / "runs").glob("default-*")
     assert f"results in runs/{run_dir.name}" in result.stdout
     assert (
+        f"  sensors: beacon_ranges beacon-range (dcsim {__version__})\n"
         f"  plugins: localiser ekf (dcsim {__version__}), task_planner ga (dcsim {__version__}), "
         f"path_planner straight-line (dcsim {__version__}), controller pd (dcsim {__version__})\n"
     ) in result.stdout

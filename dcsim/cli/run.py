@@ -158,7 +158,11 @@ def _print_summary(summary: dict, out: Path) -> None:
         f"  simulated {summary['sim_time_s']:.1f} s in {summary['wall_time_s']:.1f} s of wall time "
         f"(x{summary['real_time_factor']:.0f} real time)"
     )
-    click.echo(f"  plugins: {_plugins_flown(summary['plugins'])}")
+    flown = summary["plugins"]
+    sensors = {k.removeprefix("sensors."): v for k, v in flown.items() if k.startswith("sensors.")}
+    roles = {k: v for k, v in flown.items() if not k.startswith("sensors.")}
+    click.echo(f"  sensors: {_plugins_flown(sensors)}")
+    click.echo(f"  plugins: {_plugins_flown(roles)}")
     click.echo(f"  results in {out}")
 
 
@@ -209,7 +213,8 @@ def _megabytes(path: Path) -> str:
 
 
 def _plugins_flown(plugins: dict[str, dict[str, str]]) -> str:
-    """``localiser ekf (dcsim 0.1.0), ...``: each role's plugin and where it came from."""
+    """``localiser ekf (dcsim 0.1.0), ...``: each role's plugin (or sensor's model) and
+    where it came from."""
     return ", ".join(
         f"{role} {entry['name']} ({entry['distribution']} {entry['version']})"
         for role, entry in plugins.items()

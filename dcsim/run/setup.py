@@ -70,14 +70,23 @@ class RunSetup:
         return cls(scenario, plugins, sources, registry)
 
     def plugin_versions(self) -> dict[str, dict[str, str]]:
-        """Name, distribution and version of each role's plugin (for run summaries)."""
+        """Name, distribution and version of each sensor's model (as
+        ``sensors.<sensor>``), then of each role's plugin, for run summaries."""
+        from dcsim.scenario.sensors import sensor_choices
+
+        sources = {
+            f"sensors.{slot}": self.registry.get("sensor", choice.model)
+            for slot, choice in sensor_choices(self.scenario.sensors).items()
+            if choice is not None
+        }
+        sources.update(self.sources)
         return {
             role: {
                 "name": entry.name,
                 "distribution": entry.origin.distribution,
                 "version": entry.origin.version,
             }
-            for role, entry in self.sources.items()
+            for role, entry in sources.items()
         }
 
 
