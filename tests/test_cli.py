@@ -308,13 +308,20 @@ def test_bench_localisers_prints_the_bound_and_every_localiser(dcsim_cli, tmp_pa
     plot = tmp_path / "localisers.png"
     result = dcsim_cli("bench", "localisers", "--runs", "1", "--steps", "10", "--plot", str(plot))
     assert result.returncode == 0, result.stderr
-    labels = [
-        line.split("|")[1].strip() for line in result.stdout.splitlines() if line.startswith("| ")
+    rows = [
+        [cell.strip() for cell in line.split("|")[1:3]]
+        for line in result.stdout.splitlines()
+        if line.startswith("| ")
     ]
-    assert labels[0] == "localiser"
-    for name in ("PCRB", "trilateration", "ekf", "ukf", "sspf 1k", "sspf 10k", "sspf 100k"):
-        assert name in labels
+    assert rows[0] == ["ranges", "localiser"]
+    for case in ("white", "biased", "outliers"):
+        labels = [label for ranges, label in rows if ranges == case]
+        for name in ("PCRB", "trilateration", "ekf", "ukf", "sspf 1k", "sspf 10k", "sspf 100k"):
+            assert name in labels
     assert plot.stat().st_size > 10_000
+    unknown = dcsim_cli("bench", "localisers", "--ranges", "white,coloured")
+    assert unknown.returncode == 2 and "--ranges: unknown coloured" in unknown.stderr
+    assert "Traceback" not in unknown.stderr
 
 
 def test_bench_controllers_refuses_another_mission_type_before_any_run(dcsim_cli):
