@@ -125,7 +125,10 @@ def _stack(models: Sequence[Any], name: str) -> np.ndarray:
 
 
 def _vec3(values: ArrayLike) -> tuple[float, float, float]:
-    x, y, z = np.asarray(values, dtype=float).reshape(3).tolist()
+    if type(values) is list and len(values) == 3 and all(type(v) is float for v in values):
+        x, y, z = values  # floats already (an array's tolist())
+    else:
+        x, y, z = np.asarray(values, dtype=float).reshape(3).tolist()
     return (x, y, z)
 
 

@@ -185,6 +185,9 @@ def _items_problem(items: tuple[Any, ...], item_type: type) -> str | None:
     return None
 
 
+_NUMBERS = (int, float)
+
+
 def _all_finite(items: tuple[Any, ...]) -> bool:
     """Whether every number the messages hold is finite, tested in one pass over all of
     them (a tracker answers a track per object every tick): their arrays joined and
@@ -193,11 +196,14 @@ def _all_finite(items: tuple[Any, ...]) -> bool:
     arrays = []
     for item in items:
         for value in item.__dict__.values():
-            if type(value) is np.ndarray:
+            kind = type(value)
+            if kind is np.ndarray:
                 arrays.append(value.ravel())
-            elif isinstance(value, tuple):
+            elif kind is float or kind is int:
+                total += value
+            elif kind is tuple:
                 total += sum(_sum_of_numbers(v) for v in value if is_dataclass(v))
-            elif isinstance(value, int | float) and type(value) is not bool:
+            elif isinstance(value, _NUMBERS) and kind is not bool:
                 total += value
     if not math.isfinite(total):
         return False

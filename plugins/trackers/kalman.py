@@ -102,11 +102,13 @@ class KalmanParams(PluginParams):
 
 @dataclass(frozen=True)
 class _Details:
-    """What a track keeps from its latest accepted detection besides the state."""
+    """What a track keeps from its latest accepted detection besides the state (its
+    shape's bounding radius, m, worked out once)."""
 
     kind: ObjectKind
     mass: float
     shape: Shape
+    radius: float
 
 
 _H = np.hstack([np.eye(3), np.zeros((3, 3))])
@@ -148,7 +150,7 @@ class KalmanTracker(Tracker):
         self._covariances = _frozen(np.zeros((0, 6, 6)))
         self._last_seen = np.zeros(0)
         self._details: list[_Details] = []
-        self._spheres: dict[float, Shape] = {}
+        self._described_as: dict[tuple[ObjectKind, float, float, int], _Details] = {}
         self._step: tuple[float, np.ndarray, np.ndarray] | None = None
 
     def update(
@@ -279,17 +281,19 @@ class KalmanTracker(Tracker):
     # ------------------------------------------------------------------ answers
     def _described(self, detection: Detection) -> _Details:
         """Kind, mass and shape of a detected object: the detection's shape, or a sphere
-        of its radius plus the margin."""
-        shape = detection.shape
-        if shape is None:
-            radius = detection.radius + self.params.shape_margin
-            shape = self._spheres.get(radius)
-            if shape is None:
-                shape = self._spheres[radius] = Shape(radius=radius)
-        return _Details(detection.kind, detection.mass, shape)
+        of its radius plus the margin (the same details shared while they stay)."""
+        key = (detection.kind, detection.mass, detection.radius, id(detection.shape))
+        details = self._described_as.get(key)
+        if details is None or details.shape is not (detection.shape or details.shape):
+            shape = detection.shape or Shape(radius=detection.radius + self.params.shape_margin)
+            details = self._described_as[key] = _Details(
+                detection.kind, detection.mass, shape, shape.bounding_radius
+            )
+        return details
 
-    def _motion(self, state: np.ndarray) -> MotionModel:
-        """The frame's free motion from ``state`` at the current time."""
+    def _motion(self, state: list[float]) -> MotionModel:
+        """The frame's free motion from ``state`` ``[position, velocity]`` at the current
+        time."""
         if self._mean_motion > 0:
             return ClohessyWiltshireMotion(state[:3], state[3:], self._mean_motion, epoch=self.time)
         return LinearMotion(state[:3], state[3:], epoch=self.time)
@@ -305,13 +309,13 @@ class KalmanTracker(Tracker):
                 position=states[i, :3],
                 velocity=states[i, 3:],
                 mass=details.mass,
-                radius=details.shape.bounding_radius,
-                motion=self._motion(states[i]),
+                radius=details.radius,
+                motion=self._motion(state),
                 shape=details.shape,
                 covariance=covariances[i],
             )
-            for i, (track_id, details) in enumerate(
-                zip(self._ids.tolist(), self._details, strict=True)
+            for i, (track_id, details, state) in enumerate(
+                zip(self._ids.tolist(), self._details, states.tolist(), strict=True)
             )
         )
 
