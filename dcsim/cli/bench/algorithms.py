@@ -117,6 +117,12 @@ def bench_task_planners_command(
     show_default=True,
     help="Comma-separated controller plugins (default parameters).",
 )
+@click.option(
+    "--sensors",
+    default="ideal,realistic",
+    show_default=True,
+    help="Comma-separated sensing profiles (sensors.profile) every controller flies under.",
+)
 @cluster_options
 @overrides_option("Override a value of the crowded-field scenario, as for dcsim run. Repeatable.")
 @plot_option("Save the distribution of the closest approach here.")
@@ -124,6 +130,7 @@ def bench_controllers_command(
     seeds: int,
     first_seed: int,
     controllers: str,
+    sensors: str,
     scheduler: str | None,
     connect_timeout: float | None,
     workers: int | None,
@@ -133,7 +140,9 @@ def bench_controllers_command(
 ) -> None:
     """Controllers crossing scenarios/crowded_field.yaml, a fresh field of 60 obstacles per seed.
 
-    Reports per controller the runs with a collision, the closest approach to any
+    Every controller flies every field under each sensing profile (ideal: exact tracks
+    of the obstacles; realistic: the tracker's tracks from the object sensor). Reports
+    per controller and profile the runs with a collision, the closest approach to any
     obstacle, delta-v and mission time as a Markdown table for docs/benchmarks.md.
     The runs are campaign cases on Dask (a local cluster unless --scheduler).
     """
@@ -142,10 +151,17 @@ def bench_controllers_command(
 
     scenario = packaged_scenario_path("crowded_field.yaml")
     names = comma_words(controllers, "--controllers")
+    profiles = comma_words(sensors, "--sensors")
     registry = PluginRegistry.discover()
-    for name in names:  # unknown controllers and bad overrides fail here, before any run
-        chosen = [f"controller.plugin={name}", "controller.params={}", *overrides]
-        safety = _safety_distance(scenario, chosen, registry)
+    for name in names:  # unknown names and bad overrides fail here, before any run
+        for profile in profiles:
+            chosen = [
+                f"controller.plugin={name}",
+                "controller.params={}",
+                f"sensors.profile={profile}",
+                *overrides,
+            ]
+            safety = _safety_distance(scenario, chosen, registry)
     runs = bench_controllers(
         scenario,
         names,
@@ -153,6 +169,7 @@ def bench_controllers_command(
         overrides,
         cluster_choice(scheduler, workers, worker_deaths, connect_timeout),
         progress=progress,
+        sensors=profiles,
     )
     click.echo(markdown_table(runs))
     if plot_path is not None:
