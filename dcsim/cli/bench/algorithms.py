@@ -1,5 +1,6 @@
 """Benches of the built-in localisers (``localisers``), task planners
-(``task-planners``) and controllers (``controllers``) against their references."""
+(``task-planners``), controllers (``controllers``) and tracker (``tracking``) against
+their references."""
 
 from __future__ import annotations
 
@@ -194,3 +195,40 @@ def _safety_distance(scenario: Path, overrides: list[str], registry: PluginRegis
             param_hint="--set",
         )
     return mission.safety_distance
+
+
+@click.command("tracking", short_help="The tracker's tracks against the truth in the closed loop.")
+@click.argument("scenarios", nargs=-1, type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@count_option("--seeds", 3, "World seeds flown per scenario.")
+@count_option("--first-seed", 0, "Seed of the first run (seeds FIRST to FIRST + N - 1).", minimum=0)
+@click.option(
+    "--duration",
+    type=click.FloatRange(min=0, min_open=True),
+    help="Simulated seconds at most per run, s  [default: the scenario's world.duration]",
+)
+@overrides_option("Override a value of every scenario, as for dcsim run. Repeatable.")
+def bench_tracking_command(
+    scenarios: tuple[Path, ...],
+    seeds: int,
+    first_seed: int,
+    duration: float | None,
+    overrides: tuple[str, ...],
+) -> None:
+    """The tracker's consistency in the closed loop, under sensors.profile=realistic.
+
+    Flies each SCENARIO (default: the packaged default.yaml and crowded_field.yaml) on
+    every seed and compares, each control tick, every track of a free object the
+    mission sees with the object's true state: the position and velocity NEES, the
+    fraction of track-ticks inside the 3-sigma bound (chi-square, 3 dof, 0.9973) and
+    the RMS errors. Prints a Markdown table for docs/benchmarks.md.
+    """
+    from dcsim.bench.tracking import bench_tracking, markdown_table
+    from dcsim.scenario import packaged_scenario_path
+
+    chosen = scenarios or tuple(
+        packaged_scenario_path(name) for name in ("default.yaml", "crowded_field.yaml")
+    )
+    runs = bench_tracking(
+        chosen, range(first_seed, first_seed + seeds), duration, overrides, progress=progress
+    )
+    click.echo(markdown_table(runs))
