@@ -12,6 +12,7 @@ from dcsim.bench.controllers import (
     crowded_obstacles,
     field_override,
     fly,
+    markdown_table,
 )
 from dcsim.campaign import ClusterOptions
 from dcsim.errors import DcsimError
@@ -51,7 +52,31 @@ def test_the_bench_flies_its_cases_on_the_campaign_engine_as_in_process():
     assert [(r.controller, r.seed) for r in runs] == [("pd", 3), ("elastic", 3)]
     assert runs == [fly(ControllerCase(scenario, r.controller, 3, short)) for r in runs]
     assert len(lines) == 2
-    with pytest.raises(DcsimError, match="bench controllers: RuntimeError: pd on seed 3: stopped"):
+    with pytest.raises(
+        DcsimError, match=r"bench controllers: RuntimeError: pd \(ideal\) on seed 3: stopped"
+    ):
         bench_controllers(
             scenario, ["pd"], [3], (*short, "stop.max_wall_time=0.001"), ClusterOptions(workers=1)
         )
+
+
+def test_every_controller_flies_under_each_sensing_profile_in_its_own_row():
+    scenario = packaged_scenario_path("crowded_field.yaml")
+    short = ("world.duration=4.0",)
+    runs = [
+        fly(ControllerCase(scenario, name, 3, short, profile))
+        for profile in ("ideal", "realistic")
+        for name in ("elastic", "pd")
+    ]
+    ideal, realistic = runs[0], runs[2]
+    assert (ideal.sensors, realistic.sensors) == ("ideal", "realistic")
+    # Under realistic sensing the collector flies on the tracker's tracks and the
+    # localiser's attitude readings: another flight than on the truth.
+    assert realistic.delta_v != ideal.delta_v
+    rows = [line.split("|")[1:3] for line in markdown_table(runs).splitlines()[2:]]
+    assert [(a.strip(), b.strip()) for a, b in rows] == [
+        ("elastic", "ideal"),
+        ("elastic", "realistic"),
+        ("pd", "ideal"),
+        ("pd", "realistic"),
+    ]

@@ -51,9 +51,16 @@ def bench_localisers_command(
 
 
 @click.command(
-    "task-planners", short_help="ga's time strategies; task planners' gaps to the optimum."
+    "task-planners",
+    short_help="ga's time strategies; task planners' gaps to the optimum; tracked targets.",
 )
-@count_option("--instances", 100, "Random instances per problem size (both studies).")
+@click.option(
+    "--studies",
+    default="gaps,strategies,tracked",
+    show_default=True,
+    help="Comma-separated studies to run: gaps, strategies, tracked.",
+)
+@count_option("--instances", 100, "Random instances per problem size (gaps and strategies).")
 @count_option(
     "--moving-instances",
     50,
@@ -65,6 +72,10 @@ def bench_localisers_command(
 )
 @count_option("--dispersion-instances", 5, "Instances whose dispersion is measured.")
 @positive_option("--grid-step", 10.0, "Time grid of the moving-target optimum, s.")
+@count_option(
+    "--tracked-instances", 50, "Moving instances per size planned from the truth and from tracks."
+)
+@positive_option("--observation", 10.0, "Time the object sensor watches before planning, s.")
 @click.option(
     "--plots",
     "plot_dir",
@@ -72,18 +83,25 @@ def bench_localisers_command(
     help="Save task_planner_strategies.png and task_planner_gaps.png here.",
 )
 def bench_task_planners_command(
+    studies: str,
     instances: int,
     moving_instances: int,
     repeats: int,
     dispersion_instances: int,
     grid_step: float,
+    tracked_instances: int,
+    observation: float,
     plot_dir: Path | None,
 ) -> None:
-    """The ga planner's time strategies (thesis ch. 3) and task planners' gaps to the optimum.
+    """The ga planner's time strategies (thesis ch. 3), task planners' gaps to the
+    optimum, and their plans from tracked targets.
 
-    Time strategies: 5, 10 and 15 moving targets. Gaps: stationary targets with 5, 7, 9
-    and 11 (exact Held-Karp optimum), moving targets with 5 and 7 (optimum over a time
-    grid of 2500 s). Prints Markdown tables for docs/benchmarks.md.
+    Gaps: stationary targets with 5, 7, 9 and 11 (exact Held-Karp optimum), moving
+    targets with 5 and 7 (optimum over a time grid of 2500 s). Time strategies: 5, 10
+    and 15 moving targets. Tracked: 5 and 10 moving targets planned from their true
+    motions and from the kalman tracker's tracks of the object sensor's detections
+    (realistic profile) after --observation seconds, each plan flown against the truth.
+    Prints Markdown tables for docs/benchmarks.md.
     """
     from dcsim.bench.task_planners import (
         compare_strategies,
@@ -92,18 +110,36 @@ def bench_task_planners_command(
         plot_gaps,
         plot_strategies,
         strategy_table,
+        tracked_table,
+        tracked_targets,
     )
 
-    gaps = optimality_gaps(
-        (5, 7, 9, 11), (5, 7), instances, moving_instances, grid_step, 2500.0, progress
-    )
-    click.echo(gap_table(gaps) + "\n")
-    strategies = compare_strategies((5, 10, 15), instances, repeats, dispersion_instances, progress)
-    click.echo(strategy_table(strategies, repeats))
+    chosen = comma_words(studies, "--studies")
+    unknown = sorted(set(chosen) - {"gaps", "strategies", "tracked"})
+    if unknown:
+        raise click.BadParameter(
+            f"{', '.join(unknown)}: choose among gaps, strategies, tracked", param_hint="--studies"
+        )
     if plot_dir is not None:
         plot_dir.mkdir(parents=True, exist_ok=True)
-        plot_gaps(gaps, plot_dir / "task_planner_gaps.png")
-        plot_strategies(strategies, plot_dir / "task_planner_strategies.png")
+    if "gaps" in chosen:
+        gaps = optimality_gaps(
+            (5, 7, 9, 11), (5, 7), instances, moving_instances, grid_step, 2500.0, progress
+        )
+        click.echo(gap_table(gaps) + "\n")
+        if plot_dir is not None:
+            plot_gaps(gaps, plot_dir / "task_planner_gaps.png")
+    if "strategies" in chosen:
+        strategies = compare_strategies(
+            (5, 10, 15), instances, repeats, dispersion_instances, progress
+        )
+        click.echo(strategy_table(strategies, repeats) + "\n")
+        if plot_dir is not None:
+            plot_strategies(strategies, plot_dir / "task_planner_strategies.png")
+    if "tracked" in chosen:
+        tracked = tracked_targets((5, 10), tracked_instances, observation, progress)
+        click.echo(tracked_table(tracked))
+    if plot_dir is not None:
         click.echo(f"plots: {plot_dir}")
 
 
