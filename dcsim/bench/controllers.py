@@ -82,6 +82,9 @@ class ControllerRun:
         Simulated time at the end of the run, s.
     delivered, targets : int
         Targets delivered and targets in the mission.
+    stopped : str
+        Why the mission stopped before its end (a path planner that found no path, a
+        stop rule), or "" when the run completed.
     """
 
     controller: str
@@ -93,6 +96,7 @@ class ControllerRun:
     mission_time: float
     delivered: int
     targets: int
+    stopped: str = ""
 
 
 @dataclass(frozen=True)
@@ -124,11 +128,14 @@ def fly(case: ControllerCase) -> ControllerRun:
     """Fly ``case`` (nothing written); its overrides apply after the field, the controller
     and the sensing profile.
 
+    A run the mission or a stop rule stopped early is kept, saying why
+    (:attr:`ControllerRun.stopped`): its collisions and closest approach up to the stop
+    count, its delta-v and time are those of a shorter flight.
+
     Raises
     ------
     RuntimeError
-        If the run did not complete (a plugin failed, or a stop rule other than a
-        collision ended it): its figures would not be comparable.
+        If the run failed (a plugin failed): it has no figures.
     """
     chosen = [
         field_override(case.seed),
@@ -138,7 +145,7 @@ def fly(case: ControllerCase) -> ControllerRun:
     ]
     setup = setup_run(case.scenario, [*chosen, *case.overrides], case.seed)
     summary = Runner(setup, None).run()
-    if summary["status"] != "completed":
+    if summary["status"] == "failed":
         raise RuntimeError(
             f"{case.controller} ({case.sensors}) on seed {case.seed}: "
             f"{summary['status']}, {summary['reason']}"
@@ -153,6 +160,7 @@ def fly(case: ControllerCase) -> ControllerRun:
         summary["sim_time_s"],
         summary["delivered"],
         summary["targets"],
+        "" if summary["status"] == "completed" else summary["reason"],
     )
 
 
@@ -194,7 +202,7 @@ def bench_controllers(
     Raises
     ------
     DcsimError
-        At the first run that did not complete (the others are cancelled).
+        At the first run that failed (the others are cancelled).
     """
     cases = [
         ControllerCase(scenario, controller, seed, tuple(overrides), profile)
@@ -211,6 +219,7 @@ def bench_controllers(
         progress(
             f"{run.controller} ({run.sensors}) seed {run.seed}: {run.collisions} collisions, "
             f"closest {run.min_distance:.2f} m, delta-v {run.delta_v:.2f} m/s"
+            + (f"; stopped: {run.stopped}" if run.stopped else "")
         )
 
     with dask_client(cluster or ClusterOptions()) as client:
@@ -234,8 +243,8 @@ def markdown_table(runs: list[ControllerRun]) -> str:
     lines = [
         "| controller | sensors | seeds | runs with a collision | collisions "
         "| closest gap min / median [m] | delta-v median (p95) [m/s] "
-        "| mission time median [s] | all delivered |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|",
+        "| mission time median [s] | all delivered | stopped early |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for (name, profile), mine in _series(runs).items():
         gaps = np.array([r.min_distance for r in mine])
@@ -245,7 +254,8 @@ def markdown_table(runs: list[ControllerRun]) -> str:
             f"{sum(r.collisions for r in mine)} | {gaps.min():.2f} / {np.median(gaps):.2f} | "
             f"{np.median(dv):.2f} ({np.percentile(dv, 95):.2f}) | "
             f"{np.median([r.mission_time for r in mine]):.0f} | "
-            f"{sum(r.delivered == r.targets for r in mine)} / {len(mine)} |"
+            f"{sum(r.delivered == r.targets for r in mine)} / {len(mine)} | "
+            f"{sum(bool(r.stopped) for r in mine)} |"
         )
     return "\n".join(lines)
 
