@@ -262,15 +262,19 @@ def markdown_table(runs: list[ControllerRun]) -> str:
 
 def plot(runs: list[ControllerRun], safety_distance: float, path: Path) -> None:
     """Distribution of the closest approach per controller and sensing profile, with the
-    safety distance (m)."""
+    safety distance (m); runs stopped early (before crossing the field) are left out and
+    counted in the legend."""
     plt = pyplot()
 
     series = _series(runs)
     figure, axis = plt.subplots(figsize=(8, 4.5))
-    data = [[r.min_distance for r in mine] for mine in series.values()]
-    bins = np.linspace(min(min(d) for d in data), max(max(d) for d in data), 30)
-    for (name, profile), values in zip(series, data, strict=True):
-        label = f"{name}, {profile} ({len(values)} seeds)"
+    data = [[r.min_distance for r in mine if not r.stopped] for mine in series.values()]
+    flown = [values for values in data if values] or [[safety_distance]]
+    bins = np.linspace(min(min(d) for d in flown), max(max(d) for d in flown), 30)
+    for (name, profile), values, mine in zip(series, data, series.values(), strict=True):
+        left_out = len(mine) - len(values)
+        label = f"{name}, {profile} ({len(values)} seeds"
+        label += f"; {left_out} stopped early left out)" if left_out else ")"
         axis.hist(values, bins=bins, alpha=0.5, histtype="stepfilled", label=label)
     axis.axvline(safety_distance, color="k", ls="--", label="safety distance")
     axis.axvline(0.0, color="r", lw=1, label="contact")
