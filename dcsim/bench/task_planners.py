@@ -17,10 +17,18 @@ acceleration 0.02 m/s²):
    own (:data:`PLAN_MODEL`: the thesis's time weight, least leg time, speed fraction and
    longest leg); both planners are given it as their parameters, as a scenario file
    would, and every plan is costed by :func:`dcsim.api.plan_cost` with its time weight.
+3. **Tracked targets**: the same two planners, configured the same way, plan one moving
+   instance twice at the end of an observation (:data:`OBSERVATION`, 10 s): from the
+   targets' true motions (the oracle) and from the tracks the ``kalman`` tracker makes
+   of the ``object-sensor``'s detections at the realistic profile's numbers, the robot
+   at rest at the origin and known exactly. Every plan is then flown against the truth:
+   its order, pickup times and drop visits kept, each pickup where its target truly is
+   then (:func:`flown_against_truth`), costed by :func:`dcsim.api.plan_cost`.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -31,10 +39,14 @@ import numpy as np
 
 from dcsim.api import (
     DropPoint,
+    FrameDynamics,
+    KnownObject,
     LinearMotion,
     ObjectKind,
     ObjectTrack,
     Plan,
+    SensedTruth,
+    SensorSetup,
     StateEstimate,
     StaticMotion,
     TaskRequest,
@@ -44,7 +56,9 @@ from dcsim.api import (
 from dcsim.bench.figures import pyplot, save
 from dcsim.bench.optimal_plans import LegRules, optimal_grid_plan, optimal_static_plan
 from dcsim.registry.discovery import PluginRegistry
-from dcsim.registry.interfaces import TaskPlanner
+from dcsim.registry.interfaces import TaskPlanner, Tracker
+from dcsim.scenario.sensors import REALISTIC
+from dcsim.world.sensors.object_sensor import ObjectSensor
 
 AREA = 50.0
 """Half-width of the cube the targets start in, m."""
@@ -78,6 +92,11 @@ class _SearchingPlanner(Protocol):
 
 PLAN_MODEL = LegRules(time_weight=0.005, min_time_step=1.0, speed_fraction=0.8, max_leg_time=600.0)
 """The plan model the optimum is exact for, and the planners are configured with."""
+
+OBSERVATION = 10.0
+"""How long the object sensor watches the targets before the tracked plan, s."""
+OBSERVATION_PERIOD = 0.1
+"""Time between two of the tracker's updates while it watches, s (a control period)."""
 
 STRATEGY_VARIANTS: tuple[tuple[str, dict], ...] = (
     ("brute-force", {"time_strategy": "brute-force", "local_search": False}),
@@ -266,23 +285,7 @@ def optimality_gaps(
     """Gaps of ``ga`` and ``nearest`` to the exact (or grid-exact) optimum."""
     registry = PluginRegistry.discover()
     rules = PLAN_MODEL
-    planners = [
-        (
-            "ga",
-            "ga",
-            {
-                "time_weight": rules.time_weight,
-                "MIN_TIME_STEP": rules.min_time_step,
-                "speed_fraction": rules.speed_fraction,
-                "max_leg_time": rules.max_leg_time,
-            },
-        ),
-        (
-            "nearest",
-            "nearest",
-            {"min_time_step": rules.min_time_step, "speed_fraction": rules.speed_fraction},
-        ),
-    ]
+    planners = _model_planners(rules)
     cases = [(False, n, instances) for n in static_sizes] + [
         (True, n, moving_instances) for n in moving_sizes
     ]
@@ -315,6 +318,27 @@ def optimality_gaps(
             f"{_percent(ga_row.gaps, np.median)} %, max time {max(ga_row.seconds, default=0):.2f} s"
         )
     return results
+
+
+def _model_planners(rules: LegRules) -> list[tuple[str, str, dict]]:
+    """(label, plugin, parameters) of ``ga`` and ``nearest`` given the plan model ``rules``."""
+    return [
+        (
+            "ga",
+            "ga",
+            {
+                "time_weight": rules.time_weight,
+                "MIN_TIME_STEP": rules.min_time_step,
+                "speed_fraction": rules.speed_fraction,
+                "max_leg_time": rules.max_leg_time,
+            },
+        ),
+        (
+            "nearest",
+            "nearest",
+            {"min_time_step": rules.min_time_step, "speed_fraction": rules.speed_fraction},
+        ),
+    ]
 
 
 def _percent(gaps: list[float], statistic: Callable[[np.ndarray], float]) -> str:
@@ -364,3 +388,183 @@ def plot_gaps(results: list[GapResult], path: Path) -> None:
     axis.set_title("Task planners against the exact optimum (whiskers: 5th–95th percentile)")
     axis.grid(alpha=0.3, axis="y")
     save(figure, path)
+
+
+# --------------------------------------------------------------------- tracked targets
+
+
+def request_at(request: TaskRequest, time: float) -> TaskRequest:
+    """``request`` asked at ``time`` (s) instead: each target's track moved there along its
+    motion, the robot in the same state."""
+    targets = []
+    for track in request.targets:
+        position, velocity = track.predict(time)
+        targets.append(dataclasses.replace(track, time=time, position=position, velocity=velocity))
+    robot = dataclasses.replace(request.robot, time=time)
+    return dataclasses.replace(request, time=time, robot=robot, targets=tuple(targets))
+
+
+def tracked_request(
+    truth: TaskRequest, registry: PluginRegistry, seed: int, observation: float = OBSERVATION
+) -> TaskRequest:
+    """``truth`` with its targets as the ``kalman`` tracker knows them after watching.
+
+    From time 0 to ``truth.time`` the ``object-sensor`` (the realistic profile's model
+    and numbers, all round, unlimited reach) reads the targets on their true motions
+    from the robot, which stays at rest where ``truth.robot`` is and is known exactly,
+    and the tracker folds in its detections every :data:`OBSERVATION_PERIOD`.
+
+    Parameters
+    ----------
+    truth : TaskRequest
+        The oracle request, asked at ``observation`` s (:func:`request_at`).
+    registry : PluginRegistry
+        Where the tracker comes from (dcsim does not import plugins).
+    seed : int
+        Seeds the sensor's and the tracker's generators.
+    observation : float
+        Length of the watch, s; ``truth.time`` must equal it.
+
+    Returns
+    -------
+    TaskRequest
+        ``truth`` whose targets are the tracker's tracks at ``truth.time`` (a target
+        never detected is missing).
+    """
+    assert np.isclose(truth.time, observation), "the oracle request is asked at the watch's end"
+    choice = REALISTIC["objects"]
+    assert choice is not None  # the realistic profile gives the object sensor its model
+    sensor = ObjectSensor(choice.params, np.random.default_rng([seed, 1]))
+    catalogue = tuple(KnownObject(t.id, t.kind, t.mass, t.shape) for t in truth.targets)
+    sensor.reset(SensorSetup(control_period=OBSERVATION_PERIOD, objects=catalogue))
+    tracker = registry.create("tracker", "kalman", {}, np.random.default_rng([seed, 2]))
+    assert isinstance(tracker, Tracker)  # the registry files plugins by their class's kind
+    tracker.reset(FrameDynamics(), 0.0)
+    robot = truth.robot
+    ticks = round(observation / OBSERVATION_PERIOD)
+    tracks: tuple[ObjectTrack, ...] = ()
+    for tick in range(ticks + 1):
+        now = tick * OBSERVATION_PERIOD
+        states = [t.predict(now) for t in truth.targets]
+        reading = SensedTruth(
+            now,
+            robot.position,
+            robot.velocity,
+            np.array([0.0, 0.0, 0.0, 1.0]),
+            np.zeros(3),
+            np.array([p for p, _ in states]),
+            np.array([v for _, v in states]),
+            np.ones(len(states), dtype=bool),
+        )
+        known = StateEstimate(
+            now, robot.position, velocity=robot.velocity, covariance=np.zeros((6, 6))
+        )
+        tracks = tracker.update(now, sensor.measure(reading), known)
+    return dataclasses.replace(truth, targets=tracks)
+
+
+def flown_against_truth(truth: TaskRequest, plan: Plan) -> Plan:
+    """``plan`` flown in the true world: its order, pickup times and drop visits kept,
+    each pickup at its target's true position and velocity at the pickup time."""
+    targets = {t.id: t for t in truth.targets}
+    tasks = []
+    for task in plan.tasks:
+        position, velocity = targets[task.target_id].predict(task.pickup_time)
+        tasks.append(dataclasses.replace(task, pickup_point=position, pickup_velocity=velocity))
+    return dataclasses.replace(plan, tasks=tuple(tasks))
+
+
+@dataclass
+class TrackedResult:
+    """One planner on one problem size, planning from the truth and from tracks.
+
+    Attributes
+    ----------
+    label : str
+        The planner.
+    n : int
+        Targets per instance.
+    oracle : list of float
+        Cost of the plan made from the true motions (as planned and as flown), m/s, on
+        the instances whose tracked plan is costed.
+    planned, flown : list of float
+        Cost of the plan made from the tracks, as planned and flown against the truth,
+        m/s.
+    misses : list of float
+        Distance from each tracked plan's pickup point to where its target truly is at
+        the pickup time, m.
+    incomplete : int
+        Tracked plans that left a target out (the instance is not costed).
+    """
+
+    label: str
+    n: int
+    oracle: list[float] = field(default_factory=list)
+    planned: list[float] = field(default_factory=list)
+    flown: list[float] = field(default_factory=list)
+    misses: list[float] = field(default_factory=list)
+    incomplete: int = 0
+
+
+def tracked_targets(
+    sizes: Sequence[int],
+    instances: int,
+    observation: float = OBSERVATION,
+    progress: Progress = print,
+) -> list[TrackedResult]:
+    """``ga`` and ``nearest`` planning moving instances from the truth and from tracks."""
+    registry = PluginRegistry.discover()
+    rules = PLAN_MODEL
+    results: list[TrackedResult] = []
+    for n in sizes:
+        rows = {label: TrackedResult(label, n) for label, _, _ in _model_planners(rules)}
+        for seed in range(instances):
+            start = random_request(np.random.default_rng(20_000 + seed), n, True, 1.0)
+            truth = request_at(start, observation)
+            tracked = tracked_request(truth, registry, seed, observation)
+            for label, name, params in _model_planners(rules):
+                row = rows[label]
+                oracle = _plan(registry, name, params, seed, truth)[0]
+                plan = _plan(registry, name, params, seed, tracked)[0]
+                if len(plan.tasks) < n:
+                    row.incomplete += 1
+                    continue
+                flown = flown_against_truth(truth, plan)
+                row.oracle.append(plan_cost(truth, oracle, rules.time_weight))
+                row.planned.append(plan_cost(tracked, plan, rules.time_weight))
+                row.flown.append(plan_cost(truth, flown, rules.time_weight))
+                row.misses.extend(
+                    float(np.linalg.norm(a.pickup_point - b.pickup_point))
+                    for a, b in zip(plan.tasks, flown.tasks, strict=True)
+                )
+        results.extend(rows.values())
+        ga_row = rows["ga"]
+        progress(
+            f"tracked n={n}: ga median cost flown {np.median(ga_row.flown):.3f} m/s "
+            f"(oracle {np.median(ga_row.oracle):.3f})"
+        )
+    return results
+
+
+def tracked_table(results: list[TrackedResult]) -> str:
+    """Markdown table of the plans from the truth against those from tracks."""
+    lines = [
+        "| n | planner | instances | oracle cost median [m/s] | tracked: as planned median "
+        "[m/s] | tracked: flown median [m/s] | flown / oracle median (p95) "
+        "| flown / as planned median (max) | pickup miss median / max [m] |",
+        "|---:|---|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for r in results:
+        done = f"{len(r.flown)}"
+        if r.incomplete:
+            done += f" (+{r.incomplete} tracked plans leaving targets out)"
+        ratio = np.array(r.flown) / np.array(r.oracle)
+        drift = np.array(r.flown) / np.array(r.planned)
+        lines.append(
+            f"| {r.n} | {r.label} | {done} | {np.median(r.oracle):.3f} | "
+            f"{np.median(r.planned):.3f} | {np.median(r.flown):.3f} | "
+            f"{np.median(ratio):.3f} ({np.percentile(ratio, 95):.3f}) | "
+            f"{np.median(drift):.3f} ({np.max(drift):.3f}) | "
+            f"{np.median(r.misses):.2f} / {np.max(r.misses):.2f} |"
+        )
+    return "\n".join(lines)

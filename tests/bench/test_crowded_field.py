@@ -12,6 +12,7 @@ from dcsim.bench.controllers import (
     crowded_obstacles,
     field_override,
     fly,
+    markdown_table,
 )
 from dcsim.campaign import ClusterOptions
 from dcsim.errors import DcsimError
@@ -51,7 +52,44 @@ def test_the_bench_flies_its_cases_on_the_campaign_engine_as_in_process():
     assert [(r.controller, r.seed) for r in runs] == [("pd", 3), ("elastic", 3)]
     assert runs == [fly(ControllerCase(scenario, r.controller, 3, short)) for r in runs]
     assert len(lines) == 2
-    with pytest.raises(DcsimError, match="bench controllers: RuntimeError: pd on seed 3: stopped"):
+    with pytest.raises(DcsimError, match="(?s)bench controllers: ScenarioError: .*no_such_gain"):
         bench_controllers(
-            scenario, ["pd"], [3], (*short, "stop.max_wall_time=0.001"), ClusterOptions(workers=1)
+            scenario,
+            ["pd"],
+            [3],
+            (*short, "controller.params.no_such_gain=1"),
+            ClusterOptions(workers=1),
         )
+
+
+def test_a_run_stopped_early_is_kept_and_counted_with_its_reason():
+    scenario = packaged_scenario_path("crowded_field.yaml")
+    cut = ("world.duration=2.0", "stop.max_wall_time=0.001")
+    stopped = fly(ControllerCase(scenario, "pd", 3, cut))
+    assert stopped.stopped == "wall-time limit of 0.001 s reached"
+    complete = fly(ControllerCase(scenario, "pd", 3, cut[:1]))
+    assert complete.stopped == ""
+    row = markdown_table([stopped, complete]).splitlines()[2]
+    assert row.split("|")[-2].strip() == "1"
+
+
+def test_every_controller_flies_under_each_sensing_profile_in_its_own_row():
+    scenario = packaged_scenario_path("crowded_field.yaml")
+    short = ("world.duration=4.0",)
+    runs = [
+        fly(ControllerCase(scenario, name, 3, short, profile))
+        for profile in ("ideal", "realistic")
+        for name in ("elastic", "pd")
+    ]
+    ideal, realistic = runs[0], runs[2]
+    assert (ideal.sensors, realistic.sensors) == ("ideal", "realistic")
+    # Under realistic sensing the collector flies on the tracker's tracks and the
+    # localiser's attitude readings: another flight than on the truth.
+    assert realistic.delta_v != ideal.delta_v
+    rows = [line.split("|")[1:3] for line in markdown_table(runs).splitlines()[2:]]
+    assert [(a.strip(), b.strip()) for a, b in rows] == [
+        ("elastic", "ideal"),
+        ("elastic", "realistic"),
+        ("pd", "ideal"),
+        ("pd", "realistic"),
+    ]

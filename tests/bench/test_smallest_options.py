@@ -50,11 +50,15 @@ SMALLEST = {
         *("--plot", "{tmp}/dynamics.png"),
     ],
     "campaign": ["--cases", "1", "--workers", "1", "--duration", "0.01", "--out", "{tmp}/cases"],
-    # One controller; the crowded field's whole crossing takes 35 s, 10 s of it do here.
+    # One controller under one profile; the crowded field's whole crossing takes 35 s,
+    # 10 s of it do here.
     "controllers": [
-        *("--seeds", "1", "--controllers", "pd", "--workers", "1", "--worker-deaths", "1"),
+        *("--seeds", "1", "--controllers", "pd", "--sensors", "realistic"),
+        *("--workers", "1", "--worker-deaths", "1"),
         *("--set", "world.duration=10", "--plot", "{tmp}/gaps.png"),
     ],
+    # One seed of the default and the crowded-field scenarios, a second of each.
+    "tracking": ["--seeds", "1", "--duration", "1"],
     # About 9 s whatever the options: the thesis's two application cases are flown.
     "q-learning": [
         *("--scenario", str(SCENARIOS / "space_manipulator_reach.yaml"), "--episodes", "1"),

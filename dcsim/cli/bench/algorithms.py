@@ -1,5 +1,6 @@
 """Benches of the built-in localisers (``localisers``), task planners
-(``task-planners``) and controllers (``controllers``) against their references."""
+(``task-planners``), controllers (``controllers``) and tracker (``tracking``) against
+their references."""
 
 from __future__ import annotations
 
@@ -64,9 +65,16 @@ def bench_localisers_command(
 
 
 @click.command(
-    "task-planners", short_help="ga's time strategies; task planners' gaps to the optimum."
+    "task-planners",
+    short_help="ga's time strategies; task planners' gaps to the optimum; tracked targets.",
 )
-@count_option("--instances", 100, "Random instances per problem size (both studies).")
+@click.option(
+    "--studies",
+    default="gaps,strategies,tracked",
+    show_default=True,
+    help="Comma-separated studies to run: gaps, strategies, tracked.",
+)
+@count_option("--instances", 100, "Random instances per problem size (gaps and strategies).")
 @count_option(
     "--moving-instances",
     50,
@@ -78,6 +86,10 @@ def bench_localisers_command(
 )
 @count_option("--dispersion-instances", 5, "Instances whose dispersion is measured.")
 @positive_option("--grid-step", 10.0, "Time grid of the moving-target optimum, s.")
+@count_option(
+    "--tracked-instances", 50, "Moving instances per size planned from the truth and from tracks."
+)
+@positive_option("--observation", 10.0, "Time the object sensor watches before planning, s.")
 @click.option(
     "--plots",
     "plot_dir",
@@ -85,18 +97,25 @@ def bench_localisers_command(
     help="Save task_planner_strategies.png and task_planner_gaps.png here.",
 )
 def bench_task_planners_command(
+    studies: str,
     instances: int,
     moving_instances: int,
     repeats: int,
     dispersion_instances: int,
     grid_step: float,
+    tracked_instances: int,
+    observation: float,
     plot_dir: Path | None,
 ) -> None:
-    """The ga planner's time strategies (thesis ch. 3) and task planners' gaps to the optimum.
+    """The ga planner's time strategies (thesis ch. 3), task planners' gaps to the
+    optimum, and their plans from tracked targets.
 
-    Time strategies: 5, 10 and 15 moving targets. Gaps: stationary targets with 5, 7, 9
-    and 11 (exact Held-Karp optimum), moving targets with 5 and 7 (optimum over a time
-    grid of 2500 s). Prints Markdown tables for docs/benchmarks.md.
+    Gaps: stationary targets with 5, 7, 9 and 11 (exact Held-Karp optimum), moving
+    targets with 5 and 7 (optimum over a time grid of 2500 s). Time strategies: 5, 10
+    and 15 moving targets. Tracked: 5 and 10 moving targets planned from their true
+    motions and from the kalman tracker's tracks of the object sensor's detections
+    (realistic profile) after --observation seconds, each plan flown against the truth.
+    Prints Markdown tables for docs/benchmarks.md.
     """
     from dcsim.bench.task_planners import (
         compare_strategies,
@@ -105,18 +124,36 @@ def bench_task_planners_command(
         plot_gaps,
         plot_strategies,
         strategy_table,
+        tracked_table,
+        tracked_targets,
     )
 
-    gaps = optimality_gaps(
-        (5, 7, 9, 11), (5, 7), instances, moving_instances, grid_step, 2500.0, progress
-    )
-    click.echo(gap_table(gaps) + "\n")
-    strategies = compare_strategies((5, 10, 15), instances, repeats, dispersion_instances, progress)
-    click.echo(strategy_table(strategies, repeats))
+    chosen = comma_words(studies, "--studies")
+    unknown = sorted(set(chosen) - {"gaps", "strategies", "tracked"})
+    if unknown:
+        raise click.BadParameter(
+            f"{', '.join(unknown)}: choose among gaps, strategies, tracked", param_hint="--studies"
+        )
     if plot_dir is not None:
         plot_dir.mkdir(parents=True, exist_ok=True)
-        plot_gaps(gaps, plot_dir / "task_planner_gaps.png")
-        plot_strategies(strategies, plot_dir / "task_planner_strategies.png")
+    if "gaps" in chosen:
+        gaps = optimality_gaps(
+            (5, 7, 9, 11), (5, 7), instances, moving_instances, grid_step, 2500.0, progress
+        )
+        click.echo(gap_table(gaps) + "\n")
+        if plot_dir is not None:
+            plot_gaps(gaps, plot_dir / "task_planner_gaps.png")
+    if "strategies" in chosen:
+        strategies = compare_strategies(
+            (5, 10, 15), instances, repeats, dispersion_instances, progress
+        )
+        click.echo(strategy_table(strategies, repeats) + "\n")
+        if plot_dir is not None:
+            plot_strategies(strategies, plot_dir / "task_planner_strategies.png")
+    if "tracked" in chosen:
+        tracked = tracked_targets((5, 10), tracked_instances, observation, progress)
+        click.echo(tracked_table(tracked))
+    if plot_dir is not None:
         click.echo(f"plots: {plot_dir}")
 
 
@@ -131,6 +168,12 @@ def bench_task_planners_command(
     show_default=True,
     help="Comma-separated controller plugins (default parameters).",
 )
+@click.option(
+    "--sensors",
+    default="ideal,realistic",
+    show_default=True,
+    help="Comma-separated sensing profiles (sensors.profile) every controller flies under.",
+)
 @cluster_options
 @overrides_option("Override a value of the crowded-field scenario, as for dcsim run. Repeatable.")
 @plot_option("Save the distribution of the closest approach here.")
@@ -138,6 +181,7 @@ def bench_controllers_command(
     seeds: int,
     first_seed: int,
     controllers: str,
+    sensors: str,
     scheduler: str | None,
     connect_timeout: float | None,
     workers: int | None,
@@ -147,7 +191,9 @@ def bench_controllers_command(
 ) -> None:
     """Controllers crossing scenarios/crowded_field.yaml, a fresh field of 60 obstacles per seed.
 
-    Reports per controller the runs with a collision, the closest approach to any
+    Every controller flies every field under each sensing profile (ideal: exact tracks
+    of the obstacles; realistic: the tracker's tracks from the object sensor). Reports
+    per controller and profile the runs with a collision, the closest approach to any
     obstacle, delta-v and mission time as a Markdown table for docs/benchmarks.md.
     The runs are campaign cases on Dask (a local cluster unless --scheduler).
     """
@@ -156,10 +202,17 @@ def bench_controllers_command(
 
     scenario = packaged_scenario_path("crowded_field.yaml")
     names = comma_words(controllers, "--controllers")
+    profiles = comma_words(sensors, "--sensors")
     registry = PluginRegistry.discover()
-    for name in names:  # unknown controllers and bad overrides fail here, before any run
-        chosen = [f"controller.plugin={name}", "controller.params={}", *overrides]
-        safety = _safety_distance(scenario, chosen, registry)
+    for name in names:  # unknown names and bad overrides fail here, before any run
+        for profile in profiles:
+            chosen = [
+                f"controller.plugin={name}",
+                "controller.params={}",
+                f"sensors.profile={profile}",
+                *overrides,
+            ]
+            safety = _safety_distance(scenario, chosen, registry)
     runs = bench_controllers(
         scenario,
         names,
@@ -167,6 +220,7 @@ def bench_controllers_command(
         overrides,
         cluster_choice(scheduler, workers, worker_deaths, connect_timeout),
         progress=progress,
+        sensors=profiles,
     )
     click.echo(markdown_table(runs))
     if plot_path is not None:
@@ -191,3 +245,40 @@ def _safety_distance(scenario: Path, overrides: list[str], registry: PluginRegis
             param_hint="--set",
         )
     return mission.safety_distance
+
+
+@click.command("tracking", short_help="The tracker's tracks against the truth in the closed loop.")
+@click.argument("scenarios", nargs=-1, type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@count_option("--seeds", 3, "World seeds flown per scenario.")
+@count_option("--first-seed", 0, "Seed of the first run (seeds FIRST to FIRST + N - 1).", minimum=0)
+@click.option(
+    "--duration",
+    type=click.FloatRange(min=0, min_open=True),
+    help="Simulated seconds at most per run, s  [default: the scenario's world.duration]",
+)
+@overrides_option("Override a value of every scenario, as for dcsim run. Repeatable.")
+def bench_tracking_command(
+    scenarios: tuple[Path, ...],
+    seeds: int,
+    first_seed: int,
+    duration: float | None,
+    overrides: tuple[str, ...],
+) -> None:
+    """The tracker's consistency in the closed loop, under sensors.profile=realistic.
+
+    Flies each SCENARIO (default: the packaged default.yaml and crowded_field.yaml) on
+    every seed and compares, each control tick, every track of a free object the
+    mission sees with the object's true state: the position and velocity NEES, the
+    fraction of track-ticks inside the 3-sigma bound (chi-square, 3 dof, 0.9973) and
+    the RMS errors. Prints a Markdown table for docs/benchmarks.md.
+    """
+    from dcsim.bench.tracking import bench_tracking, markdown_table
+    from dcsim.scenario import packaged_scenario_path
+
+    chosen = scenarios or tuple(
+        packaged_scenario_path(name) for name in ("default.yaml", "crowded_field.yaml")
+    )
+    runs = bench_tracking(
+        chosen, range(first_seed, first_seed + seeds), duration, overrides, progress=progress
+    )
+    click.echo(markdown_table(runs))
