@@ -5,13 +5,14 @@ Detections carry the object's identity, so a detection updates the track of its 
 and an ``id`` without a track starts one.
 
 Measurement
-    The absolute position ``z = robot.position + detection.relative_position``, with
-    covariance ``detection.covariance + robot.covariance[:3, :3]``. This treats the
-    robot's position error as independent of the object's and white from one detection
-    to the next; in truth it is common to every object seen at one tick and wanders
-    slowly with the localiser, so the tracks are somewhat overconfident about the part
-    of their error that is the robot's (an approximation every tracker built on a
-    separate localiser makes).
+    The absolute position ``z = robot.position + detection.relative_position``, filtered
+    with the detection's own covariance. The robot's error enters every detection of a
+    tick alike and wanders slowly with the localiser, so filtering cannot average it
+    away: it is left out of the filter, and each track carries apart the robot's
+    covariance (position and velocity) at its latest accepted detection, moved by the
+    frame's motion since, which is added to the filter's covariance when the track is
+    answered (a "consider" covariance). Taken instead as white noise on each detection,
+    it would be averaged away and leave the tracks overconfident.
 Prediction
     The frame's free motion: the Clohessy–Wiltshire state transition with the frame's
     mean motion in an LVLH frame (under a ``two-body`` or ``j2`` world this is the
@@ -148,6 +149,8 @@ class KalmanTracker(Tracker):
         self._ids = np.zeros(0, dtype=np.int64)
         self._states = _frozen(np.zeros((0, 6)))
         self._covariances = _frozen(np.zeros((0, 6, 6)))
+        self._robot_parts = np.zeros((0, 6, 6))
+        self._robot_now = np.zeros((6, 6))
         self._last_seen = np.zeros(0)
         self._details: list[_Details] = []
         self._described_as: dict[tuple[ObjectKind, float, float, int], _Details] = {}
@@ -174,6 +177,7 @@ class KalmanTracker(Tracker):
         phi, noise = self._transition(dt)
         self._states = _frozen(self._states @ phi.T)
         self._covariances = _frozen(_symmetric(phi @ self._covariances @ phi.T + noise))
+        self._robot_parts = phi @ self._robot_parts @ phi.T
 
     def _transition(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """The state transition (6, 6) and process noise covariance (6, 6) over ``dt``
@@ -198,10 +202,11 @@ class KalmanTracker(Tracker):
 
     def _fold(self, detections: Sequence[Detection], robot: StateEstimate) -> None:
         """Update the detected tracks (gated), start tracks for new objects."""
+        self._robot_now = _base_covariance(robot)
         ids, first = np.unique([d.id for d in detections], return_index=True)
         chosen = [detections[i] for i in first]  # one detection per object
         measured = robot.position + np.array([d.relative_position for d in chosen])
-        noise = np.array([d.covariance for d in chosen]) + robot.covariance[:3, :3]
+        noise = np.array([d.covariance for d in chosen])
         slots = np.searchsorted(self._ids, ids)
         known = slots < len(self._ids)
         known[known] = self._ids[slots[known]] == ids[known]
@@ -244,6 +249,7 @@ class KalmanTracker(Tracker):
             + gain @ noise @ gain.transpose(0, 2, 1)
         )
         self._states, self._covariances = _frozen(new_states), _frozen(new_covariances)
+        self._robot_parts[slots] = self._robot_now
         self._last_seen[slots] = self.time
         for slot, index in zip(slots.tolist(), np.flatnonzero(accepted).tolist(), strict=True):
             self._details[slot] = self._described(detections[index])
@@ -264,6 +270,8 @@ class KalmanTracker(Tracker):
         self._ids = all_ids[order]
         self._states = _frozen(np.concatenate([self._states, states])[order])
         self._covariances = _frozen(np.concatenate([self._covariances, covariances])[order])
+        robot_parts = np.broadcast_to(self._robot_now, covariances.shape)
+        self._robot_parts = np.concatenate([self._robot_parts, robot_parts])[order]
         self._last_seen = np.concatenate([self._last_seen, np.full(len(ids), self.time)])[order]
         details = self._details + [self._described(d) for d in detections]
         self._details = [details[i] for i in order.tolist()]
@@ -276,6 +284,7 @@ class KalmanTracker(Tracker):
         self._ids, self._last_seen = self._ids[live], self._last_seen[live]
         self._states = _frozen(self._states[live])
         self._covariances = _frozen(self._covariances[live])
+        self._robot_parts = self._robot_parts[live]
         self._details = [d for d, keep in zip(self._details, live.tolist(), strict=True) if keep]
 
     # ------------------------------------------------------------------ answers
@@ -299,8 +308,10 @@ class KalmanTracker(Tracker):
         return LinearMotion(state[:3], state[3:], epoch=self.time)
 
     def _tracks(self) -> tuple[ObjectTrack, ...]:
-        """Every live track as a message (its arrays read-only views of the filter's)."""
-        states, covariances = self._states, self._covariances
+        """Every live track as a message, its covariance the filter's plus the robot's
+        part (its state arrays read-only views of the filter's)."""
+        states = self._states
+        covariances = _frozen(self._covariances + self._robot_parts)
         return tuple(
             ObjectTrack.trusted(
                 id=track_id,
@@ -323,6 +334,15 @@ class KalmanTracker(Tracker):
 def _symmetric(matrices: np.ndarray) -> np.ndarray:
     """``matrices`` (..., k, k) made exactly symmetric (their mean with their transposes)."""
     return 0.5 * (matrices + np.swapaxes(matrices, -1, -2))
+
+
+def _base_covariance(robot: StateEstimate) -> np.ndarray:
+    """The covariance (6, 6) of the robot base's position and velocity in ``robot``'s
+    (its leading block; zeros where the estimate gives fewer states)."""
+    covariance = np.zeros((6, 6))
+    size = min(6, len(robot.covariance))
+    covariance[:size, :size] = robot.covariance[:size, :size]
+    return covariance
 
 
 def _frozen(array: np.ndarray) -> np.ndarray:

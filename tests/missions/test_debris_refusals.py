@@ -31,3 +31,20 @@ def test_the_run_stops_with_the_planners_reason(registry, attempts):
     assert summary["goal_met"] is False
     retry = runner.scenario.mission.path_retry
     assert summary["sim_time_s"] < attempts * retry + 1.0
+
+
+def test_a_pickup_without_a_path_is_planned_anew_from_the_tracks_then(registry):
+    overrides = ["path_planner={plugin: ompl-geometric}", "mission.max_plan_attempts=2"]
+    runner = Runner(setup_run(None, overrides, registry=registry))
+    runner.run()
+    events = runner.recorder.events
+    refused = next(i for i, e in enumerate(events) if e["event"] == "no_path")
+    after = events[refused + 1 :]
+    replanned = next(
+        i for i, e in enumerate(after) if e["event"] == "mode" and e["mode"] == "DEVISE_PLAN"
+    )
+    assert after[replanned]["reason"] == "no path to the pickup"
+    assert after[replanned]["t"] >= events[refused]["t"] + runner.scenario.mission.path_retry
+    assert [e["event"] for e in after[replanned + 1 :] if e["event"] in ("plan", "no_path")][
+        :2
+    ] == ["plan", "no_path"], "the tasks are planned afresh before the path is asked again"

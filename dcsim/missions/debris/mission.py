@@ -125,6 +125,7 @@ class DebrisMission(Mission):
         self.release_refused = False
         self.refusals = 0
         self.refusal = ""
+        self.pickup_refused = False
         self.time = 0.0
         self.attitude = _held_attitude(scenario, self.settings.attitude)
         self._handlers: dict[Mode, Callable[[], Reference]] = {
@@ -342,6 +343,7 @@ class DebrisMission(Mission):
             target_at_pickup = track.predict(step.pickup_time)[0]
             self.approach = unit(self.estimate.position - target_at_pickup)
             self.retry_at = -np.inf
+            self.pickup_refused = False
             self._go(Mode.MOVE_TO_NEXT, f"pickup of target {step.target_id}")
         return self._holding()
 
@@ -376,11 +378,15 @@ class DebrisMission(Mission):
             self._go(Mode.DEVISE_PLAN, f"new target {newcomer.id} in sight")
             return self._holding()
         if self.trajectory is None and self.time >= self.retry_at:
+            if self.pickup_refused:  # the pickup as planned has no path: plan the tasks anew
+                self._go(Mode.DEVISE_PLAN, "no path to the pickup")
+                return self._holding()
             goal_position, goal_velocity = self._standoff(track, task.pickup_time)
             arrive = task.pickup_time if task.pickup_time > self.time else None
             self.trajectory = self._plan_path(
                 GoalRegion(goal_position, 0.5 * self.settings.reach, goal_velocity, arrive)
             )
+            self.pickup_refused = self.trajectory is None
         if self.trajectory is None:
             if self.world.carried_ids():
                 self.steps.clear()  # deliver what is on board, then plan afresh
