@@ -125,10 +125,12 @@ def _stack(models: Sequence[Any], name: str) -> np.ndarray:
 
 
 def _vec3(values: ArrayLike) -> tuple[float, float, float]:
-    if type(values) is list and len(values) == 3 and all(type(v) is float for v in values):
-        x, y, z = values  # floats already (an array's tolist())
-    else:
-        x, y, z = np.asarray(values, dtype=float).reshape(3).tolist()
+    """Three floats from ``values`` (a tuple of three floats is kept as it is)."""
+    if type(values) is tuple and len(values) == 3:
+        x, y, z = values
+        if type(x) is float and type(y) is float and type(z) is float:
+            return values
+    x, y, z = np.asarray(values, dtype=float).reshape(3).tolist()
     return (x, y, z)
 
 

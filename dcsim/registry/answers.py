@@ -198,7 +198,7 @@ def _all_finite(items: tuple[Any, ...]) -> bool:
         for value in item.__dict__.values():
             kind = type(value)
             if kind is np.ndarray:
-                arrays.append(value.ravel())
+                arrays.append(value)
             elif kind is float or kind is int:
                 total += value
             elif kind is tuple:
@@ -207,7 +207,7 @@ def _all_finite(items: tuple[Any, ...]) -> bool:
                 total += value
     if not math.isfinite(total):
         return False
-    return not arrays or bool(np.isfinite(np.concatenate(arrays)).all())
+    return not arrays or bool(np.isfinite(np.concatenate(arrays, axis=None)).all())
 
 
 def _non_finite(message: Any) -> str | None:

@@ -303,9 +303,10 @@ class KalmanTracker(Tracker):
     def _motion(self, state: list[float]) -> MotionModel:
         """The frame's free motion from ``state`` ``[position, velocity]`` at the current
         time."""
+        position, velocity = tuple(state[:3]), tuple(state[3:])
         if self._mean_motion > 0:
-            return ClohessyWiltshireMotion(state[:3], state[3:], self._mean_motion, epoch=self.time)
-        return LinearMotion(state[:3], state[3:], epoch=self.time)
+            return ClohessyWiltshireMotion(position, velocity, self._mean_motion, epoch=self.time)
+        return LinearMotion(position, velocity, epoch=self.time)
 
     def _tracks(self) -> tuple[ObjectTrack, ...]:
         """Every live track as a message, its covariance the filter's plus the robot's
