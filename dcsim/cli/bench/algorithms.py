@@ -66,7 +66,7 @@ def bench_localisers_command(
 
 @click.command(
     "task-planners",
-    short_help="ga's time strategies; task planners' gaps to the optimum; tracked targets.",
+    short_help="Task planners: optimality gaps, strategies, tracked targets.",
 )
 @click.option(
     "--studies",
