@@ -158,8 +158,8 @@ class World:
         The world's generator (beacon range noise; the other sensor models draw from
         their own, :func:`~dcsim.world.sensors.build_sensor_models`).
     registry : PluginRegistry, optional
-        Where the scenario's sensor models are found; discovered from the installed
-        packages if None.
+        Where the scenario's sensor models are found; the installed packages' (found
+        once per process) if None.
 
     Attributes
     ----------

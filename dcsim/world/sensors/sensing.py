@@ -11,6 +11,7 @@ exact tracks of the objects in sensor range (each with its true shape and motion
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping
 
 import numpy as np
@@ -40,7 +41,7 @@ def build_sensor_models(
     scenario: Scenario, rng: np.random.Generator, registry: PluginRegistry | None = None
 ) -> dict[str, SensorModel]:
     """Construct the scenario's sensor models, by sensor (those that report the truth
-    are left out).
+    are left out), from ``registry`` (the installed plugins, found once, if None).
 
     Each has its own generator from the scenario seed (``sensors.<sensor>``), but the
     beacon range sensor draws from ``rng``, the world's generator, as beacon noise
@@ -56,7 +57,7 @@ def build_sensor_models(
     """
     from dcsim.errors import PluginError
 
-    registry = registry if registry is not None else PluginRegistry.discover()
+    registry = registry if registry is not None else _installed()
     models: dict[str, SensorModel] = {}
     for slot, choice in sensor_choices(scenario.sensors).items():
         if choice is None:
@@ -74,6 +75,13 @@ def build_sensor_models(
         )
         models[slot] = cls(choice.params, generator)  # type: ignore[assignment]
     return models
+
+
+@functools.cache
+def _installed() -> PluginRegistry:
+    """The installed plugins, discovered once per process for the worlds built without a
+    registry (a run passes its own)."""
+    return PluginRegistry.discover()
 
 
 class Sensing:
