@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import subprocess
 import sys
 import time
@@ -290,4 +291,8 @@ def test_a_deadline_sooner_than_the_budget_is_the_budget_the_answer_quotes():
         small_problem(time_budget=5.0, obstacles=wall), deadline=time.monotonic() + 0.3
     )
     answer = plan(problem, controls="discrete")
-    assert isinstance(answer, NoPath) and "within the 0.3 s budget" in answer.reason
+    assert isinstance(answer, NoPath)
+    # The time left when the planner starts, a little under 0.3 s (less on a busy
+    # machine), not the problem's 5 s time_budget.
+    quoted = re.search(r"within the ([0-9.]+) s budget", answer.reason)
+    assert quoted is not None and 0.2 < float(quoted.group(1)) <= 0.3, answer.reason
