@@ -1,7 +1,9 @@
 """The default scenario flown with ``ga`` against the ``nearest`` baseline over 20 seeds.
 
 Each seed is a test group of its own, so that pytest-xdist spreads the 40 runs over
-its workers; the checks hold on every seed when they pass for each.
+its workers; the checks hold on every seed when they pass for each. The first
+``QUICK_SEEDS`` are in ``make test``; the rest of the sweep is in the slow group
+(``make test-slow``).
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from dcsim.run.loop import Runner
 from dcsim.run.setup import setup_run
 
 SEEDS = range(20)
+QUICK_SEEDS = 5
 
 
 def fly(planner: str, seed: int) -> dict:
@@ -23,7 +26,12 @@ def fly(planner: str, seed: int) -> dict:
 @pytest.fixture(
     scope="module",
     params=[
-        pytest.param(seed, id=f"seed{seed}", marks=pytest.mark.xdist_group(f"ga-seed{seed}"))
+        pytest.param(
+            seed,
+            id=f"seed{seed}",
+            marks=[pytest.mark.xdist_group(f"ga-seed{seed}")]
+            + ([] if seed < QUICK_SEEDS else [pytest.mark.slow]),
+        )
         for seed in SEEDS
     ],
 )
