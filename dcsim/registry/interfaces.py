@@ -203,7 +203,7 @@ class Localiser(Plugin):
     def update_attitude(self, attitude: AttitudeReading | None, rate: RateReading | None) -> None:  # noqa: B027 - a hook a localiser may leave alone
         """Correct the attitude belief with the star tracker's and the gyros' readings
         made now (None when a sensor gave none). Called each tick after :meth:`update`
-        when sensing is not ideal; ignored unless :attr:`estimates_attitude`."""
+        when :attr:`estimates_attitude` and the attitude sensors are not ideal."""
 
 
 class TaskPlanner(Plugin):

@@ -491,14 +491,20 @@ class Runner:
         if world.time > 0:
             call_plugin(plugins, "localiser", "predict", world.motion_input(), world.control_period)
         call_plugin(plugins, "localiser", "update", list(observations.ranges))
-        localiser = cast(Localiser, plugins["localiser"])
-        if observations.star_tracker is None and observations.gyros is None:
-            return _with_readings(call_plugin(plugins, "localiser", "estimate"), observations)
-        call_plugin(
-            plugins, "localiser", "update_attitude", observations.star_tracker, observations.gyros
+        own_attitude = (
+            cast(Localiser, plugins["localiser"]).estimates_attitude
+            and not world.sensing.ideal_attitude
         )
+        if own_attitude:
+            call_plugin(
+                plugins,
+                "localiser",
+                "update_attitude",
+                observations.star_tracker,
+                observations.gyros,
+            )
         estimate = call_plugin(plugins, "localiser", "estimate")
-        return estimate if localiser.estimates_attitude else _with_readings(estimate, observations)
+        return estimate if own_attitude else _with_readings(estimate, observations)
 
     def _tracked(
         self, t: float, observations: Observations, estimate: StateEstimate

@@ -43,7 +43,7 @@ from dcsim.scenario.model import (
     SensorsSection,
     scenario_model,
 )
-from dcsim.scenario.sensors import sensor_choices
+from dcsim.scenario.sensors import sensor_choices, sensor_model_class
 
 DEFAULT_SCENARIO = "default.yaml"
 
@@ -271,7 +271,7 @@ def _resolve_sensors(
         if choice is None:
             continue
         try:
-            cls = registry.get("sensor", choice.model).cls
+            cls = sensor_model_class(registry, slot, choice.model)
             params = cls.Params.parse(choice.model, choice.params)
         except PluginParameterError as exc:
             problems += [
@@ -280,15 +280,6 @@ def _resolve_sensors(
             continue
         except DcsimError as exc:
             problems.append(doc.problem(("sensors", slot, "model"), str(exc)))
-            continue
-        measures = getattr(cls, "measures", None)
-        if measures != slot:
-            problems.append(
-                doc.problem(
-                    ("sensors", slot, "model"),
-                    f"sensor model '{choice.model}' measures {measures}, not {slot}",
-                )
-            )
             continue
         resolved[slot] = choice.model_copy(update={"params": params.model_dump(mode="json")})
     return scenario.sensors.model_copy(update=resolved), problems

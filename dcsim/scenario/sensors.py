@@ -20,8 +20,14 @@ The realistic profile's numbers and their sources:
 
 from __future__ import annotations
 
-from dcsim.registry.interfaces import SENSOR_SLOTS
+from typing import TYPE_CHECKING
+
+from dcsim.errors import PluginError
+from dcsim.registry.interfaces import SENSOR_SLOTS, SensorModel
 from dcsim.scenario.model import SensorChoice, SensorsSection
+
+if TYPE_CHECKING:
+    from dcsim.registry.discovery import PluginRegistry
 
 IDEAL: dict[str, SensorChoice | None] = {
     "beacon_ranges": SensorChoice(model="beacon-range"),
@@ -79,3 +85,22 @@ def _merged(given: SensorChoice | None, default: SensorChoice | None) -> SensorC
     if default is None or given.model != default.model:
         return given
     return given.model_copy(update={"params": {**default.params, **given.params}})
+
+
+def sensor_model_class(registry: PluginRegistry, slot: str, model: str) -> type[SensorModel]:
+    """The registered sensor model ``model``, checked to measure the sensor ``slot``.
+
+    Raises
+    ------
+    PluginNotFoundError
+        If no sensor model has that name.
+    PluginError
+        If it measures another sensor.
+    """
+    cls = registry.get("sensor", model).cls
+    measures = getattr(cls, "measures", None)
+    if measures != slot:
+        raise PluginError(
+            f"sensor model '{model}' measures {measures}, not {slot}: give it as sensors.{measures}"
+        )
+    return cls  # type: ignore[return-value]

@@ -153,7 +153,7 @@ class KalmanTracker(Tracker):
         self._robot_now = np.zeros((6, 6))
         self._last_seen = np.zeros(0)
         self._details: list[_Details] = []
-        self._described_as: dict[tuple[ObjectKind, float, float, int], _Details] = {}
+        self._spheres: dict[tuple[ObjectKind, float, float], _Details] = {}
         self._step: tuple[float, np.ndarray, np.ndarray] | None = None
 
     def update(
@@ -290,13 +290,16 @@ class KalmanTracker(Tracker):
     # ------------------------------------------------------------------ answers
     def _described(self, detection: Detection) -> _Details:
         """Kind, mass and shape of a detected object: the detection's shape, or a sphere
-        of its radius plus the margin (the same details shared while they stay)."""
-        key = (detection.kind, detection.mass, detection.radius, id(detection.shape))
-        details = self._described_as.get(key)
-        if details is None or details.shape is not (detection.shape or details.shape):
-            shape = detection.shape or Shape(radius=detection.radius + self.params.shape_margin)
-            details = self._described_as[key] = _Details(
-                detection.kind, detection.mass, shape, shape.bounding_radius
+        of its radius plus the margin (shared while a detection repeats them)."""
+        if detection.shape is not None:
+            shape = detection.shape
+            return _Details(detection.kind, detection.mass, shape, shape.bounding_radius)
+        key = (detection.kind, detection.mass, detection.radius)
+        details = self._spheres.get(key)
+        if details is None:
+            sphere = Shape(radius=detection.radius + self.params.shape_margin)
+            details = self._spheres[key] = _Details(
+                detection.kind, detection.mass, sphere, sphere.radius
             )
         return details
 

@@ -9,7 +9,14 @@ import numpy as np
 import pytest
 from dcsim_plugins.trackers.kalman import KalmanTracker
 
-from dcsim.api import AttitudeReading, Detection, PluginParams, RateReading, SensorModel
+from dcsim.api import (
+    AttitudeReading,
+    Detection,
+    PluginParams,
+    RateReading,
+    SensorModel,
+    quaternion_multiply,
+)
 from dcsim.testing import SensorModelContract, TrackerContract, check_plugin, checks_for
 
 
@@ -28,15 +35,7 @@ class TruthfulStarTracker(SensorModel):
         turn = self.rng.normal(0.0, 1e-5, 3)
         x, y, z = 0.5 * turn
         q = np.array([x, y, z, 1.0]) / np.sqrt(1.0 + x * x + y * y + z * z)
-        a = truth.attitude
-        attitude = np.array(
-            [
-                q[3] * a[0] + q[0] * a[3] + q[1] * a[2] - q[2] * a[1],
-                q[3] * a[1] - q[0] * a[2] + q[1] * a[3] + q[2] * a[0],
-                q[3] * a[2] + q[0] * a[1] - q[1] * a[0] + q[2] * a[3],
-                q[3] * a[3] - q[0] * a[0] - q[1] * a[1] - q[2] * a[2],
-            ]
-        )
+        attitude = quaternion_multiply(q, truth.attitude)
         return AttitudeReading(truth.time, attitude, np.full(3, 1e-5))
 
 

@@ -15,7 +15,7 @@ from dcsim.api import (
     quantity,
 )
 from dcsim.errors import ScenarioError
-from dcsim.geometry import rotate
+from dcsim.geometry import quaternion_multiply, rotate
 from dcsim.missions import scenario_roles
 from dcsim.params import PluginParams
 from dcsim.registry.discovery import PluginOrigin
@@ -49,12 +49,7 @@ class TiltedStarTracker(SensorModel):
             raise RuntimeError("lens cap on")
         if self.ticks % 2 == 0:
             return None
-        x, y, z, w = truth.attitude
-        a, b, c, d = TILT
-        q = np.array(
-            [w * a + x * d + y * c - z * b, w * b - x * c + y * d + z * a,
-             w * c + x * b - y * a + z * d, w * d - x * a - y * b - z * c]
-        )  # fmt: skip
+        q = quaternion_multiply(truth.attitude, TILT)
         return AttitudeReading(truth.time, q, sigma=[1e-5] * 3)
 
 
@@ -70,6 +65,20 @@ class SpinningGyros(SensorModel):
 
     def measure(self, truth):
         return RateReading(truth.time, [0.0, 0.0, 0.01], sigma=1e-6)
+
+
+class SlowGyros(SpinningGyros):
+    """Read on every other tick, as the tilted star tracker does (test)."""
+
+    name = "slow"
+    summary = "Gyros reading every other tick (test)"
+
+    def reset(self, setup):
+        self.ticks = 0
+
+    def measure(self, truth):
+        self.ticks += 1
+        return super().measure(truth) if self.ticks % 2 else None
 
 
 class WrongAnswerGyros(SpinningGyros):
@@ -95,7 +104,13 @@ class AttitudeEstimatingEKF(EKFLocaliser):
 
 def registry() -> PluginRegistry:
     found = PluginRegistry.discover()
-    for cls in (TiltedStarTracker, SpinningGyros, WrongAnswerGyros, AttitudeEstimatingEKF):
+    for cls in (
+        TiltedStarTracker,
+        SpinningGyros,
+        SlowGyros,
+        WrongAnswerGyros,
+        AttitudeEstimatingEKF,
+    ):
         found.register_class(cls, ORIGIN)
     return found
 
@@ -150,7 +165,13 @@ def test_gyro_readings_become_the_estimate_s_rate_in_the_world_frame():
 
 
 def test_a_localiser_that_estimates_attitude_keeps_its_own():
-    runner = opened("sensors.star_tracker={model: tilted}", "localiser.plugin=ekf-attitude")
+    runner = opened(
+        "sensors.star_tracker={model: tilted}",
+        "sensors.gyros={model: slow}",
+        "localiser.plugin=ekf-attitude",
+    )
+    assert np.array_equal(runner.estimate.attitude, [0.0, 0.0, 0.0, 1.0])
+    runner.advance()  # a tick on which neither sensor reads: still its own
     assert np.array_equal(runner.estimate.attitude, [0.0, 0.0, 0.0, 1.0])
     assert runner.plugins["localiser"].readings == 1
     runner.close()

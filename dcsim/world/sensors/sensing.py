@@ -16,7 +16,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from dcsim.geometry import rotate, row_lengths
+from dcsim.geometry import quaternion_conjugate, rotate, row_lengths
 from dcsim.messages import (
     AttitudeReading,
     BeaconRange,
@@ -33,7 +33,7 @@ from dcsim.registry.discovery import PluginRegistry
 from dcsim.registry.interfaces import SENSOR_SLOTS, SensorModel
 from dcsim.run.seeding import component_rng
 from dcsim.scenario.model import Scenario, point_to_cartesian
-from dcsim.scenario.sensors import sensor_choices
+from dcsim.scenario.sensors import sensor_choices, sensor_model_class
 from dcsim.world.objects import ObjectField
 
 
@@ -55,25 +55,18 @@ def build_sensor_models(
         If a model measures another sensor than the one it is given for, or its
         parameters are invalid.
     """
-    from dcsim.errors import PluginError
-
     registry = registry if registry is not None else _installed()
     models: dict[str, SensorModel] = {}
     for slot, choice in sensor_choices(scenario.sensors).items():
         if choice is None:
             continue
-        cls = registry.get("sensor", choice.model).cls
-        if getattr(cls, "measures", None) != slot:
-            raise PluginError(
-                f"sensor model '{choice.model}' measures {getattr(cls, 'measures', None)!r}, "
-                f"not {slot}: give it as sensors.{getattr(cls, 'measures', slot)}"
-            )
+        cls = sensor_model_class(registry, slot, choice.model)
         generator = (
             rng
             if slot == "beacon_ranges"
             else component_rng(scenario.world.seed, f"sensors.{slot}")
         )
-        models[slot] = cls(choice.params, generator)  # type: ignore[assignment]
+        models[slot] = cls(choice.params, generator)
     return models
 
 
@@ -105,6 +98,8 @@ class Sensing:
         The sensor models by sensor.
     ideal_objects : bool
         Whether the object sensor reports the truth (exact tracks, no tracker).
+    ideal_attitude : bool
+        Whether the star tracker and the gyros both report the truth (no model).
     """
 
     def __init__(
@@ -120,12 +115,12 @@ class Sensing:
         self.models = {slot: models[slot] for slot in SENSOR_SLOTS if slot in models}
         self._roles = {f"sensors.{slot}": model for slot, model in self.models.items()}
         self.ideal_objects = "objects" not in self.models
-        self._ideal_attitude = "star_tracker" not in self.models and "gyros" not in self.models
+        self.ideal_attitude = "star_tracker" not in self.models and "gyros" not in self.models
         initial = scenario.robot.initial
         self._attitude = np.array(initial.attitude, dtype=float)
         self._attitude.setflags(write=False)
         self._body_rate = rotate(
-            _conjugate(self._attitude), np.array(initial.angular_velocity, dtype=float)
+            quaternion_conjugate(self._attitude), np.array(initial.angular_velocity, dtype=float)
         )
         setup = SensorSetup(
             control_period=scenario.world.control_period,
@@ -233,22 +228,18 @@ class Sensing:
         else:
             tracks = ()
             detections = call_plugin(self._roles, "sensors.objects", "measure", truth)
-        if self._ideal_attitude:
-            return Observations(
-                time=time,
-                ranges=ranges,
-                tracks=tracks,
-                attitude=attitude,
-                angular_velocity=angular_velocity,
-                detections=detections,
-            )
-        star, rate = self._attitude_readings(truth)
+        if self.ideal_attitude:
+            star = rate = None
+            seen_attitude, seen_rate = attitude, angular_velocity
+        else:
+            star, rate = self._attitude_readings(truth)
+            seen_attitude, seen_rate = self._attitude, rotate(self._attitude, self._body_rate)
         return Observations(
             time=time,
             ranges=ranges,
             tracks=tracks,
-            attitude=self._attitude,
-            angular_velocity=rotate(self._attitude, self._body_rate),
+            attitude=seen_attitude,
+            angular_velocity=seen_rate,
             detections=detections,
             star_tracker=star,
             gyros=rate,
@@ -269,16 +260,11 @@ class Sensing:
             rate = call_plugin(self._roles, "sensors.gyros", "measure", truth)
         else:
             rate = RateReading(
-                truth.time, rotate(_conjugate(truth.attitude), truth.angular_velocity)
+                truth.time, rotate(quaternion_conjugate(truth.attitude), truth.angular_velocity)
             )
         if rate is not None:
             self._body_rate = rate.angular_velocity
         return star, rate
-
-
-def _conjugate(q: np.ndarray) -> np.ndarray:
-    """The inverse rotation of the unit quaternion ``q`` ``[x, y, z, w]``."""
-    return np.array([-q[0], -q[1], -q[2], q[3]])
 
 
 _NO_OBJECTS = np.zeros((0, 3))
