@@ -102,13 +102,13 @@ def mission_types() -> dict[str, type[Mission]]:
 def scenario_roles(scenario: Scenario) -> tuple[str, ...]:
     """The plugin roles a scenario's run uses, in data-flow order.
 
-    Those its mission needs, the tracker when an object sensor has a model, and the
-    optional ones (``role_defaults`` of None in the
-    mission's settings) for which the scenario names a plugin.
+    Those its mission uses for which the scenario names a plugin (a role the mission's
+    ``role_defaults`` list may be null: none), and the tracker when an object sensor
+    has a model.
     """
     mission = mission_class(scenario.mission.type)
-    optional = [role for role, default in mission.Settings.role_defaults.items() if default is None]
-    used = set(mission.roles) | {role for role in optional if getattr(scenario, role) is not None}
+    roles = {*mission.roles, *mission.Settings.role_defaults}
+    used = {role for role in roles if getattr(scenario, role, None) is not None}
     if sensor_choices(scenario.sensors)["objects"] is not None:
         used.add("tracker")  # detections become tracks
     return tuple(role for role in PLUGIN_KINDS if role in used)

@@ -28,17 +28,25 @@ import math
 import sys
 import time as wallclock
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any, TypedDict, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from dcsim.errors import CwValidityWarning, PlannerModelWarning
 from dcsim.geometry import Vector, attitude_error
-from dcsim.messages import Command, Observations, Prior, Reference, StateEstimate
+from dcsim.messages import (
+    Command,
+    Observations,
+    Prior,
+    Reference,
+    StateEstimate,
+    Surroundings,
+)
 from dcsim.missions import Mission, mission_class
-from dcsim.registry.answers import ActuatorCounts
+from dcsim.registry.answers import ActuatorCounts, output_problem
 from dcsim.registry.calls import PluginFailure, call_plugin
 from dcsim.registry.hookspecs import RunInfo
 from dcsim.registry.interfaces import Localiser
@@ -162,6 +170,9 @@ class Runner:
         The scenario's mission, from :meth:`open` on.
     estimate : StateEstimate or None
         The estimate at the current time (the localiser's, with the attitude sensors').
+    surroundings : Surroundings or None
+        What the controller is told of its neighbourhood at the current time: the
+        tracked obstacles and the gap to keep from them.
     failure : PluginFailure or None
         The plugin failure that ended the run, if one did (its ``traceback`` is the
         plugin's own, when it raised).
@@ -201,11 +212,14 @@ class Runner:
         self.status: str | None = None
         self.reason = ""
         self.estimate: StateEstimate | None = None
+        self.surroundings: Surroundings | None = None
         self.outputs: dict[str, Any] = {}
         self.summary: dict[str, Any] = {}
         self.laps = LapTimer()
         self.failure: PluginFailure | None = None
         self._command = Command()
+        self._actuators = ActuatorCounts()
+        self._pending_row: dict[str, Any] | None = None
         self._reference: Reference | None = None
         self._robot_changes = 0
         self._started = 0.0
@@ -233,6 +247,12 @@ class Runner:
         if self.mission is None:
             raise RuntimeError("the run is not open: call open() first")
         return self.mission
+
+    @property
+    def reference(self) -> Reference | None:
+        """The mission's reference for the current control period (what the controller
+        tracks); None before :meth:`open`."""
+        return self._reference
 
     @property
     def mode(self) -> str | None:
@@ -282,11 +302,14 @@ class Runner:
         self,
         disturbance_force: np.ndarray | None = None,
         disturbance_torque: np.ndarray | None = None,
+        command: Command | Mapping[str, ArrayLike] | None = None,
     ) -> None:
-        """Fly the decided command for one control period, then decide the next.
+        """Fly one control period, then decide the next.
 
-        Once the run has ended the world coasts: the period is flown without thrust
-        and nothing more is recorded.
+        The period is flown with the controller's command, or with ``command`` in its
+        place (an agent's: a Gymnasium environment's step, a replay). Once the run has
+        ended the world coasts: the period is flown without thrust and nothing more is
+        recorded.
 
         Parameters
         ----------
@@ -295,6 +318,19 @@ class Runner:
             None).
         disturbance_torque : ndarray (3,), optional
             External torque on the collector over the period, world frame, N·m.
+        command : Command or mapping, optional
+            What the actuators apply over the period instead of the controller's
+            command: a :class:`~dcsim.messages.Command` replaces all of it; a mapping
+            of some of its fields to values (``{"force": [0.1, 0, 0]}``: world frame,
+            SI) replaces those fields, the controller's command giving the others (its
+            torque holding the attitude, say). It is recorded as the tick's command.
+
+        Raises
+        ------
+        ValueError
+            If ``command`` names a field a :class:`Command` does not have, or has
+            non-finite numbers or the wrong number of joint torques, thruster on-times
+            or wheel torques (nothing is flown).
         """
         disturbance_force = np.zeros(3) if disturbance_force is None else disturbance_force
         disturbance_torque = np.zeros(3) if disturbance_torque is None else disturbance_torque
@@ -307,6 +343,8 @@ class Runner:
             )
             self.outputs = world.outputs()
             return
+        if command is not None:
+            self._take_command(command)
         self._guarded(self._advance, disturbance_force, disturbance_torque)
 
     def close(self) -> dict[str, Any]:
@@ -400,6 +438,7 @@ class Runner:
 
     def _end(self, status: str, reason: str) -> None:
         self.status, self.reason = status, reason
+        self._commit_row()
 
     def _start(self) -> None:
         world = self._opened_world
@@ -461,7 +500,8 @@ class Runner:
         if world.robot_changes != self._robot_changes:  # a grab or a release
             self._robot_changes = world.robot_changes
             call_plugin(plugins, "controller", "reset", world.robot_spec())
-        surroundings = mission.surroundings(observations)
+        surroundings = self.surroundings = mission.surroundings(observations)
+        self._actuators = self._actuator_counts._replace(joints=len(observations.joint_positions))
         self._command = call_plugin(
             plugins,
             "controller",
@@ -470,7 +510,7 @@ class Runner:
             estimate,
             reference,
             surroundings,
-            actuators=self._actuator_counts._replace(joints=len(observations.joint_positions)),
+            actuators=self._actuators,
         )
         laps.lap("controller")
         self._record(t, estimate, mission.mode, self._command)
@@ -515,7 +555,40 @@ class Runner:
         )
         return Observations.trusted(**{**observations.__dict__, "tracks": tracks})
 
+    def _take_command(self, command: Command | Mapping[str, ArrayLike]) -> None:
+        """Fly ``command`` (all of it, or the fields it maps) instead of the controller's
+        this period, and record it as the tick's command."""
+        if isinstance(command, Command):
+            chosen = command
+        else:
+            unknown = sorted(set(command) - set(Command.__dataclass_fields__))
+            if unknown:
+                fields = ", ".join(Command.__dataclass_fields__)
+                raise ValueError(f"a Command has no field {', '.join(unknown)} (it has {fields})")
+            try:
+                values = {name: np.asarray(value, dtype=float) for name, value in command.items()}
+                chosen = dataclasses.replace(self._command, **values)
+            except (TypeError, ValueError) as error:
+                raise ValueError(f"the command is not a Command: {error}") from None
+        problem = output_problem("controller", "command", chosen, self._actuators)
+        if problem is not None:
+            raise ValueError(f"the command {problem.removeprefix('returned ')}")
+        self._command = chosen
+        self.outputs["command"] = chosen
+        if self._pending_row is not None:
+            self._pending_row.update(zip(("fx", "fy", "fz"), chosen.force.tolist(), strict=True))
+
+    def _commit_row(self) -> None:
+        """Record the current tick's telemetry row, its command now known."""
+        row, self._pending_row = self._pending_row, None
+        if row is None:
+            return
+        self.recorder.row(row)
+        if self._step_observed:
+            self._hook("dcsim_run_step", run=self.info, row=row)
+
     def _advance(self, disturbance_force: np.ndarray, disturbance_torque: np.ndarray) -> None:
+        self._commit_row()
         command = self._command
         inputs = WorldInputs(
             force=command.force,
@@ -558,15 +631,17 @@ class Runner:
     def _check_stop(self, t: float) -> None:
         stop = self.scenario.stop
         finished = self._opened_mission.finished()
-        if finished is not None:
-            raise _RunEnded(*finished)
-        if t >= self.scenario.world.duration - 1e-9:
-            raise _RunEnded("completed", "duration reached")
+        if finished is None and t >= self.scenario.world.duration - 1e-9:
+            finished = "completed", "duration reached"
         if (
-            stop.max_wall_time is not None
+            finished is None
+            and stop.max_wall_time is not None
             and wallclock.perf_counter() - self._started > stop.max_wall_time
         ):
-            raise _RunEnded("stopped", f"wall-time limit of {stop.max_wall_time:g} s reached")
+            finished = "stopped", f"wall-time limit of {stop.max_wall_time:g} s reached"
+        if finished is not None:
+            self._commit_row()  # the last row: no command follows
+            raise _RunEnded(*finished)
 
     def _prior(self) -> Prior:
         """The localiser's initial belief: the true start, blurred by the stated sigmas."""
@@ -606,15 +681,14 @@ class Runner:
             duty = out["thruster_duty"].tolist()
             row.update(zip(self._duty_columns, duty, strict=True))
         self._accumulate(out, estimate)
-        self.recorder.row(row)
-        if self._step_observed:
-            self._hook("dcsim_run_step", run=self.info, row=row)
+        self._pending_row = row
 
     def _record_final(self, mode: str) -> None:
         """Record the state reached by the last step (the run ends after it), with the
         last estimate (no new one is made)."""
         assert self.estimate is not None  # every control period's decision makes one
         self._record(self._opened_world.time, self.estimate, mode, Command())
+        self._commit_row()
 
     def _event(self, name: str, at: float | None = None, **data: Any) -> None:
         event = {"t": self._opened_world.time if at is None else at, "event": name, **data}

@@ -62,6 +62,8 @@ def _type_name(annotation: Any) -> str:
 
 def _default(model: type[BaseModel], name: str) -> str:
     info = model.model_fields[name]
+    if isinstance(info.default, PluginChoice):  # a mission's choice of a role's plugin
+        return f"`plugin: {info.default.plugin}`"
     if info.default_factory is not None:
         value = info.default_factory()  # type: ignore[call-arg]
         if isinstance(value, PluginChoice):

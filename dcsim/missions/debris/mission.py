@@ -16,6 +16,10 @@ enters sensor range, a grab fails, or a pickup can no longer be met. After
 up and the run ends ``stopped`` with the planner's reason. Every mode change, plan,
 grab, release and path failure is reported through the ``emit`` callback as an event.
 
+Without a path planner (``path_planner: null``) the collector is given the target's
+stand-off point, or the drop point, as it moves: the controller, or an agent flying
+through :meth:`~dcsim.run.loop.Runner.advance`, flies there directly.
+
 Every reference holds the collector's initial attitude, fixed in the world frame
 (``mission.attitude: hold``, the default), or leaves it free (``free``).
 """
@@ -249,6 +253,13 @@ class DebrisMission(Mission):
     def _new_target(self) -> ObjectTrack | None:
         return next((t for t in self._free_targets() if t.id not in self.planned), None)
 
+    @property
+    def plans_paths(self) -> bool:
+        """Whether a path planner is asked for the way to each target and to the drop
+        point; without one (``path_planner: null``) the references are the live
+        stand-off and drop-point states themselves."""
+        return "path_planner" in self.plugins
+
     def _plan_path(self, goal: GoalRegion, max_speed: float | None = None) -> Trajectory | None:
         """Ask the path planner for a way to ``goal`` at up to ``max_speed`` (the robot's)."""
         problem = PathProblem(
@@ -377,7 +388,7 @@ class DebrisMission(Mission):
         if newcomer is not None:
             self._go(Mode.DEVISE_PLAN, f"new target {newcomer.id} in sight")
             return self._holding()
-        if self.trajectory is None and self.time >= self.retry_at:
+        if self.trajectory is None and self.plans_paths and self.time >= self.retry_at:
             if self.pickup_refused:  # the pickup as planned has no path: plan the tasks anew
                 self._go(Mode.DEVISE_PLAN, "no path to the pickup")
                 return self._holding()
@@ -387,7 +398,7 @@ class DebrisMission(Mission):
                 GoalRegion(goal_position, 0.5 * self.settings.reach, goal_velocity, arrive)
             )
             self.pickup_refused = self.trajectory is None
-        if self.trajectory is None:
+        if self.trajectory is None and self.plans_paths:
             if self.world.carried_ids():
                 self.steps.clear()  # deliver what is on board, then plan afresh
                 self.visit = None
@@ -437,7 +448,7 @@ class DebrisMission(Mission):
 
     def _move_to_drop(self) -> Reference:
         drop = self.drop_point
-        if self.trajectory is None and self.time >= self.retry_at:
+        if self.trajectory is None and self.plans_paths and self.time >= self.retry_at:
             arrive = self.visit.time if self.visit and self.visit.time > self.time else None
             position, velocity = drop.state_at(self.time if arrive is None else arrive)
             self.trajectory = self._plan_path(

@@ -13,6 +13,7 @@ from dcsim.scenario.loader import Rule
 from dcsim.scenario.model import (
     MissionSettings,
     MotionSpec,
+    PluginChoice,
     Point,
     Section,
     SpaceObjectSpec,
@@ -43,6 +44,9 @@ class DropPointSection(Section):
 class DebrisMissionSection(MissionSettings):
     """How the executer flies the debris-collection mission (the thesis's §5.2 and §5.4)."""
 
+    role_defaults: ClassVar[dict[str, PluginChoice | None]] = {
+        "path_planner": PluginChoice(plugin="straight-line"),
+    }
     rules: ClassVar[tuple[Rule, ...]] = RULES
     targets_key: ClassVar[str | None] = "targets"
     moved_keys: ClassVar[dict[tuple[str, ...], tuple[str, ...]]] = {

@@ -135,7 +135,10 @@ class ReachMission(Mission):
         if self.state == "PLAN":
             self._plan(estimate.as_state())
         if self.joint_path is None:
-            return self._holding(estimate)
+            reference = self._holding(estimate)
+            if self.state == "REACH":  # no path planner: whatever drives the arm reaches
+                self._check_arrival(time, estimate)
+            return reference
         sample = self.joint_path.at(time)
         self.reference_end_effector = sample.end_effector
         base = self.base_reference
@@ -148,13 +151,19 @@ class ReachMission(Mission):
             joint_velocities=sample.rates,
             joint_accelerations=sample.accelerations,
         )
-        if time >= self.joint_path.end_time and self.reached_at is None:
-            distance = float(np.linalg.norm(self._end_effector(estimate) - self.target))
-            if distance <= self.settings.tolerance:
-                self.reached_at = time
-                self.emit("arrived", time_to_target=time, distance=distance)
-                self._go("ARRIVED")
+        if time >= self.joint_path.end_time:
+            self._check_arrival(time, estimate)
         return self.reference
+
+    def _check_arrival(self, time: float, estimate: StateEstimate) -> None:
+        """Say the target is reached, once, when the end effector is within tolerance."""
+        if self.reached_at is not None:
+            return
+        distance = float(np.linalg.norm(self._end_effector(estimate) - self.target))
+        if distance <= self.settings.tolerance:
+            self.reached_at = time
+            self.emit("arrived", time_to_target=time, distance=distance)
+            self._go("ARRIVED")
 
     def finished(self) -> tuple[str, str] | None:
         """Completed at the target; stopped when there is no path."""
@@ -173,8 +182,12 @@ class ReachMission(Mission):
     # ------------------------------------------------------------------ planning
     def _plan(self, start: RobotState) -> None:
         """Ask for the end effector's path and derive the joint references; the base is
-        to stay where it is."""
+        to stay where it is. Without a path planner (``path_planner: null``) the arm
+        holds its start until something else drives it (an agent's joint torques)."""
         self.base_reference = start
+        if "path_planner" not in self.plugins:
+            self._go("REACH")
+            return
         began = wallclock.perf_counter()
         result = self.call("path_planner", "plan", self._problem(start))
         self.planning_time += wallclock.perf_counter() - began

@@ -9,6 +9,10 @@ spheres) share this shape. Modes::
       │ ▼                  │
      HOLD ◄────────────────┘ (re-plans at once from the estimate)
 
+Without a path planner (``path_planner: null``) the reference is the goal region's
+centre from the start: the controller, or an agent flying through
+:meth:`~dcsim.run.loop.Runner.advance`, flies there in FLY.
+
 The path planner is asked once at the start and again from the current estimate when it
 said "no path" (after ``retry`` seconds) or when the estimate strays from the trajectory
 by more than ``tracking_tolerance``. The controller tracks the trajectory's full state
@@ -126,6 +130,9 @@ class TransferMission(Mission):
                 self.emit("arrived", time_to_goal=time)
             self._go("ARRIVED")
             return self._holding(state)
+        if "path_planner" not in self.plugins:
+            self._go("FLY")
+            return self._toward_goal(time)
         if self.trajectory is None and time >= self.retry_at:
             self._plan(state, observations)
         if self.trajectory is None:
@@ -231,6 +238,17 @@ class TransferMission(Mission):
             return self.goal.attitude
         initial = np.asarray(self.scenario.robot.initial.attitude, dtype=float)
         return initial / np.linalg.norm(initial)
+
+    def _toward_goal(self, time: float) -> Reference:
+        """The goal region's centre and velocity as the reference, attitude held: what
+        the controller (or an agent) flies at without a path planner."""
+        self.reference = Reference(
+            time=time,
+            position=self.goal.position,
+            velocity=self.goal.velocity,
+            attitude=self._held_attitude(),
+        )
+        return self.reference
 
     def _holding(self, state: RobotState) -> Reference:
         """Hold where the robot was when holding began, at rest, attitude held."""

@@ -88,7 +88,10 @@ class WeightsSection(Section):
 class TransferMissionSection(MissionSettings):
     """A transfer: from the robot's initial state to a goal region among obstacles."""
 
-    role_defaults: ClassVar[dict[str, PluginChoice | None]] = {"localiser": None}
+    role_defaults: ClassVar[dict[str, PluginChoice | None]] = {
+        "localiser": None,
+        "path_planner": PluginChoice(plugin="straight-line"),
+    }
 
     type: Literal["transfer"] = Field(
         "transfer", description="The mission type: a transfer to a goal region."
