@@ -64,6 +64,13 @@ def test_packaged_default_is_the_repository_default():
     assert read_scenario().name == "default"
 
 
+def test_every_packaged_scenario_is_its_repository_copy():
+    packaged = sorted(default_scenario_path().parent.glob("*.yaml"))
+    assert len(packaged) >= 5
+    for path in packaged:
+        assert path.read_text() == (REPO / "scenarios" / path.name).read_text(), path.name
+
+
 def test_resolution_fills_plugin_defaults(registry):
     scenario = read_scenario(registry=registry)
     assert scenario.controller.params == {
