@@ -1,5 +1,5 @@
-"""The Python examples of README.md, docs/python.md and docs/campaigns.md run as saved
-scripts, and a script that starts a campaign without its guard gets a dcsim error.
+"""The Python examples of README.md, docs/python.md, docs/campaigns.md and docs/gym.md run
+as saved scripts, and a script that starts a campaign without its guard gets a dcsim error.
 
 Each ```` ```python ```` block is saved as a script of its own and run with this
 environment's Python in a new process, in a folder of its own holding a copy of the
@@ -23,7 +23,7 @@ import pytest
 
 from tests.conftest import REPO
 
-DOCS = ("README.md", "docs/python.md", "docs/campaigns.md")
+DOCS = ("README.md", "docs/python.md", "docs/campaigns.md", "docs/gym.md")
 BLOCK = re.compile(r"```python\n(.*?)```", re.S)
 CAMPAIGN = Path("campaigns") / "default_dispersed.yaml"
 SHORTENED = {"cases: 40\n": "cases: 8\nset:\n  world.duration: 20.0\n"}
@@ -73,7 +73,19 @@ def test_every_document_has_its_python_examples():
     counts = {
         document: len(BLOCK.findall((REPO / document).read_text("utf-8"))) for document in DOCS
     }
-    assert counts == {"README.md": 1, "docs/python.md": 3, "docs/campaigns.md": 1}
+    assert counts == {
+        "README.md": 1,
+        "docs/python.md": 3,
+        "docs/campaigns.md": 1,
+        "docs/gym.md": 3,
+    }
+
+
+def test_the_gym_pages_command_example_prints_what_the_page_says(scenarios, tmp_path):
+    text = (REPO / "docs" / "gym.md").read_text("utf-8")
+    done = run_script(tmp_path, scenarios, BLOCK.findall(text)[-1])
+    assert done.returncode == 0, done.stderr
+    assert f"prints `{done.stdout.strip()}`" in text
 
 
 @pytest.mark.parametrize("code", examples())

@@ -219,7 +219,7 @@ class Runner:
         self.failure: PluginFailure | None = None
         self._command = Command()
         self._actuators = ActuatorCounts()
-        self._pending_row: dict[str, Any] | None = None
+        self._pending: tuple[float, StateEstimate, str] | None = None
         self._reference: Reference | None = None
         self._robot_changes = 0
         self._started = 0.0
@@ -573,19 +573,7 @@ class Runner:
         problem = output_problem("controller", "command", chosen, self._actuators)
         if problem is not None:
             raise ValueError(f"the command {problem.removeprefix('returned ')}")
-        self._command = chosen
-        self.outputs["command"] = chosen
-        if self._pending_row is not None:
-            self._pending_row.update(zip(("fx", "fy", "fz"), chosen.force.tolist(), strict=True))
-
-    def _commit_row(self) -> None:
-        """Record the current tick's telemetry row, its command now known."""
-        row, self._pending_row = self._pending_row, None
-        if row is None:
-            return
-        self.recorder.row(row)
-        if self._step_observed:
-            self._hook("dcsim_run_step", run=self.info, row=row)
+        self._command = self.outputs["command"] = chosen
 
     def _advance(self, disturbance_force: np.ndarray, disturbance_torque: np.ndarray) -> None:
         self._commit_row()
@@ -653,8 +641,30 @@ class Runner:
 
     # ------------------------------------------------------------------ records
     def _record(self, t: float, estimate: StateEstimate, mode: str, command: Command) -> None:
+        """Take the world's outputs of this tick, with its command; its telemetry row is
+        recorded once the command is sure (:meth:`_commit_row`)."""
         out = self.outputs = self._opened_world.outputs()
         out["command"] = command
+        held = None if self._reference is None else self._reference.attitude
+        out["attitude_error"] = math.nan if held is None else attitude_error(out["attitude"], held)
+        self._pending = t, estimate, mode
+
+    def _commit_row(self) -> None:
+        """Record the current tick's telemetry row, its command (``outputs["command"]``)
+        now known: the controller's, or what :meth:`advance` was given in its place."""
+        pending, self._pending = self._pending, None
+        if pending is None:
+            return
+        row = self._telemetry_row(*pending, self.outputs)
+        self._accumulate(self.outputs, pending[1])
+        self.recorder.row(row)
+        if self._step_observed:
+            self._hook("dcsim_run_step", run=self.info, row=row)
+
+    def _telemetry_row(
+        self, t: float, estimate: StateEstimate, mode: str, out: dict[str, Any]
+    ) -> dict[str, Any]:
+        """One tick's telemetry row from the world's outputs and the estimate."""
         row: dict[str, Any] = {"time": t}  # floats from tolist(): the same values, quicker
         row.update(zip(("x", "y", "z"), out["position"].tolist(), strict=True))
         row.update(zip(("vx", "vy", "vz"), out["velocity"].tolist(), strict=True))
@@ -668,20 +678,17 @@ class Runner:
             delta_v=out["delta_v"],
             nearest_obstacle=out["nearest_obstacle_distance"],
         )
-        row.update(zip(("fx", "fy", "fz"), command.force.tolist(), strict=True))
+        row.update(zip(("fx", "fy", "fz"), out["command"].force.tolist(), strict=True))
         row.update(zip(("wx", "wy", "wz"), out["angular_velocity"].tolist(), strict=True))
         row.update(zip(SIGMA_COLUMNS, _position_sigmas(estimate.covariance), strict=True))
-        held = None if self._reference is None else self._reference.attitude
-        row["attitude_error"] = math.nan if held is None else attitude_error(out["attitude"], held)
-        out["attitude_error"] = row["attitude_error"]
+        row["attitude_error"] = out["attitude_error"]
         if self._wheel_columns:
             momenta = out["wheel_momentum"].tolist()
             row.update(zip(self._wheel_columns, momenta, strict=True))
         if self._duty_columns:
             duty = out["thruster_duty"].tolist()
             row.update(zip(self._duty_columns, duty, strict=True))
-        self._accumulate(out, estimate)
-        self._pending_row = row
+        return row
 
     def _record_final(self, mode: str) -> None:
         """Record the state reached by the last step (the run ends after it), with the
