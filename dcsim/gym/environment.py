@@ -103,6 +103,7 @@ class MissionEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         self.progress_weight = float(progress_weight)
         self.runner: Runner | None = None
         self._collisions = 0
+        self._over = False
         self.observation_names = tuple(self._observation_names())
         self.action_names = tuple(self._action_names())
         self.observation_space = spaces.Box(
@@ -141,6 +142,7 @@ class MissionEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         assert self.runner.world is not None  # an open run has its world
         self.start_state = self.runner.world.robot_state()
         self._collisions = 0
+        self._over = False
         return self._observation(), self._info()
 
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
@@ -166,7 +168,7 @@ class MissionEnv(gymnasium.Env[np.ndarray, np.ndarray]):
             If the episode has ended (or none was started).
         """
         runner = self.runner
-        if runner is None or runner.ended:
+        if runner is None or runner.ended or self._over:
             raise EpisodeOver("the episode is over: call reset() to start another")
         clipped = np.clip(np.asarray(action, dtype=float), -1.0, 1.0)
         before = self._progress_state()
@@ -181,8 +183,7 @@ class MissionEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         reward += self._event_reward(before)
         terminated = goal_met or collided
         truncated = runner.ended and not terminated
-        if terminated and not runner.ended:
-            runner.close()  # ended by the environment: a collision the run does not stop on
+        self._over = terminated or truncated  # a collision the run goes on after ends it too
         return self._observation(), float(reward), terminated, truncated, self._info()
 
     def close(self) -> None:

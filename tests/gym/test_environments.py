@@ -147,14 +147,20 @@ def test_arriving_in_the_goal_region_terminates_with_the_goal_reward():
     env.close()
 
 
-def test_a_collision_terminates_with_the_penalty():
-    env = gymnasium.make("dcsim/Transfer-v0", attitude="controller")
+@pytest.mark.parametrize("stops", ["true", "false"])
+def test_a_collision_terminates_with_the_penalty_whether_or_not_the_run_stops_on_it(stops):
+    env = gymnasium.make(
+        "dcsim/Transfer-v0", overrides=[f"stop.on_collision={stops}"], attitude="controller"
+    )
     env.reset(seed=0)
     terminated = truncated = False
     while not (terminated or truncated):
-        _, reward, terminated, truncated, info = env.step(np.array([1.0, 0.0, 0.0]))
-    assert terminated and info["collisions"] == 1 and not info["goal_met"]
-    assert reward < -9.0 and info["reason"].startswith("collision")
+        observation, reward, terminated, truncated, info = env.step(np.array([1.0, 0.0, 0.0]))
+    assert terminated and info["collisions"] >= 1 and not info["goal_met"]
+    assert reward < -9.0 and np.isfinite(observation).all()
+    assert env.unwrapped.runner.ended == (stops == "true")
+    with pytest.raises(EpisodeOver):
+        env.step(np.zeros(3))
     env.close()
 
 
