@@ -141,6 +141,8 @@ def output_problem(
         return _items_problem(cast(tuple[Any, ...], output), ObjectTrack)
     if isinstance(output, NoPath):
         return None if str(output.reason).strip() else "returned a NoPath without a reason"
+    if type(output) is Command:
+        return command_problem(output, actuators)
     problem = _non_finite(output)
     if problem is not None:
         return problem
@@ -218,6 +220,35 @@ def _non_finite(message: Any) -> str | None:
         if not _finite(value):
             return f"returned non-finite numbers: {name} {_show(value)}"
     return None
+
+
+def command_problem(command: Command, actuators: ActuatorCounts | None = None) -> str | None:
+    """What is wrong with a command, in words, or None when nothing is.
+
+    Parameters
+    ----------
+    command : Command
+        A controller's answer, or a command given to the run from outside.
+    actuators : ActuatorCounts, optional
+        The robot's joints, thrusters and wheels: the command gives one value per
+        actuator of a kind, or none.
+
+    Returns
+    -------
+    str or None
+        E.g. ``"returned non-finite numbers: force [nan 0 0]"`` or ``"returned 2 joint
+        torques for a robot with 6 joints"``.
+    """
+    values = (
+        command.force,
+        command.torque,
+        command.joint_torques,
+        command.thruster_on_times,
+        command.wheel_torques,
+    )
+    if not np.isfinite(np.concatenate(values)).all():
+        return _non_finite(command)
+    return None if actuators is None else _command_shape_problem(command, actuators)
 
 
 def _command_shape_problem(command: Command, actuators: ActuatorCounts) -> str | None:

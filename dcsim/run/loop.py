@@ -46,7 +46,7 @@ from dcsim.messages import (
     Surroundings,
 )
 from dcsim.missions import Mission, mission_class
-from dcsim.registry.answers import ActuatorCounts, output_problem
+from dcsim.registry.answers import ActuatorCounts, command_problem
 from dcsim.registry.calls import PluginFailure, call_plugin
 from dcsim.registry.hookspecs import RunInfo
 from dcsim.registry.interfaces import Localiser
@@ -570,7 +570,7 @@ class Runner:
                 chosen = dataclasses.replace(self._command, **values)
             except (TypeError, ValueError) as error:
                 raise ValueError(f"the command is not a Command: {error}") from None
-        problem = output_problem("controller", "command", chosen, self._actuators)
+        problem = command_problem(chosen, self._actuators)
         if problem is not None:
             raise ValueError(f"the command {problem.removeprefix('returned ')}")
         self._command = self.outputs["command"] = chosen
