@@ -19,7 +19,13 @@ from __future__ import annotations
 
 from typing import Any
 
-import gymnasium
+try:
+    import gymnasium
+except ModuleNotFoundError as missing:  # the optional extra is not installed
+    raise ModuleNotFoundError(
+        "dcsim.gym needs Gymnasium: pip install 'dcsim[rl]' (or pip install gymnasium)",
+        name=missing.name,
+    ) from None
 
 from dcsim.gym.debris import DebrisEnv
 from dcsim.gym.environment import EpisodeOver, MissionEnv
