@@ -4,7 +4,9 @@ An episode is one run of the scenario (:class:`~dcsim.run.loop.Runner`) recorded
 memory without keeping its rows: :meth:`MissionEnv.reset` opens it, each
 :meth:`MissionEnv.step` flies one control period (``world.control_period``) with the
 agent's action as the command (:meth:`~dcsim.run.loop.Runner.advance`), in place of
-the controller's for the fields the action sets. The mission flies without its path
+the controller's; the controller is asked only for the fields an action leaves to it
+(the torque that holds the attitude, say), so an agent that gives the whole command
+pays nothing for it. The mission flies without its path
 planner (``path_planner: null``): the agent is the planner, and the mission's
 reference — the goal region, the stand-off point of the target it chose, the drop
 point — is what the observation calls the goal.
@@ -25,6 +27,7 @@ import numpy as np
 from gymnasium import spaces
 
 from dcsim.errors import Problem, ScenarioError
+from dcsim.messages import Command
 from dcsim.registry.discovery import PluginRegistry
 from dcsim.run.loop import Runner
 from dcsim.run.setup import Overrides, RunSetup, ScenarioInput, override_texts, setup_run
@@ -136,7 +139,8 @@ class MissionEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         episode_seed = seed if seed is not None else int(self.np_random.integers(SEED_RANGE))
         self.close()
         scenario = self._episode_scenario(episode_seed)
-        self.runner = Runner(RunSetup.from_scenario(scenario, self.registry), keep_rows=False)
+        setup = RunSetup.from_scenario(scenario, self.registry)
+        self.runner = Runner(setup, keep_rows=False, controller_on_demand=True)
         self.runner.open()
         self._check_failure()
         assert self.runner.world is not None  # an open run has its world
@@ -201,8 +205,9 @@ class MissionEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         """The action's entries, each named with the limit it is scaled to."""
         raise NotImplementedError
 
-    def _command(self, action: np.ndarray) -> Mapping[str, np.ndarray]:
-        """The command fields an action in [-1, 1] sets (SI units)."""
+    def _command(self, action: np.ndarray) -> Command | Mapping[str, np.ndarray]:
+        """The command an action in [-1, 1] gives (SI units): a whole :class:`Command`,
+        or the fields it sets, the scenario's controller giving the others."""
         raise NotImplementedError
 
     def _observation(self) -> np.ndarray:

@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from dcsim.gym.environment import MissionEnv, nearest_first
+from dcsim.messages import Command
 from dcsim.registry.discovery import PluginRegistry
 from dcsim.run.seeding import component_rng
 from dcsim.run.setup import Overrides, ScenarioInput
@@ -126,11 +127,11 @@ class FreeFlyerEnv(MissionEnv):
         torque = [f"t{axis} (× robot.max_torque)" for axis in "xyz"]
         return force if self.attitude == "controller" else [*force, *torque]
 
-    def _command(self, action: np.ndarray) -> Mapping[str, np.ndarray]:
-        command = {"force": action[:3] * self._force_limit}
-        if self.attitude == "agent":
-            command["torque"] = action[3:6] * self._torque_limit
-        return command
+    def _command(self, action: np.ndarray) -> Command | Mapping[str, np.ndarray]:
+        force = action[:3] * self._force_limit
+        if self.attitude == "controller":
+            return {"force": force}
+        return Command(force=force, torque=action[3:6] * self._torque_limit)
 
     def _observation(self) -> np.ndarray:
         runner = self.runner

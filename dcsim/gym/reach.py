@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from dcsim.gym.environment import MissionEnv
-from dcsim.messages import RobotState
+from dcsim.messages import Command, RobotState
 from dcsim.missions.reach.settings import ReachMissionSection
 from dcsim.registry.discovery import PluginRegistry
 from dcsim.robots.manipulator import ManipulatorModel
@@ -117,11 +117,11 @@ class ReachEnv(MissionEnv):
         joints = range(1, self._joint_count() + 1)
         return [f"tau{j} (× links[{j - 1}].torque_limit)" for j in joints]
 
-    def _command(self, action: np.ndarray) -> Mapping[str, np.ndarray]:
-        command = {"joint_torques": action * self._torque_limits}
-        if self.base == "free":
-            command.update(force=np.zeros(3), torque=np.zeros(3))
-        return command
+    def _command(self, action: np.ndarray) -> Command | Mapping[str, np.ndarray]:
+        torques = action * self._torque_limits
+        if self.base == "controller":
+            return {"joint_torques": torques}
+        return Command(joint_torques=torques)
 
     def _observation(self) -> np.ndarray:
         runner = self.runner

@@ -86,6 +86,9 @@ SUMMARY_FIGURES = (
 )
 """The numeric fields of every run's summary; a mission adds its ``summary_names``."""
 
+_NO_COMMAND = Command()
+"""The command of a period in which nothing is applied."""
+
 _NO_SPREAD = np.zeros((6, 6))
 _NO_SPREAD.setflags(write=False)  # the true state's covariance, shared by every tick's estimate
 
@@ -158,6 +161,13 @@ class Runner:
     plots : bool, optional
         Draw the mission's plots into ``plots/`` of the run directory at the end
         (default); a campaign's cases usually skip them.
+    controller_on_demand : bool, optional
+        Ask the controller for a period's command only when the period needs it: when
+        :meth:`advance` is given no command, or a mapping that leaves fields to it. For
+        runs an agent flies with whole commands (the Gymnasium environments), which then
+        pay nothing for the controller; ``outputs["command"]`` is None until the
+        period's command is known, and the last row records no command. By default the
+        controller decides every period's command as it is decided (an FMU outputs it).
 
     Attributes
     ----------
@@ -190,6 +200,7 @@ class Runner:
         progress: Progress | None = None,
         keep_rows: bool | None = None,
         plots: bool = True,
+        controller_on_demand: bool = False,
     ) -> None:
         self.setup = setup
         self.plots = plots
@@ -217,7 +228,8 @@ class Runner:
         self.summary: dict[str, Any] = {}
         self.laps = LapTimer()
         self.failure: PluginFailure | None = None
-        self._command = Command()
+        self.controller_on_demand = controller_on_demand
+        self._command: Command | None = None
         self._actuators = ActuatorCounts()
         self._pending: tuple[float, StateEstimate, str] | None = None
         self._reference: Reference | None = None
@@ -343,9 +355,7 @@ class Runner:
             )
             self.outputs = world.outputs()
             return
-        if command is not None:
-            self._take_command(command)
-        self._guarded(self._advance, disturbance_force, disturbance_torque)
+        self._guarded(self._advance, disturbance_force, disturbance_torque, command)
 
     def close(self) -> dict[str, Any]:
         """End the run, close the world, write the records; return the summary."""
@@ -495,27 +505,37 @@ class Runner:
         if "tracker" in plugins:
             observations = self._tracked(t, observations, estimate)
             laps.lap("tracker")
-        reference = self._reference = mission.tick(t, estimate, observations)
+        self._reference = mission.tick(t, estimate, observations)
         laps.lap("mission")
         if world.robot_changes != self._robot_changes:  # a grab or a release
             self._robot_changes = world.robot_changes
             call_plugin(plugins, "controller", "reset", world.robot_spec())
-        surroundings = self.surroundings = mission.surroundings(observations)
+        self.surroundings = mission.surroundings(observations)
         self._actuators = self._actuator_counts._replace(joints=len(observations.joint_positions))
-        self._command = call_plugin(
-            plugins,
-            "controller",
-            "command",
-            t,
-            estimate,
-            reference,
-            surroundings,
-            actuators=self._actuators,
-        )
-        laps.lap("controller")
-        self._record(t, estimate, mission.mode, self._command)
+        self._command = None
+        if not self.controller_on_demand:
+            self._controller_command()
+            laps.lap("controller")
+        self._record(t, estimate, mission.mode)
         self._check_stop(t)
         laps.lap("recording")
+
+    def _controller_command(self) -> Command:
+        """The controller's command for the current control period, asked once."""
+        if self._command is None:
+            world = self._opened_world
+            assert self.estimate is not None and self._reference is not None  # decided
+            self._command = call_plugin(
+                self.plugins,
+                "controller",
+                "command",
+                world.time,
+                self.estimate,
+                self._reference,
+                self.surroundings,
+                actuators=self._actuators,
+            )
+        return self._command
 
     def _localise(self, observations: Observations) -> StateEstimate:
         """The localiser's estimate now, or the true state when the mission flies without
@@ -567,7 +587,7 @@ class Runner:
                 raise ValueError(f"a Command has no field {', '.join(unknown)} (it has {fields})")
             try:
                 values = {name: np.asarray(value, dtype=float) for name, value in command.items()}
-                chosen = dataclasses.replace(self._command, **values)
+                chosen = dataclasses.replace(self._controller_command(), **values)
             except (TypeError, ValueError) as error:
                 raise ValueError(f"the command is not a Command: {error}") from None
         problem = command_problem(chosen, self._actuators)
@@ -575,17 +595,29 @@ class Runner:
             raise ValueError(f"the command {problem.removeprefix('returned ')}")
         self._command = self.outputs["command"] = chosen
 
-    def _advance(self, disturbance_force: np.ndarray, disturbance_torque: np.ndarray) -> None:
+    def _advance(
+        self,
+        disturbance_force: np.ndarray,
+        disturbance_torque: np.ndarray,
+        command: Command | Mapping[str, ArrayLike] | None = None,
+    ) -> None:
+        if self.controller_on_demand:
+            self.laps.lap("agent")  # what the agent did since the period was decided
+        if command is not None:
+            self._take_command(command)
+        flown = self._command
+        if flown is None:  # asked on demand: no command was given
+            flown = self.outputs["command"] = self._controller_command()
+            self.laps.lap("controller")
         self._commit_row()
-        command = self._command
         inputs = WorldInputs(
-            force=command.force,
-            torque=command.torque,
+            force=flown.force,
+            torque=flown.torque,
             disturbance_force=disturbance_force,
             disturbance_torque=disturbance_torque,
-            joint_torques=command.joint_torques,
-            thruster_on_times=command.thruster_on_times,
-            wheel_torques=command.wheel_torques,
+            joint_torques=flown.joint_torques,
+            thruster_on_times=flown.thruster_on_times,
+            wheel_torques=flown.wheel_torques,
         )
         world = self._opened_world
         actuators = world.actuators
@@ -640,11 +672,11 @@ class Runner:
         return Prior(position, initial.position_sigma, velocity, initial.velocity_sigma)
 
     # ------------------------------------------------------------------ records
-    def _record(self, t: float, estimate: StateEstimate, mode: str, command: Command) -> None:
-        """Take the world's outputs of this tick, with its command; its telemetry row is
-        recorded once the command is sure (:meth:`_commit_row`)."""
+    def _record(self, t: float, estimate: StateEstimate, mode: str) -> None:
+        """Take the world's outputs of this tick, with its command if it is known; its
+        telemetry row is recorded once the command is sure (:meth:`_commit_row`)."""
         out = self.outputs = self._opened_world.outputs()
-        out["command"] = command
+        out["command"] = self._command
         held = None if self._reference is None else self._reference.attitude
         out["attitude_error"] = math.nan if held is None else attitude_error(out["attitude"], held)
         self._pending = t, estimate, mode
@@ -655,6 +687,8 @@ class Runner:
         pending, self._pending = self._pending, None
         if pending is None:
             return
+        if self.outputs["command"] is None:  # the run ends before the controller was asked
+            self.outputs["command"] = _NO_COMMAND
         row = self._telemetry_row(*pending, self.outputs)
         self._accumulate(self.outputs, pending[1])
         self.recorder.row(row)
@@ -694,7 +728,8 @@ class Runner:
         """Record the state reached by the last step (the run ends after it), with the
         last estimate (no new one is made)."""
         assert self.estimate is not None  # every control period's decision makes one
-        self._record(self._opened_world.time, self.estimate, mode, Command())
+        self._command = _NO_COMMAND
+        self._record(self._opened_world.time, self.estimate, mode)
         self._commit_row()
 
     def _event(self, name: str, at: float | None = None, **data: Any) -> None:

@@ -8,6 +8,8 @@ import pandas as pd
 import pytest
 
 from dcsim.api import Command, close_run, open_run, run
+from dcsim.run.loop import Runner
+from dcsim.run.setup import setup_run
 from tests.conftest import REPO
 
 DEBRIS = ["world.duration=130"]  # grabs its first target at 124 s: the pd holds attitude after
@@ -83,3 +85,40 @@ def test_a_debris_mission_without_a_path_planner_still_plans_its_tasks_and_grabs
     events = [e["event"] for e in result.events]
     assert "plan" in events and "grab" in events and "path" not in events
     assert "path_planner" not in result.summary["plugins"]
+
+
+def test_a_controller_asked_on_demand_flies_the_same_run_and_is_not_asked_for_whole_commands():
+    flown = run(overrides=DEBRIS)
+    setup = setup_run(None, DEBRIS)
+    runner = Runner(setup, controller_on_demand=True)
+    runner.open()
+    while not runner.ended:
+        runner.advance()
+    on_demand = close_run(runner)
+    command_columns = ["fx_N", "fy_N", "fz_N"]
+    # the same run; its last row records no command, as none is flown after it
+    pd.testing.assert_frame_equal(
+        on_demand.telemetry.drop(columns=command_columns),
+        flown.telemetry.drop(columns=command_columns),
+        check_exact=True,
+    )
+    assert (
+        (
+            on_demand.telemetry[command_columns].iloc[:-1]
+            == flown.telemetry[command_columns].iloc[:-1]
+        )
+        .all()
+        .all()
+    )
+    assert not on_demand.telemetry[command_columns].iloc[-1].any()
+    assert "controller" in on_demand.summary["wall_time_by_phase_s"]
+
+    agent = Runner(
+        setup_run(FFSR, ["path_planner=null", "world.duration=3"]), controller_on_demand=True
+    )
+    agent.open()
+    assert agent.outputs["command"] is None  # not asked yet
+    while not agent.ended:
+        agent.advance(command=Command(force=np.array([0.1, 0.0, 0.0])))
+    phases = close_run(agent).summary["wall_time_by_phase_s"]
+    assert "controller" not in phases and "agent" in phases
