@@ -67,6 +67,9 @@ class Throughput:
         Vector steps flown (each steps every copy once).
     seconds : float
         Wall time of those steps, s.
+    episodes_ended : int
+        Episodes that ended (terminated or truncated) in those steps; each copy's next
+        step was its reset, timed with the rest.
     """
 
     env_id: str
@@ -74,6 +77,7 @@ class Throughput:
     envs: int
     steps: int
     seconds: float
+    episodes_ended: int
 
     @property
     def env_steps(self) -> int:
@@ -218,7 +222,14 @@ def bench_gym(
     return GymBenchResult(rows, costs)
 
 
-def throughput(env_id: str, vector: str, count: int, steps: int, seed: int = 0) -> Throughput:
+def throughput(
+    env_id: str,
+    vector: str,
+    count: int,
+    steps: int,
+    seed: int = 0,
+    overrides: Sequence[str] = (),
+) -> Throughput:
     """Step ``count`` copies of ``env_id`` in a ``vector`` environment ``steps`` times.
 
     Parameters
@@ -233,26 +244,30 @@ def throughput(env_id: str, vector: str, count: int, steps: int, seed: int = 0) 
         Vector steps timed, after one reset with ``seed``.
     seed : int
         Seeds the reset (copy ``i`` with ``seed + i``) and the action space.
+    overrides : sequence of str
+        ``key.path=value`` overrides of the environment's scenario.
 
     Returns
     -------
     Throughput
-        The steps and their wall time.
+        The steps, their wall time and the episodes that ended.
     """
-    make = functools.partial(gymnasium.make, MODULE_PREFIX + env_id)
+    make = functools.partial(gymnasium.make, MODULE_PREFIX + env_id, overrides=list(overrides))
     kind = gymnasium.vector.AsyncVectorEnv if vector == "async" else gymnasium.vector.SyncVectorEnv
     envs = kind([make] * count)
     try:
         envs.action_space.seed(seed)
         envs.reset(seed=seed)
         actions = [envs.action_space.sample() for _ in range(steps)]
+        ended = 0
         started = time.perf_counter()
         for action in actions:
-            envs.step(action)
+            _, _, terminated, truncated, _ = envs.step(action)
+            ended += int(np.count_nonzero(terminated | truncated))
         seconds = time.perf_counter() - started
     finally:
         envs.close()
-    return Throughput(env_id, vector, count, steps, seconds)
+    return Throughput(env_id, vector, count, steps, seconds, ended)
 
 
 def step_cost(
@@ -329,11 +344,12 @@ def _run_period(scenario: Path, periods: int, seed: int, registry: PluginRegistr
 def markdown_tables(result: GymBenchResult) -> str:
     """The throughput and the step costs as two Markdown tables, with the target's verdict."""
     lines = [
-        "| environment | vector | envs | env steps | wall [s] | env steps/s |",
-        "|---|---|---:|---:|---:|---:|",
+        "| environment | vector | envs | env steps | episodes ended | wall [s] | env steps/s |",
+        "|---|---|---:|---:|---:|---:|---:|",
     ]
     lines += [
-        f"| {row.env_id} | {row.vector} | {row.envs} | {row.env_steps} | {row.seconds:.3f} "
+        f"| {row.env_id} | {row.vector} | {row.envs} | {row.env_steps} "
+        f"| {row.episodes_ended} | {row.seconds:.3f} "
         f"| {row.steps_per_second:.0f} |"
         for row in result.throughput
     ]

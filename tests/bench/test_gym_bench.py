@@ -30,8 +30,17 @@ def test_every_vector_and_count_is_measured_once(result):
         (TRANSFER, "sync", 2),
     ]
     assert [row.env_steps for row in result.throughput] == [3, 6, 3, 6]
+    assert all(0 <= row.episodes_ended <= row.env_steps for row in result.throughput)
     rates = [row.steps_per_second for row in result.throughput]
     assert all(math.isfinite(rate) and rate > 0 for rate in rates)
+
+
+@pytest.mark.parametrize("vector", bench.VECTOR_KINDS)
+def test_episodes_that_end_while_timed_are_counted(vector):
+    # Two control periods to a run: every copy's episode is truncated at its second
+    # step, and its third is its reset.
+    row = bench.throughput(TRANSFER, vector, 2, steps=3, overrides=["world.duration=0.2"])
+    assert row.episodes_ended == 2
 
 
 def test_the_step_cost_has_every_repeat_of_both_sides(result):
