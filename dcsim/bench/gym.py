@@ -393,8 +393,9 @@ def plot(result: GymBenchResult, path: Path) -> None:
             heights = [rate.get((vector, count), math.nan) for vector in vectors]
             bars = axis.bar(x, heights, width, label=f"{count} env{'s' * (count > 1)}")
             axis.bar_label(bars, fmt="%.0f", fontsize=7)
+        axis.set_ylim(0, 1.2 * max(rate.values()))  # room for the legend above the bars
         axis.set_xticks(np.arange(len(vectors)), [f"{v} vector" for v in vectors])
         axis.set_title(env_id, fontsize=10)
         axis.set_ylabel("environment steps per second")
-    axes[0][0].legend(fontsize=8)
+    axes[0][0].legend(fontsize=8, ncol=len(counts), loc="upper center")
     save(figure, path)
