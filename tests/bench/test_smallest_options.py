@@ -57,6 +57,11 @@ SMALLEST = {
         *("--workers", "1", "--worker-deaths", "1"),
         *("--set", "world.duration=10", "--plot", "{tmp}/gaps.png"),
     ],
+    # One environment, one copy in one vector kind, one step and one period.
+    "gym": [
+        *("--envs", "dcsim/Transfer-v0", "--counts", "1", "--vector", "sync"),
+        *("--steps", "1", "--periods", "1", "--repeats", "1", "--out", "{tmp}/gym"),
+    ],
     # One seed of the default and the crowded-field scenarios, a second of each.
     "tracking": ["--seeds", "1", "--duration", "1"],
     # About 9 s whatever the options: the thesis's two application cases are flown.

@@ -1,7 +1,8 @@
 """Benches of dcsim's engine: the closed loop against PyBullet (``world``), the orbit
 models against an inertial reference (``dynamics``), a long run (``soak``), the FMU
 (``fmu``), the campaign engine (``campaign``), the attitude loop beside Basilisk's
-(``peers``) and the manipulator model against Pinocchio's (``manipulator``)."""
+(``peers``), the manipulator model against Pinocchio's (``manipulator``) and the
+Gymnasium environments' step speed (``gym``)."""
 
 from __future__ import annotations
 
@@ -359,3 +360,78 @@ def bench_manipulator_command(
     if scenario is not None:
         speed = bench.scenario_speed(scenario, registry=plugin_registry())
         click.echo(f"\n{bench.scenario_line(speed)}")
+
+
+@click.command("gym", short_help="Gymnasium environments' step rates and cost per run tick.")
+@click.option(
+    "--envs",
+    default=None,
+    help="Comma-separated environment ids. Default: all (dcsim/Transfer-v0, "
+    "dcsim/Debris-v0, dcsim/Reach-v0).",
+)
+@click.option(
+    "--counts", default="1,2,8", show_default=True, help="Comma-separated copies per vector."
+)
+@click.option(
+    "--vector",
+    "vectors",
+    default="async,sync",
+    show_default=True,
+    help="Vector environments: async (a process per copy), sync (one process).",
+)
+@count_option("--steps", 500, "Vector steps timed per vector and number of copies.")
+@count_option("--periods", 1000, "Control periods per step-cost measurement, each side.")
+@count_option("--repeats", 5, "Step-cost measurements per side (medians are reported).")
+@click.option("--seed", type=int, default=0, show_default=True, help="Seeds resets and actions.")
+@out_dir_option("Write gym.json (the results) and gym.png (steps per second) here.")
+def bench_gym_command(
+    envs: str | None,
+    counts: str,
+    vectors: str,
+    steps: int,
+    periods: int,
+    repeats: int,
+    seed: int,
+    out: Path | None,
+) -> None:
+    """The Gymnasium environments' speed: steps per second in vectors, a step against a tick.
+
+    For each environment, COUNTS copies are stepped STEPS times with random actions in
+    each vector kind (AsyncVectorEnv: a worker process per copy; SyncVectorEnv: one
+    process) and the environment steps per wall second reported. Then one environment
+    step (gymnasium.make) is timed against one tick of dcsim run on the same scenario
+    with path_planner=null and its controller commanding, over PERIODS control periods,
+    alternately REPEATS times; the ratio of the medians is checked against the target
+    (at most 1.2). Prints Markdown tables for docs/benchmarks.md. Needs Gymnasium (pip
+    install 'dcsim[rl]').
+    """
+    import importlib.util
+    import json
+
+    if importlib.util.find_spec("gymnasium") is None:
+        raise DcsimError("dcsim bench gym needs Gymnasium: pip install 'dcsim[rl]'")
+    from dcsim.bench import gym as bench
+    from dcsim.gym import ENVIRONMENTS
+
+    env_ids = list(ENVIRONMENTS) if envs is None else comma_words(envs, "--envs")
+    kinds = comma_words(vectors, "--vector")
+    for option, words, allowed in (
+        ("--envs", env_ids, tuple(ENVIRONMENTS)),
+        ("--vector", kinds, bench.VECTOR_KINDS),
+    ):
+        unknown = [w for w in words if w not in allowed]
+        if unknown:
+            raise DcsimError(f"{option}: unknown {', '.join(unknown)}; use {', '.join(allowed)}")
+    numbers = comma_numbers(counts, "--counts")
+    if not all(n >= 1 and n == int(n) for n in numbers):
+        raise DcsimError(f"--counts: expected whole numbers >= 1 like 1,2,8, got {counts!r}")
+    result = bench.bench_gym(
+        env_ids, [int(n) for n in numbers], kinds, steps, periods, repeats, seed, progress
+    )
+    click.echo(bench.markdown_tables(result))
+    click.echo(bench.verdict(result))
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "gym.json").write_text(json.dumps(result.as_json(), indent=2) + "\n")
+        bench.plot(result, out / "gym.png")
+        click.echo(f"\nresults: {out / 'gym.json'}, plot: {out / 'gym.png'}")
