@@ -147,6 +147,7 @@ class MissionEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         self.start_state = self.runner.world.robot_state()
         self._collisions = 0
         self._over = False
+        self._start_episode()
         return self._observation(), self._info()
 
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
@@ -197,6 +198,9 @@ class MissionEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         self.runner = None
 
     # ------------------------------------------------------------------ per mission
+    def _start_episode(self) -> None:
+        """Take what the episode's steps reuse, once its run is open (nothing here)."""
+
     def _observation_names(self) -> Sequence[str]:
         """The observation's entries, named with their unit suffix."""
         raise NotImplementedError

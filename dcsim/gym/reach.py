@@ -140,24 +140,28 @@ class ReachEnv(MissionEnv):
         return np.concatenate(parts).astype(np.float32)
 
     # ------------------------------------------------------------------ reward
+    def _start_episode(self) -> None:
+        """Keep the arm's model (its kinematics do not change with the propellant
+        burnt) and the end effector's true distance to the target."""
+        runner = self.runner
+        assert runner is not None and runner.world is not None
+        model = runner.world.robot_spec().model
+        assert isinstance(model, ManipulatorModel)  # the reach mission flies manipulators
+        self._arm = model
+        self._distance = self._true_distance()
+
     def _progress_state(self) -> dict[str, Any]:
-        return {"distance": self._true_distance()}
+        return {"distance": self._distance}
 
     def _reward(self, before: Mapping[str, Any], action: np.ndarray) -> float:
-        progress = self.progress_weight * (before["distance"] - self._true_distance())
+        self._distance = self._true_distance()
+        progress = self.progress_weight * (before["distance"] - self._distance)
         effort = self.effort_weight * float(np.mean(action**2)) * self.scenario.world.control_period
         return progress - effort
 
     # ------------------------------------------------------------------ geometry
-    def _model(self) -> ManipulatorModel:
-        runner = self.runner
-        assert runner is not None and runner.world is not None
-        model = runner.world.robot_spec().model
-        assert isinstance(model, ManipulatorModel)
-        return model
-
     def _end_effector(self, state: RobotState) -> np.ndarray:
-        return self._model().forward_kinematics(state.configuration).end_effector
+        return self._arm.forward_kinematics(state.configuration).end_effector
 
     def _true_distance(self) -> float:
         runner = self.runner
