@@ -48,7 +48,7 @@ def test_the_random_pilot_flies_two_seeded_episodes_the_same_twice(script):
     assert first == script.evaluate(script.random_pilot, [0, 1])
     assert len(first) == 2 and first[0] != first[1]
     for episode in first:
-        assert set(episode) == {"return", "goal_met", "collided", "time_s"}
+        assert set(episode) == {"return", "goal_met", "collided", "time_s", "peak_speed_mps"}
         assert episode["return"] < 0  # a random walk pays for its path length
     summary = script.summarise(first)
     assert summary["episodes"] == 2 and summary["success_rate"] == 0.0
@@ -60,3 +60,5 @@ def test_the_pd_pilot_strikes_the_first_sphere_flying_straight_at_the_goal(scrip
     assert [e["collided"] for e in episodes] == [True, True]
     assert [e["goal_met"] for e in episodes] == [False, False]
     assert all(e["return"] is None for e in episodes)
+    # the controller keeps to the robot's max_speed (0.2 m/s) until it strikes
+    assert all(0.0 < e["peak_speed_mps"] <= 0.2 for e in episodes)

@@ -18,8 +18,10 @@ flies ``--episodes`` episodes of seeds 0, 1, ... with each of three pilots:
   episode's run is advanced with the controller's own command).
 
 It writes ``learning_curve.png`` (the training episodes' return and success rate
-against timesteps) and ``results.json`` (success and collision rates, mean returns,
-timesteps, wall time, the environment's options) into ``--out`` and prints a table.
+against timesteps), ``results.json`` (success and collision rates, mean returns, times
+to goal and peak speeds, each episode's outcome, timesteps, wall time, the
+environment's options) and the trained policy (``policy.zip``, with its observation
+normaliser ``normaliser.pkl``) into ``--out`` and prints a table.
 
 Needs the ``rl`` extra (Gymnasium, Stable-Baselines3, PyTorch): a CPU PyTorch is
 ``pip install torch --index-url https://download.pytorch.org/whl/cpu`` before
@@ -73,22 +75,31 @@ def fly(env: gymnasium.Env, pilot: Pilot, seed: int) -> dict[str, Any]:
     Returns
     -------
     dict
-        ``return`` (sum of rewards), ``goal_met``, ``collided`` and ``time_s`` (the
-        simulated time at the episode's end, s).
+        ``return`` (sum of rewards), ``goal_met``, ``collided``, ``time_s`` (the
+        simulated time at the episode's end, s) and ``peak_speed_mps`` (the fastest
+        true speed at the end of a step, m/s).
     """
     observation, info = env.reset(seed=seed)
     env.action_space.seed(seed)
-    total, over = 0.0, False
+    total, peak, over = 0.0, 0.0, False
     while not over:
         observation, reward, terminated, truncated, info = env.step(pilot(env, observation, seed))
         total += float(reward)
+        peak = max(peak, speed(env))
         over = terminated or truncated
     return {
         "return": total,
         "goal_met": bool(info["goal_met"]),
         "collided": info["collisions"] > 0,
         "time_s": float(info["time_s"]),
+        "peak_speed_mps": peak,
     }
+
+
+def speed(env: gymnasium.Env) -> float:
+    """The robot's true speed (m/s) in the episode's run now."""
+    assert isinstance(env.unwrapped, TransferEnv) and env.unwrapped.runner is not None
+    return float(np.linalg.norm(env.unwrapped.runner.outputs["velocity"]))
 
 
 def random_pilot(env: gymnasium.Env, observation: np.ndarray, seed: int) -> np.ndarray:
@@ -120,8 +131,10 @@ def evaluate_pd(seeds: Sequence[int]) -> list[dict[str, Any]]:
         assert isinstance(env.unwrapped, TransferEnv)
         runner = env.unwrapped.runner
         assert runner is not None  # reset opens the episode's run
+        peak = 0.0
         while not runner.ended:
             runner.advance()
+            peak = max(peak, speed(env))
         summary = runner.close()
         episodes.append(
             {
@@ -129,6 +142,7 @@ def evaluate_pd(seeds: Sequence[int]) -> list[dict[str, Any]]:
                 "goal_met": bool(summary["goal_met"]),
                 "collided": summary["collisions"] > 0,
                 "time_s": float(summary["sim_time_s"]),
+                "peak_speed_mps": peak,
             }
         )
     env.close()
@@ -136,10 +150,12 @@ def evaluate_pd(seeds: Sequence[int]) -> list[dict[str, Any]]:
 
 
 def summarise(episodes: Sequence[dict[str, Any]]) -> dict[str, Any]:
-    """Success and collision rates, mean return and mean time to goal of some episodes."""
+    """Success and collision rates, mean return, mean time to goal and mean peak speed of
+    some episodes."""
     returns = [e["return"] for e in episodes if e["return"] is not None]
     arrivals = [e["time_s"] for e in episodes if e["goal_met"]]
     return {
+        "mean_peak_speed_mps": float(np.mean([e["peak_speed_mps"] for e in episodes])),
         "episodes": len(episodes),
         "success_rate": float(np.mean([e["goal_met"] for e in episodes])),
         "collision_rate": float(np.mean([e["collided"] for e in episodes])),
@@ -151,15 +167,17 @@ def summarise(episodes: Sequence[dict[str, Any]]) -> dict[str, Any]:
 def table(results: dict[str, dict[str, Any]]) -> str:
     """The summaries as a Markdown table, one row per pilot."""
     lines = [
-        "| pilot | success | collision | mean return | mean time to goal (s) |",
-        "|---|---|---|---|---|",
+        "| pilot | success | collision | mean return | mean time to goal (s) "
+        "| mean peak speed (m/s) |",
+        "|---|---|---|---|---|---|",
     ]
     for name, row in results.items():
         mean_return = "—" if row["mean_return"] is None else f"{row['mean_return']:.2f}"
         arrival = row["mean_time_to_goal_s"]
         lines.append(
             f"| {name} | {row['success_rate']:.0%} | {row['collision_rate']:.0%} "
-            f"| {mean_return} | {'—' if arrival is None else f'{arrival:.1f}'} |"
+            f"| {mean_return} | {'—' if arrival is None else f'{arrival:.1f}'} "
+            f"| {row['mean_peak_speed_mps']:.2f} |"
         )
     return "\n".join(lines)
 
@@ -250,12 +268,15 @@ def train(arguments: argparse.Namespace) -> tuple[Any, Any, list[tuple[int, floa
 
 
 def main(argv: Sequence[str] | None = None) -> dict[str, Any]:
-    """Train, evaluate, write ``learning_curve.png`` and ``results.json``, print the table."""
+    """Train, save the policy, evaluate, write ``learning_curve.png`` and ``results.json``,
+    print the table (see the module)."""
     arguments = parse(argv)
     arguments.out.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
     model, normaliser, curve = train(arguments)
     trained_s = time.perf_counter() - started
+    model.save(arguments.out / "policy.zip")
+    normaliser.save(str(arguments.out / "normaliser.pkl"))
 
     def trained(env: gymnasium.Env, observation: np.ndarray, seed: int) -> np.ndarray:
         action, _ = model.predict(normaliser.normalize_obs(observation), deterministic=True)
