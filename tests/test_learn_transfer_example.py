@@ -48,7 +48,15 @@ def test_the_random_pilot_flies_two_seeded_episodes_the_same_twice(script):
     assert first == script.evaluate(script.random_pilot, [0, 1])
     assert len(first) == 2 and first[0] != first[1]
     for episode in first:
-        assert set(episode) == {"return", "goal_met", "collided", "time_s", "peak_speed_mps"}
+        assert set(episode) == {
+            "return",
+            "goal_met",
+            "collided",
+            "time_s",
+            "peak_speed_mps",
+            "delta_v_mps",
+            "goal_distance_m",
+        }
         assert episode["return"] < 0  # a random walk pays for its path length
     summary = script.summarise(first)
     assert summary["episodes"] == 2 and summary["success_rate"] == 0.0
@@ -62,3 +70,5 @@ def test_the_pd_pilot_strikes_the_first_sphere_flying_straight_at_the_goal(scrip
     assert all(e["return"] is None for e in episodes)
     # the controller keeps to the robot's max_speed (0.2 m/s) until it strikes
     assert all(0.0 < e["peak_speed_mps"] <= 0.2 for e in episodes)
+    # the first sphere sits 1.6 m along the 6 m transfer
+    assert all(4.0 < e["goal_distance_m"] < 6.0 for e in episodes)

@@ -19,9 +19,10 @@ flies ``--episodes`` episodes of seeds 0, 1, ... with each of three pilots:
 
 It writes ``learning_curve.png`` (the training episodes' return and success rate
 against timesteps), ``results.json`` (success and collision rates, mean returns, times
-to goal and peak speeds, each episode's outcome, timesteps, wall time, the
-environment's options) and the trained policy (``policy.zip``, with its observation
-normaliser ``normaliser.pkl``) into ``--out`` and prints a table.
+to goal, peak speeds and delta-v, each episode's outcome and distance left to the goal,
+timesteps, wall time, the environment's options) and the trained policy
+(``policy.zip``, with its observation normaliser ``normaliser.pkl``) into ``--out`` and
+prints a table.
 
 Needs the ``rl`` extra (Gymnasium, Stable-Baselines3, PyTorch): a CPU PyTorch is
 ``pip install torch --index-url https://download.pytorch.org/whl/cpu`` before
@@ -43,6 +44,7 @@ import gymnasium
 import numpy as np
 
 from dcsim.gym import TransferEnv
+from dcsim.run.loop import Runner
 
 ENV_ID = "dcsim.gym:dcsim/Transfer-v0"
 """The environment trained and evaluated (the packaged ffsr_obstacles.yaml)."""
@@ -76,8 +78,7 @@ def fly(env: gymnasium.Env, pilot: Pilot, seed: int) -> dict[str, Any]:
     -------
     dict
         ``return`` (sum of rewards), ``goal_met``, ``collided``, ``time_s`` (the
-        simulated time at the episode's end, s) and ``peak_speed_mps`` (the fastest
-        true speed at the end of a step, m/s).
+        simulated time at the episode's end, s) and what :func:`flight` gives.
     """
     observation, info = env.reset(seed=seed)
     env.action_space.seed(seed)
@@ -92,14 +93,33 @@ def fly(env: gymnasium.Env, pilot: Pilot, seed: int) -> dict[str, Any]:
         "goal_met": bool(info["goal_met"]),
         "collided": info["collisions"] > 0,
         "time_s": float(info["time_s"]),
-        "peak_speed_mps": peak,
+        **flight(env, peak),
     }
+
+
+def episode_run(env: gymnasium.Env) -> Runner:
+    """The run of the environment's current episode."""
+    assert isinstance(env.unwrapped, TransferEnv) and env.unwrapped.runner is not None
+    return env.unwrapped.runner
 
 
 def speed(env: gymnasium.Env) -> float:
     """The robot's true speed (m/s) in the episode's run now."""
-    assert isinstance(env.unwrapped, TransferEnv) and env.unwrapped.runner is not None
-    return float(np.linalg.norm(env.unwrapped.runner.outputs["velocity"]))
+    return float(np.linalg.norm(episode_run(env).outputs["velocity"]))
+
+
+def flight(env: gymnasium.Env, peak_speed: float) -> dict[str, float]:
+    """How the episode's run has flown: ``peak_speed_mps`` (as given: the fastest true
+    speed at the end of a control period, m/s), ``delta_v_mps`` (spent, m/s) and
+    ``goal_distance_m`` (true distance from the goal's centre now, m)."""
+    runner = episode_run(env)
+    assert runner.reference is not None  # the transfer's reference is the goal
+    position = np.asarray(runner.outputs["position"])
+    return {
+        "peak_speed_mps": peak_speed,
+        "delta_v_mps": float(runner.outputs["delta_v"]),
+        "goal_distance_m": float(np.linalg.norm(position - runner.reference.position)),
+    }
 
 
 def random_pilot(env: gymnasium.Env, observation: np.ndarray, seed: int) -> np.ndarray:
@@ -128,9 +148,7 @@ def evaluate_pd(seeds: Sequence[int]) -> list[dict[str, Any]]:
     episodes = []
     for seed in seeds:
         env.reset(seed=seed)
-        assert isinstance(env.unwrapped, TransferEnv)
-        runner = env.unwrapped.runner
-        assert runner is not None  # reset opens the episode's run
+        runner = episode_run(env)
         peak = 0.0
         while not runner.ended:
             runner.advance()
@@ -142,7 +160,7 @@ def evaluate_pd(seeds: Sequence[int]) -> list[dict[str, Any]]:
                 "goal_met": bool(summary["goal_met"]),
                 "collided": summary["collisions"] > 0,
                 "time_s": float(summary["sim_time_s"]),
-                "peak_speed_mps": peak,
+                **flight(env, peak),
             }
         )
     env.close()
@@ -150,12 +168,13 @@ def evaluate_pd(seeds: Sequence[int]) -> list[dict[str, Any]]:
 
 
 def summarise(episodes: Sequence[dict[str, Any]]) -> dict[str, Any]:
-    """Success and collision rates, mean return, mean time to goal and mean peak speed of
-    some episodes."""
+    """Success and collision rates, mean return, mean time to goal, mean peak speed and
+    median delta-v of some episodes."""
     returns = [e["return"] for e in episodes if e["return"] is not None]
     arrivals = [e["time_s"] for e in episodes if e["goal_met"]]
     return {
         "mean_peak_speed_mps": float(np.mean([e["peak_speed_mps"] for e in episodes])),
+        "median_delta_v_mps": float(np.median([e["delta_v_mps"] for e in episodes])),
         "episodes": len(episodes),
         "success_rate": float(np.mean([e["goal_met"] for e in episodes])),
         "collision_rate": float(np.mean([e["collided"] for e in episodes])),
@@ -168,8 +187,8 @@ def table(results: dict[str, dict[str, Any]]) -> str:
     """The summaries as a Markdown table, one row per pilot."""
     lines = [
         "| pilot | success | collision | mean return | mean time to goal (s) "
-        "| mean peak speed (m/s) |",
-        "|---|---|---|---|---|---|",
+        "| mean peak speed (m/s) | median delta-v (m/s) |",
+        "|---|---|---|---|---|---|---|",
     ]
     for name, row in results.items():
         mean_return = "—" if row["mean_return"] is None else f"{row['mean_return']:.2f}"
@@ -177,7 +196,7 @@ def table(results: dict[str, dict[str, Any]]) -> str:
         lines.append(
             f"| {name} | {row['success_rate']:.0%} | {row['collision_rate']:.0%} "
             f"| {mean_return} | {'—' if arrival is None else f'{arrival:.1f}'} "
-            f"| {row['mean_peak_speed_mps']:.2f} |"
+            f"| {row['mean_peak_speed_mps']:.2f} | {row['median_delta_v_mps']:.2f} |"
         )
     return "\n".join(lines)
 
