@@ -212,16 +212,17 @@ def plot_curve(curve: Sequence[tuple[int, float, bool]], path: Path, window: int
     steps = np.array([c[0] for c in curve])
     returns = np.array([c[1] for c in curve])
     successes = np.array([c[2] for c in curve], dtype=float)
-    kernel = np.ones(min(window, max(len(curve), 1))) / min(window, max(len(curve), 1))
+    width = min(window, max(len(curve), 1))
+    kernel = np.ones(width) / width
     figure, (top, bottom) = pyplot.subplots(2, 1, sharex=True, figsize=(7, 5))
     top.plot(steps, returns, ".", markersize=2, alpha=0.3, color="grey")
-    if len(curve) >= len(kernel):
-        valid = slice(len(kernel) - 1, None)
+    if len(curve) >= width:
+        valid = slice(width - 1, None)
         top.plot(steps[valid], np.convolve(returns, kernel, "valid"), color="C0")
         bottom.plot(steps[valid], np.convolve(successes, kernel, "valid"), color="C2")
     top.set_yscale("symlog", linthresh=10.0)
     top.set_ylabel("episode return")
-    bottom.set_ylabel(f"success rate\n(last {len(kernel)} episodes)")
+    bottom.set_ylabel(f"success rate\n(last {width} episodes)")
     bottom.set_xlabel("timesteps")
     bottom.set_ylim(-0.02, 1.02)
     figure.suptitle("dcsim/Transfer-v0: training episodes")
