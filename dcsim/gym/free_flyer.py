@@ -18,10 +18,13 @@ zeros where fewer are tracked).
 Reward of a step (true state)::
 
     progress_weight · (d_before − d_after) − (w_dv Δv + w_L ΔL + w_T Δt)
+        − speed_weight · max(0, ‖v‖ − v_max) Δt
         + goal_reward on meeting the goal − collision_penalty on a collision
 
 ``d`` is the distance (m) to the goal given at the step's start, ``Δv`` the delta-v
-spent (m/s), ``ΔL`` the distance flown (m) and ``Δt`` the control period (s); the
+spent (m/s), ``ΔL`` the distance flown (m), ``Δt`` the control period (s), ``‖v‖`` the
+speed at the step's end and ``v_max`` the scenario's ``robot.max_speed`` (m/s), which
+planned flights keep to and nothing else holds an agent to; the
 weights are the scenario's path-cost weights (``mission.weights``) unless the
 environment is given its own. The shaping term telescopes over an episode to
 ``progress_weight`` times the distance closed, so it does not change which paths are
@@ -72,6 +75,9 @@ class FreeFlyerEnv(MissionEnv):
         episode's start is drawn, uniformly, by the episode's seed; 0: the scenario's.
     cost_weights : tuple of 3 floats, optional
         ``(w_dv, w_L, w_T)`` in s/m, 1/m and 1/s; the mission's own if None.
+    speed_weight : float
+        Weight of the speed-limit term (1/m): reward taken away per m/s above
+        ``robot.max_speed`` per second.
     goal_reward, collision_penalty, progress_weight, registry
         As for :class:`MissionEnv`.
     """
@@ -85,6 +91,7 @@ class FreeFlyerEnv(MissionEnv):
         attitude: str = "agent",
         start_spread: float = 0.0,
         cost_weights: Sequence[float] | None = None,
+        speed_weight: float = 10.0,
         goal_reward: float = 10.0,
         collision_penalty: float = 10.0,
         progress_weight: float = 1.0,
@@ -93,11 +100,12 @@ class FreeFlyerEnv(MissionEnv):
         if attitude not in ATTITUDE_CHOICES:
             choices = ", ".join(ATTITUDE_CHOICES)
             raise ValueError(f"attitude must be one of {choices}, not {attitude!r}")
-        if obstacles < 0 or start_spread < 0:
-            raise ValueError("obstacles and start_spread must not be negative")
+        if obstacles < 0 or start_spread < 0 or speed_weight < 0:
+            raise ValueError("obstacles, start_spread and speed_weight must not be negative")
         self.obstacle_count = int(obstacles)
         self.attitude = attitude
         self.start_spread = float(start_spread)
+        self.speed_weight = float(speed_weight)
         self._given_weights = None if cost_weights is None else np.asarray(cost_weights, float)
         super().__init__(
             scenario,
@@ -111,6 +119,7 @@ class FreeFlyerEnv(MissionEnv):
         self.cost_weights = self._mission_weights() if weights is None else weights
         robot = self.scenario.robot
         self._force_limit = float(robot.max_force)
+        self._speed_limit = float(robot.max_speed)
         self._torque_limit = float(robot.max_torque)
 
     # ------------------------------------------------------------------ spaces
@@ -200,7 +209,9 @@ class FreeFlyerEnv(MissionEnv):
             ]
         )
         progress = self.progress_weight * (before["distance"] - distance)
-        return progress - float(self.cost_weights @ spent)
+        speed = float(np.linalg.norm(runner.outputs["velocity"]))
+        over = self.speed_weight * max(0.0, speed - self._speed_limit) * spent[2]
+        return progress - float(self.cost_weights @ spent) - over
 
     # ------------------------------------------------------------------ episodes
     def _episode_scenario(self, seed: int) -> Scenario:

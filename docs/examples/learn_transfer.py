@@ -59,6 +59,7 @@ ENV_OPTIONS: dict[str, Any] = {
     "attitude": "controller",  # the action is the force; the controller holds attitude
     "start_spread": 0.5,  # m: each episode starts in a 1 m box about the scenario's start
     "progress_weight": 2.0,  # the shaping outweighs the path-length cost (w_L = 1/m)
+    "speed_weight": 10.0,  # 1/m: flying above robot.max_speed (0.2 m/s) costs (the default)
 }
 """The options every pilot flies with (``gymnasium.make(ENV_ID, **ENV_OPTIONS)``)."""
 

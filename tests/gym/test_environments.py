@@ -147,6 +147,24 @@ def test_arriving_in_the_goal_region_terminates_with_the_goal_reward():
     env.close()
 
 
+def test_flying_above_the_speed_limit_costs_what_the_speed_term_says():
+    options = {"overrides": ["obstacles=[]"], "attitude": "controller"}
+    limited = gymnasium.make("dcsim/Transfer-v0", speed_weight=10.0, **options)
+    free = gymnasium.make("dcsim/Transfer-v0", speed_weight=0.0, **options)
+    limited.reset(seed=0)
+    free.reset(seed=0)
+    full = np.array([1.0, 0.0, 0.0])  # 0.2 m/s² on 5 kg: past 0.2 m/s after about 1 s
+    for _ in range(20):
+        _, with_term, *_ = limited.step(full)
+        _, without, *_ = free.step(full)
+        speed = float(np.linalg.norm(limited.unwrapped.runner.outputs["velocity"]))
+        over = max(0.0, speed - 0.2)
+        assert without - with_term == pytest.approx(10.0 * over * 0.1, abs=1e-12)
+    assert over > 0.15
+    limited.close()
+    free.close()
+
+
 @pytest.mark.parametrize("stops", ["true", "false"])
 def test_a_collision_terminates_with_the_penalty_whether_or_not_the_run_stops_on_it(stops):
     env = gymnasium.make(
