@@ -20,6 +20,7 @@ estimate); the terms are documented in docs/gym.md and by each environment.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from os import PathLike
 from typing import Any, ClassVar
 
 import gymnasium
@@ -98,7 +99,8 @@ class MissionEnv(gymnasium.Env[np.ndarray, np.ndarray]):
                 f"is {setup.scenario.mission.type}, but {type(self).__name__} flies "
                 f"{self.mission_type} missions"
             )
-            raise ScenarioError(str(source), [Problem("mission.type", message)])
+            name = str(source) if isinstance(source, str | PathLike) else "the scenario"
+            raise ScenarioError(name, [Problem("mission.type", message)])
         self.scenario: Scenario = setup.scenario
         self.registry = setup.registry
         self.goal_reward = float(goal_reward)
