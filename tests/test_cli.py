@@ -290,6 +290,12 @@ def test_bench_world_prints_a_table_for_each_size(dcsim_cli):
     assert min(parts) >= 0 and parts[0] > 0 and parts[2] > 0
     assert total == pytest.approx(sum(parts), abs=0.021)  # four roundings to 0.01
     assert ceiling == pytest.approx(724.2 / total, rel=0.05)
+    loop = float(re.search(r"\(the whole loop: ([\d.]+) s\)", result.stdout).group(1))
+    last = result.stdout.splitlines()[-1]
+    ratio = re.fullmatch(r"default scenario: the whole loop is (\d+\.\d)× its floor", last)
+    assert ratio, last
+    rounding = 0.05 + 0.005 / total + 0.005 * loop / total**2  # one decimal; 0.01 s inputs
+    assert float(ratio.group(1)) == pytest.approx(loop / total, abs=rounding)
     assert "5 objects: bare stepping" in result.stderr
     negative = dcsim_cli("bench", "world", "--objects", "5,-1")
     assert negative.returncode == 2 and "expected integers >= 0" in negative.stderr

@@ -4,6 +4,7 @@ time, with the records kept; a plugin that raises leaves its own traceback."""
 
 from __future__ import annotations
 
+import copy
 import json
 import subprocess
 import sys
@@ -12,17 +13,23 @@ import numpy as np
 import pytest
 
 from dcsim.api import (
+    AttitudeReading,
+    BeaconRange,
     Command,
     Controller,
+    DropVisit,
     NoPath,
     PathPlanner,
     Plan,
+    PlanTask,
     PluginParams,
+    RateReading,
     StateEstimate,
     TaskPlanner,
     Trajectory,
     quantity,
 )
+from dcsim.registry import answers
 from dcsim.registry.answers import ActuatorCounts, output_problem
 from dcsim.run.loop import Runner
 from dcsim.run.setup import setup_run
@@ -285,3 +292,68 @@ def test_the_output_check_passes_good_answers():
     assert output_problem("path_planner", "plan", trajectory) is None
     still = Trajectory(times=[0, 0], positions=np.zeros((2, 3)), velocities=np.zeros((2, 3)))
     assert "times do not increase" in output_problem("path_planner", "plan", still)
+
+
+def _spoiled(message, bad):
+    """Copies of ``message`` with each number it holds made ``bad`` in turn (an array's
+    last element), those of the messages in its tuples included, as a plugin could
+    hand them back: the fields set as they are, past any check."""
+    for name in message.__dataclass_fields__:
+        value = getattr(message, name)
+        if isinstance(value, tuple):
+            for index, item in enumerate(value):
+                for worse in _spoiled(item, bad):
+                    yield _with(message, name, (*value[:index], worse, *value[index + 1 :]))
+        elif isinstance(value, np.ndarray) and value.size:
+            array = value.copy()
+            array.flat[-1] = bad
+            yield _with(message, name, array)
+        elif isinstance(value, float):
+            yield _with(message, name, bad)
+
+
+def _with(message, name, value):
+    changed = copy.copy(message)
+    object.__setattr__(changed, name, value)
+    return changed
+
+
+GOOD_ANSWERS = [
+    StateEstimate(
+        1.5,
+        [1.0, 2.0, 3.0],
+        joint_positions=[0.1, 0.2],
+        joint_velocities=[0.0, 0.3],
+        covariance=np.eye(6),
+    ),
+    Command(force=[1.0, 0.0, 0.0], joint_torques=[0.5], wheel_torques=[0.1, 0.2]),
+    Trajectory(times=[0, 1], positions=np.ones((2, 3)), velocities=np.zeros((2, 3))),
+    Plan(
+        tasks=(PlanTask(3, 10.0, [1.0, 2.0, 3.0]), PlanTask(4, 20.0, [4.0, 5.0, 6.0])),
+        drop_visits=(DropVisit(1, 30.0, [0.0, 0.0, 1.0]),),
+        cost=12.0,
+    ),
+    AttitudeReading(2.0, [0.0, 0.0, 0.0, 1.0], sigma=[1e-4, 1e-4, 1e-4]),
+    RateReading(2.0, [0.0, 0.1, 0.0], sigma=1e-5),
+    BeaconRange(2, [100.0, 0.0, 0.0], range=50.0, sigma=0.05),
+]
+
+
+@pytest.mark.parametrize("good", GOOD_ANSWERS, ids=lambda m: type(m).__name__)
+def test_the_quick_finite_test_agrees_with_the_exact_walk(good):
+    assert answers._non_finite(good) is None and answers._first_non_finite(good) is None
+    spoiled = [*_spoiled(good, np.nan), *_spoiled(good, np.inf), *_spoiled(good, -np.inf)]
+    assert len(spoiled) >= 9  # every number of every message, three ways
+    for bad in spoiled:
+        said = answers._non_finite(bad)
+        assert said is not None and said.startswith("returned non-finite numbers: ")
+        assert said == answers._first_non_finite(bad)
+    for huge in _spoiled(good, 1e300):  # finite, though their squares overflow
+        assert answers._non_finite(huge) is None
+
+
+def test_a_huge_finite_command_is_still_checked_for_its_actuators():
+    huge = Command(force=[1e300, 0.0, 0.0], joint_torques=[1e300, 1.0])
+    assert output_problem("controller", "command", huge, ActuatorCounts(joints=2)) is None
+    said = output_problem("controller", "command", huge, ActuatorCounts(joints=3))
+    assert said == "returned 2 joint torques for a robot with 3 joints"

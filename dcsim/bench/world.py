@@ -215,9 +215,19 @@ class LoopFloor:
     closed_loop: float
 
     @property
+    def total(self) -> float:
+        """The floor: stepping, forces and the localiser together, s."""
+        return self.stepping + self.forces + self.localiser
+
+    @property
     def ceiling(self) -> float:
         """The real-time factor if everything else in the loop cost nothing."""
-        return self.sim_time / (self.stepping + self.forces + self.localiser)
+        return self.sim_time / self.total
+
+    @property
+    def ratio(self) -> float:
+        """The whole loop's wall time over the floor (1.0 would be a free framework)."""
+        return self.closed_loop / self.total
 
 
 def loop_floor(
@@ -307,11 +317,16 @@ def _localise(
 def floor_line(floor: LoopFloor) -> str:
     """The floor as one line of the bench's output: its parts, their sum, the ceiling on
     the real-time factor, and the whole loop's wall time (s)."""
-    total = floor.stepping + floor.forces + floor.localiser
     return (
         f"floor of the default scenario over its {floor.sim_time:.1f} s: stepping "
         f"{floor.stepping:.2f} s + per-step state reads and forces {floor.forces:.2f} s + "
-        f"localiser plugin alone {floor.localiser:.2f} s = {total:.2f} s, so a real-time "
+        f"localiser plugin alone {floor.localiser:.2f} s = {floor.total:.2f} s, so a real-time "
         f"factor of at most {floor.ceiling:.0f} if the rest of the loop were free "
         f"(the whole loop: {floor.closed_loop:.2f} s)"
     )
+
+
+def ratio_line(floor: LoopFloor) -> str:
+    """How far the default scenario's whole loop is above its floor, as the bench's last
+    line: their ratio of wall times (``2.0×`` is twice the floor)."""
+    return f"default scenario: the whole loop is {floor.ratio:.1f}× its floor"

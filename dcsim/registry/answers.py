@@ -193,7 +193,9 @@ _NUMBERS = (int, float)
 def _all_finite(items: tuple[Any, ...]) -> bool:
     """Whether every number the messages hold is finite, tested in one pass over all of
     them (a tracker answers a track per object every tick): their arrays joined and
-    tested, their scalars and the numbers of messages in their tuples summed."""
+    tested, their scalars and the numbers of messages in their tuples summed (NaN and
+    ±inf survive a sum; one that overflows says False, and the exact walk,
+    :func:`_first_non_finite`, then finds nothing wrong)."""
     total = 0.0
     arrays = []
     for item in items:
@@ -213,9 +215,16 @@ def _all_finite(items: tuple[Any, ...]) -> bool:
 
 
 def _non_finite(message: Any) -> str | None:
-    """The first non-finite number of a message, in words, or None."""
-    if math.isfinite(_sum_of_numbers(message)):  # NaN and ±inf survive a sum
+    """The first non-finite number of a message, in words, or None: its numbers tested
+    all at once (:func:`_all_finite`), and walked one by one only to name the bad one."""
+    if _all_finite((message,)):
         return None
+    return _first_non_finite(message)
+
+
+def _first_non_finite(message: Any) -> str | None:
+    """The first non-finite number of a message in field order, in words, or None: the
+    exact walk, one number at a time."""
     for name, value in _numbers(message):
         if not _finite(value):
             return f"returned non-finite numbers: {name} {_show(value)}"
@@ -247,7 +256,7 @@ def command_problem(command: Command, actuators: ActuatorCounts | None = None) -
         command.wheel_torques,
     )
     if not np.isfinite(np.concatenate(values)).all():
-        return _non_finite(command)
+        return _first_non_finite(command)
     return None if actuators is None else _command_shape_problem(command, actuators)
 
 

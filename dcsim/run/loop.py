@@ -51,7 +51,8 @@ from dcsim.registry.calls import PluginFailure, call_plugin
 from dcsim.registry.hookspecs import RunInfo
 from dcsim.registry.interfaces import Localiser
 from dcsim.run.recording import (
-    SIGMA_COLUMNS,
+    LEADING_COLUMNS,
+    TRAILING_COLUMNS,
     Recorder,
     RecordingError,
     duty_columns,
@@ -699,23 +700,28 @@ class Runner:
         self, t: float, estimate: StateEstimate, mode: str, out: dict[str, Any]
     ) -> dict[str, Any]:
         """One tick's telemetry row from the world's outputs and the estimate."""
-        row: dict[str, Any] = {"time": t}  # floats from tolist(): the same values, quicker
-        row.update(zip(("x", "y", "z"), out["position"].tolist(), strict=True))
-        row.update(zip(("vx", "vy", "vz"), out["velocity"].tolist(), strict=True))
-        row.update(zip(("est_x", "est_y", "est_z"), estimate.position.tolist(), strict=True))
-        row.update(zip(("est_vx", "est_vy", "est_vz"), estimate.velocity.tolist(), strict=True))
-        row.update(zip(("qx", "qy", "qz", "qw"), out["attitude"].tolist(), strict=True))
-        row.update(mode=mode, converged=int(estimate.converged))
-        row.update(self._opened_mission.telemetry(out))
-        row.update(
-            fuel_used=out["fuel_used"],
-            delta_v=out["delta_v"],
-            nearest_obstacle=out["nearest_obstacle_distance"],
+        leading = (  # floats from tolist(): the same values, quicker
+            t,
+            *out["position"].tolist(),
+            *out["velocity"].tolist(),
+            *estimate.position.tolist(),
+            *estimate.velocity.tolist(),
+            *out["attitude"].tolist(),
+            mode,
+            int(estimate.converged),
         )
-        row.update(zip(("fx", "fy", "fz"), out["command"].force.tolist(), strict=True))
-        row.update(zip(("wx", "wy", "wz"), out["angular_velocity"].tolist(), strict=True))
-        row.update(zip(SIGMA_COLUMNS, _position_sigmas(estimate.covariance), strict=True))
-        row["attitude_error"] = out["attitude_error"]
+        row: dict[str, Any] = dict(zip(LEADING_COLUMNS, leading, strict=True))
+        row.update(self._opened_mission.telemetry(out))
+        trailing = (
+            out["fuel_used"],
+            out["delta_v"],
+            out["nearest_obstacle_distance"],
+            *out["command"].force.tolist(),
+            *out["angular_velocity"].tolist(),
+            *_position_sigmas(estimate.covariance),
+            out["attitude_error"],
+        )
+        row.update(zip(TRAILING_COLUMNS, trailing, strict=True))
         if self._wheel_columns:
             momenta = out["wheel_momentum"].tolist()
             row.update(zip(self._wheel_columns, momenta, strict=True))

@@ -31,21 +31,23 @@ FLUSH_SECONDS = 2.0
 FLUSH_ROWS = 2000
 """Rows buffered at most before they are written."""
 
-_LEADING_COLUMNS = (
+LEADING_COLUMNS = (
     "time",
     "x", "y", "z", "vx", "vy", "vz",
     "est_x", "est_y", "est_z", "est_vx", "est_vy", "est_vz",
     "qx", "qy", "qz", "qw",
     "mode", "converged",
 )  # fmt: skip
+"""The columns every run records before the mission's own (:func:`telemetry_columns`)."""
 SIGMA_COLUMNS = ("est_sigma_x", "est_sigma_y", "est_sigma_z")
 """Standard deviations of the estimated position per axis (m): the square roots of the
 diagonal of the estimate's covariance, position block."""
 
-_TRAILING_COLUMNS = (
+TRAILING_COLUMNS = (
     "fuel_used", "delta_v", "nearest_obstacle", "fx", "fy", "fz",
     "wx", "wy", "wz", *SIGMA_COLUMNS, "attitude_error",
 )  # fmt: skip
+"""The columns every run records after the mission's own, before any hardware's."""
 _TEXT_COLUMNS = frozenset({"mode"})
 
 UNITS = {
@@ -112,7 +114,7 @@ def telemetry_columns(
     each one's duty cycle (:func:`duty_columns`).
     """
     hardware = (*wheel_columns(wheels), *duty_columns(thrusters))
-    return (*_LEADING_COLUMNS, *mission_columns, *_TRAILING_COLUMNS, *hardware)
+    return (*LEADING_COLUMNS, *mission_columns, *TRAILING_COLUMNS, *hardware)
 
 
 def telemetry_units(mission_units: Mapping[str, str], wheels: int = 0) -> dict[str, str]:

@@ -9,6 +9,7 @@ from dcsim_plugins.localisers.ekf import EKFLocaliser
 
 from dcsim.api import (
     AttitudeReading,
+    Observations,
     PluginRegistry,
     RateReading,
     SensorModel,
@@ -260,4 +261,16 @@ def test_sensors_asked_twice_at_one_instant_give_nothing_new():
     again = world.observations()  # the runner read the sensors at t = 0 already
     assert again.gyros is None and again.star_tracker is None
     assert np.array_equal(again.attitude, runner.estimate.attitude)
+    runner.close()
+
+
+@pytest.mark.parametrize("profile", ["ideal", "realistic"])
+def test_observations_are_what_their_constructor_would_build_and_read_only(profile):
+    runner = opened(f"sensors.profile={profile}")
+    for _ in range(9):  # the star tracker and the gyros read at their own rates
+        observations = runner.world.observations()
+        assert Observations(**vars(observations)) == observations
+        for value in vars(observations).values():
+            assert not isinstance(value, np.ndarray) or not value.flags.writeable
+        runner.advance()
     runner.close()

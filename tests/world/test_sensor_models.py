@@ -15,6 +15,7 @@ import pytest
 from scipy import stats
 
 from dcsim.api import (
+    BeaconRange,
     KnownObject,
     ObjectKind,
     PluginParameterError,
@@ -97,6 +98,16 @@ def test_default_beacon_ranges_draw_exactly_one_normal_per_range_and_tick():
         expected = true[:4] + reference.normal(0.0, 0.1, 4)
         assert [r.range for r in ranges] == expected.tolist()
     assert model.rng.bit_generator.state == reference.bit_generator.state
+
+
+def test_beacon_ranges_are_what_their_constructor_would_build_and_read_only():
+    ranges = beacon_model().measure(truth(0.0))
+    for r in ranges:
+        assert r == BeaconRange(r.beacon_id, BEACONS[r.beacon_id], r.range, r.sigma)
+        assert type(r.range) is float and type(r.beacon_id) is int
+        assert not r.beacon_position.flags.writeable and r.beacon_position.base is not None
+        assert not r.beacon_position.base.flags.writeable  # a view of the setup's beacons
+    assert len(ranges) == 4
 
 
 def test_beacon_bias_shifts_every_range_and_is_not_reported():

@@ -56,10 +56,17 @@ def bench_world_command(objects: str, duration: float, orbit_model: str, sensing
     only) and flown by the full runner; the closed loop is split by phase of the run
     loop. Then the default scenario is flown once for its real-time factor. Prints a
     Markdown table for docs/benchmarks.md, and the floor under the default scenario's
-    real-time factor: stepping, the per-step force calls and the localiser plugin alone.
+    real-time factor: stepping, the per-step force calls and the localiser plugin alone;
+    the last line is the whole loop's wall time over that floor.
     Every world moves by ORBIT_MODEL's dynamics and is sensed with the SENSING profile.
     """
-    from dcsim.bench.world import bench_world, floor_line, loop_floor, markdown_table
+    from dcsim.bench.world import (
+        bench_world,
+        floor_line,
+        loop_floor,
+        markdown_table,
+        ratio_line,
+    )
     from dcsim.run.loop import Runner
 
     words = [word.strip() for word in objects.split(",")]
@@ -86,6 +93,7 @@ def bench_world_command(objects: str, duration: float, orbit_model: str, sensing
     )
     floor = loop_floor(summary["sim_time_s"], summary["wall_time_s"], registry, overrides=overrides)
     click.echo(floor_line(floor))
+    click.echo(ratio_line(floor))
 
 
 @click.command("dynamics", short_help="The orbit models' free drift against an inertial reference.")

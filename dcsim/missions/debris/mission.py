@@ -26,7 +26,6 @@ Every reference holds the collector's initial attitude, fixed in the world frame
 
 from __future__ import annotations
 
-import dataclasses
 import enum
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
@@ -166,7 +165,7 @@ class DebrisMission(Mission):
                 break
         if self.attitude is None:
             return reference
-        return dataclasses.replace(reference, attitude=self.attitude)
+        return Reference.trusted(**{**reference.__dict__, "attitude": self.attitude})
 
     def telemetry(self, outputs: Mapping[str, Any]) -> dict[str, Any]:
         """Targets carried and delivered now."""
@@ -456,9 +455,8 @@ class DebrisMission(Mission):
             )
             self.release_refused = False
         # The limit also holds once the trajectory is flown and the drop point is tracked.
-        reference = dataclasses.replace(
-            self._follow(lambda: drop.state_at(self.time)), max_speed=self._drop_speed()
-        )
+        followed = self._follow(lambda: drop.state_at(self.time))
+        reference = Reference.trusted(**{**followed.__dict__, "max_speed": self._drop_speed()})
         distance = length(self.estimate.position - drop.state_at(self.time)[0])
         if distance <= self.settings.release_fraction * drop.tolerance:
             result = release(self.world, drop)
@@ -482,7 +480,9 @@ def _held_attitude(scenario: Scenario, attitude: str) -> np.ndarray | None:
     if attitude == "free":
         return None
     initial = np.asarray(scenario.robot.initial.attitude, dtype=float)
-    return initial / np.linalg.norm(initial)
+    held = initial / np.linalg.norm(initial)
+    held.setflags(write=False)  # given to every reference as it is
+    return held
 
 
 def _ordered_steps(plan: Plan) -> list[PlanTask | DropVisit]:

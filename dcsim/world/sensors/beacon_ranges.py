@@ -20,6 +20,8 @@ when enabled.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from dcsim.api import (
@@ -68,6 +70,7 @@ class BeaconRangeSensor(SensorModel):
     def reset(self, setup: SensorSetup) -> None:
         """Keep the beacons and the sensor's noise, reach and count; start the clock."""
         self.setup = setup
+        self._rows = list(setup.beacons)  # each beacon's position, a read-only view
         self._clock = SampleClock(self.params.rate)
 
     def measure(self, truth: SensedTruth) -> tuple[BeaconRange, ...]:
@@ -78,19 +81,22 @@ class BeaconRangeSensor(SensorModel):
         if len(beacons) == 0 or not self._clock.due(truth.time):
             return ()
         distances = row_lengths(beacons - truth.position)
-        order = np.argsort(distances, kind="stable")
-        if np.isfinite(setup.beacon_max_range):
+        order = distances.argsort(kind="stable")
+        if math.isfinite(setup.beacon_max_range):
             order = order[distances[order] <= setup.beacon_max_range]
         order = order[: setup.beacon_report_nearest]
         sigma = float(setup.beacon_noise)
         noise = self.rng.normal(0.0, sigma, len(order)) if sigma else 0.0
-        measured = np.atleast_1d(distances[order] + noise + self._errors(len(order)))
+        measured = distances[order] + noise + self._errors(len(order))
         kept = self._kept(len(order))
         if kept is not None:
             order, measured = order[kept], measured[kept]
+        rows = self._rows
         return tuple(
-            BeaconRange.trusted(beacon_id=i, beacon_position=beacons[i], range=r, sigma=sigma)
-            for i, r in zip(order.tolist(), measured.tolist(), strict=True)
+            [
+                BeaconRange.trusted(beacon_id=i, beacon_position=rows[i], range=r, sigma=sigma)
+                for i, r in zip(order.tolist(), measured.tolist(), strict=True)
+            ]
         )
 
     def _errors(self, count: int) -> float | np.ndarray:

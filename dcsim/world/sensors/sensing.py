@@ -219,6 +219,9 @@ class Sensing:
             Base attitude ``[x, y, z, w]``.
         angular_velocity : ndarray (3,)
             Base angular velocity, world frame, rad/s.
+
+        Every array is read-only and owns its data, as the world's state readings do
+        (:meth:`dcsim.world.World.base_state`): the observations keep them as they are.
         """
         truth = self.truth(time, position, velocity, attitude, angular_velocity)
         ranges = self.beacon_ranges(truth)
@@ -234,12 +237,15 @@ class Sensing:
         else:
             star, rate = self._attitude_readings(truth)
             seen_attitude, seen_rate = self._attitude, rotate(self._attitude, self._body_rate)
-        return Observations(
+            seen_rate.setflags(write=False)
+        return Observations.trusted(  # the world's and the readings' read-only arrays
             time=time,
             ranges=ranges,
             tracks=tracks,
             attitude=seen_attitude,
             angular_velocity=seen_rate,
+            joint_positions=_NO_JOINTS,
+            joint_velocities=_NO_JOINTS,
             detections=detections,
             star_tracker=star,
             gyros=rate,
@@ -271,3 +277,5 @@ _NO_OBJECTS = np.zeros((0, 3))
 _NO_OBJECTS.setflags(write=False)
 _NONE_FREE = np.zeros(0, dtype=bool)
 _NONE_FREE.setflags(write=False)
+_NO_JOINTS = np.zeros(0)
+_NO_JOINTS.setflags(write=False)
