@@ -210,6 +210,7 @@ class World:
         self._state_cache: (
             tuple[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] | None
         ) = None
+        self._cargo_cache: tuple[tuple[int, int], list[tuple[np.ndarray, float]]] | None = None
         pb.setTimeStep(self.physics_step, physicsClientId=self._client)
         self._robot = _build_robot_body(self._client, robot)
         self.actuators = _build_actuators(robot, self.control_period, self.physics_step)
@@ -384,6 +385,9 @@ class World:
         if not obstacles.size:
             return float("inf")
         positions = self.field.free_states(self.time)[0][obstacles]
+        if not self._payload.held and spheres.all():  # the robot alone, every pair exact
+            gaps = row_lengths(positions - self.base_state()[0]) - radii - self.robot.radius
+            return float(gaps.min())
         parts = self._assembly_spheres()
         centres = np.array([centre for centre, _ in parts])
         part_radii = np.array([radius for _, radius in parts])
@@ -432,7 +436,24 @@ class World:
 
     def _assembly_spheres(self) -> list[tuple[np.ndarray, float]]:
         """Centre and bounding radius of the robot, then of each object it carries."""
-        return [(self.base_state()[0], self.robot.radius), *self._payload.spheres()]
+        return [(self.base_state()[0], self.robot.radius), *self._cargo_spheres()]
+
+    def _cargo_spheres(self) -> list[tuple[np.ndarray, float]]:
+        """Centre (m, world frame, read-only) and bounding radius (m) of each object
+        carried, read from PyBullet once per physics step and payload."""
+        key = (self._steps, self._payload.changes)
+        if self._cargo_cache is None or self._cargo_cache[0] != key:
+            spheres = self._payload.spheres()
+            for centre, _ in spheres:
+                centre.setflags(write=False)
+            self._cargo_cache = (key, spheres)
+        return self._cargo_cache[1]
+
+    def _assembly_reach(self, position: np.ndarray) -> float:
+        """How far the assembly's bounding spheres reach from ``position``, the base's
+        centre (m): the robot's radius, or a carried object's farther reach."""
+        reaches = (length(c - position) + r for c, r in self._cargo_spheres())
+        return max([self.robot.radius, *reaches])
 
     def _assembly_is_sphere(self) -> np.ndarray:
         """Whether each part of :meth:`_assembly_spheres` is a sphere (the robot's part is
@@ -689,14 +710,13 @@ class World:
 
     def _update_broad_phase(self, force: np.ndarray) -> None:
         """Find the free objects that could touch the assembly in the coming period."""
-        free = np.flatnonzero(self.field.free_mask())
+        field = self.field
+        free = field.free_indices()
         if free.size == 0:
             self._candidates = free
             return
         period = self.control_period
         position, velocity, _, _ = self.base_state()
-        spheres = self._assembly_spheres()
-        reach = max(length(c - position) + r for c, r in spheres)
         push = length(force) + length(self.inputs.disturbance_force)
         accel = push / self._period_mass
         if self._mean_motion is not None:
@@ -704,12 +724,13 @@ class World:
         elif self._exact_forces is not None:
             accel += 2 * length(np.array(self._exact_forces.base.base))
         sweep = length(velocity) * period + accel * period**2
-        now = self.field.free_states(self.time)[0][free]
-        later = self.field.free_states((self._steps + self.steps_per_control) * self.physics_step)[
-            0
-        ][free]
+        now = field.free_states(self.time)[0]
+        later = field.free_states((self._steps + self.steps_per_control) * self.physics_step)[0]
+        radii = field.radii
+        if free.size < len(field):
+            now, later, radii = now[free], later[free], radii[free]
         moves = row_lengths(later - now)
-        gaps = row_lengths(now - position) - reach - self.field.radii[free]
+        gaps = row_lengths(now - position) - self._assembly_reach(position) - radii
         self._candidates = free[gaps <= 1.5 * (moves + sweep) + _BROAD_PHASE_SLACK]
 
     def _detect_collisions(self) -> list[CollisionEvent]:
