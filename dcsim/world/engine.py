@@ -541,17 +541,14 @@ class World:
         if self._exact_forces is not None:
             self._linearise_orbital_forces()
         self._update_broad_phase(force)
-        disturbance = tuple(float(f) for f in self.inputs.disturbance_force)
+        disturbance = tuple(np.asarray(self.inputs.disturbance_force, dtype=float).tolist())
+        other_torque = np.asarray(self.inputs.disturbance_torque, dtype=float)
         if self.actuators is not None and self.actuators.thrusters is not None:
             profile = self._fire_thrusters(force)
-            torque = tuple(float(q) for q in self.inputs.disturbance_torque)
+            torque = tuple(other_torque.tolist())
             started = self._fly_period(None, disturbance, torque, profile)
         else:
-            commanded = self._torque_on_base()
-            torque = tuple(
-                float(q)
-                for q in commanded + np.asarray(self.inputs.disturbance_torque, dtype=float)
-            )
+            torque = tuple((self._torque_on_base() + other_torque).tolist())
             thrusts = self._propellant.burn(force, self._period_mass)
             started = self._fly_period(thrusts, disturbance, torque)
         self._set_body_mass(self.base_mass())
@@ -638,7 +635,7 @@ class World:
         get_pose, get_velocity = pb.getBasePositionAndOrientation, pb.getBaseVelocity
         apply_force, step = pb.applyExternalForce, pb.stepSimulation
         cargo = [(c, self.field.objects[i].mass) for i, (c, _) in self._payload.held.items()]
-        robot, links = self._robot, self._robot.links
+        robot, links, joints = self._robot, self._robot.links, self._robot.n_joints > 0
         exact, dt = self._exact_forces, self.physics_step
         parts = exact is not None and exact.has_parts
         wheels, actuators = self.wheels, self.actuators
@@ -675,7 +672,8 @@ class World:
                 fx, fy, fz = fx + mass * ax, fy + mass * ay, fz + mass * az
                 if parts:
                     exact.apply_to_parts(k * dt)
-            robot.apply_joint_torques(self._joint_torques)
+            if joints:
+                robot.apply_joint_torques(self._joint_torques)
             apply_force(body, -1, (fx, fy, fz), position, pb.WORLD_FRAME, client)
             if wheels is not None:
                 self._apply_wheel_torque(attitude, moments, step_torque)
