@@ -646,28 +646,34 @@ class World:
             moments = (ix, iy, iz)
         apply_torque = torque != (0.0, 0.0, 0.0) or profile is not None
         check_contacts = len(self._candidates) > 0
+        # each step reads the base's state once: the rotation for the thrusters' and the
+        # wheels' body-frame torques, the velocity for the orbital force and the wheels
+        turns = profile is not None or wheels is not None
+        moves = n is not None or exact is not None or wheels is not None
         dx, dy, dz = disturbance
         started: list[CollisionEvent] = []
         for k in range(self.steps_per_control):
             position, attitude = get_pose(body, client)
+            if turns:
+                rotation = pb.getMatrixFromQuaternion(attitude)
+            if moves:
+                velocity, angular = get_velocity(body, client)
             if thrusts is not None:
                 tx, ty, tz = thrusts[k]
                 step_torque = torque
             else:
-                rotation = pb.getMatrixFromQuaternion(attitude)
                 tx, ty, tz = turn(rotation, body_forces[k])
                 qx, qy, qz = turn(rotation, body_torques[k])
                 step_torque = (qx + torque[0], qy + torque[1], qz + torque[2])
             fx, fy, fz = tx + dx, ty + dy, tz + dz
             if n is not None:
-                ax, ay, az = cw_acceleration(n, position, get_velocity(body, client)[0])
+                ax, ay, az = cw_acceleration(n, position, velocity)
                 fx, fy, fz = fx + mass * ax, fy + mass * ay, fz + mass * az
                 for carried, carried_mass in cargo:
                     apply_cw_force(client, carried, carried_mass, n)
                 for link, link_mass in links:
                     apply_cw_force_on_link(client, body, link, link_mass, n)
             elif exact is not None:
-                velocity = get_velocity(body, client)[0]
                 ax, ay, az = exact.base_acceleration(k * dt, body, position, velocity)
                 fx, fy, fz = fx + mass * ax, fy + mass * ay, fz + mass * az
                 if parts:
@@ -676,7 +682,7 @@ class World:
                 robot.apply_joint_torques(self._joint_torques)
             apply_force(body, -1, (fx, fy, fz), position, pb.WORLD_FRAME, client)
             if wheels is not None:
-                self._apply_wheel_torque(attitude, moments, step_torque)
+                self._apply_wheel_torque(rotation, angular, moments, step_torque)
             elif apply_torque:
                 pb.applyExternalTorque(body, -1, step_torque, pb.WORLD_FRAME, client)
             step(client)
@@ -689,17 +695,19 @@ class World:
 
     def _apply_wheel_torque(
         self,
-        attitude: tuple[float, ...],
+        rotation: tuple[float, ...],
+        angular_velocity: tuple[float, ...],
         moments: tuple[float, float, float],
         disturbance: tuple[float, ...],
     ) -> None:
         """Step the reaction wheels and put their reaction, with ``disturbance`` (world
-        frame, N·m), on the base for the coming physics step; ``attitude`` is the base's
-        now ``[x, y, z, w]``, ``moments`` its principal moments of inertia (kg·m²)."""
+        frame, N·m), on the base for the coming physics step; ``rotation`` is the base's
+        body-to-world rotation now (nine floats, row by row), ``angular_velocity`` its
+        angular velocity (world frame, rad/s), ``moments`` its principal moments of
+        inertia (kg·m²)."""
         assert self.wheels is not None
         client, body = self._client, self.robot_id
-        rotation = pb.getMatrixFromQuaternion(attitude)
-        wx, wy, wz = pb.getBaseVelocity(body, client)[1]
+        wx, wy, wz = angular_velocity
         dx, dy, dz = disturbance
         rx, ry, rz = self.wheels.step(
             rotation, (wx, wy, wz), moments, (dx, dy, dz), self.physics_step
