@@ -211,6 +211,7 @@ class World:
             tuple[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] | None
         ) = None
         self._cargo_cache: tuple[tuple[int, int], list[tuple[np.ndarray, float]]] | None = None
+        self._kinds_cache: tuple[int, tuple[np.ndarray, np.ndarray]] | None = None
         pb.setTimeStep(self.physics_step, physicsClientId=self._client)
         self._robot = _build_robot_body(self._client, robot)
         self.actuators = _build_actuators(robot, self.control_period, self.physics_step)
@@ -388,12 +389,10 @@ class World:
         if not self._payload.held and spheres.all():  # the robot alone, every pair exact
             gaps = row_lengths(positions - self.base_state()[0]) - radii - self.robot.radius
             return float(gaps.min())
-        parts = self._assembly_spheres()
-        centres = np.array([centre for centre, _ in parts])
-        part_radii = np.array([radius for _, radius in parts])
+        centres = np.array([centre for centre, _ in self._assembly_spheres()])
+        part_radii, is_sphere = self._assembly_kinds()
         distances = row_lengths(positions - centres[:, None])  # (parts, obstacles)
         bounds = distances - radii - part_radii[:, None]
-        is_sphere = self._assembly_is_sphere()
         if spheres.all() and is_sphere.all():  # every pair exact: sphere to sphere
             return float(bounds.min())
         exact = np.outer(is_sphere, spheres)
@@ -455,10 +454,17 @@ class World:
         reaches = (length(c - position) + r for c, r in self._cargo_spheres())
         return max([self.robot.radius, *reaches])
 
-    def _assembly_is_sphere(self) -> np.ndarray:
-        """Whether each part of :meth:`_assembly_spheres` is a sphere (the robot's part is
-        its bounding sphere)."""
-        return np.array([True, *self.field.is_sphere[list(self._payload.held)]])
+    def _assembly_kinds(self) -> tuple[np.ndarray, np.ndarray]:
+        """The bounding radius (m) of each part of :meth:`_assembly_spheres` and whether
+        it is a sphere (the robot's part is its bounding sphere), kept until the payload
+        changes."""
+        changes = self._payload.changes
+        if self._kinds_cache is None or self._kinds_cache[0] != changes:
+            held = list(self._payload.held)
+            radii = np.array([self.robot.radius, *self.field.radii[held]])
+            spheres = np.array([True, *self.field.is_sphere[held]])
+            self._kinds_cache = (changes, (radii, spheres))
+        return self._kinds_cache[1]
 
     def parameters(self) -> dict[str, float]:
         """Named scalar parameters of the world as a system (fixed for its lifetime)."""

@@ -404,3 +404,23 @@ def test_the_nearest_obstacle_gap_is_the_least_sphere_to_sphere_gap():
     centres = world.object_states()[0][obstacles]
     gaps = np.linalg.norm(centres - position, axis=1) - world.field.radii[obstacles] - 0.5
     assert world.nearest_obstacle_distance() == gaps.min()
+
+
+def test_the_nearest_obstacle_gap_counts_the_cargo():
+    # Target 1 (0.5 m) carried beside the collector passes nearer the obstacle at x = 2.
+    text = BROAD_PHASE.replace("[1.05, 0, 0]", "[2.0, 2.2, 0]").replace(
+        "[0, 0, -1.1]", "[0, 0, -4]"
+    )
+    world = world_from(text)
+    assert grab_target(world, 1).success
+    for _ in range(3):
+        world.step()
+        parts = [(world.base_state()[0], 0.5), (world.object_states()[0][0], 0.5)]
+        obstacles = [2, 3]
+        centres = world.object_states()[0][obstacles]
+        gaps = [
+            np.linalg.norm(centres - centre, axis=1) - world.field.radii[obstacles] - radius
+            for centre, radius in parts
+        ]
+        assert np.argmin(np.min(gaps, axis=1)) == 1  # the cargo is the nearer part
+        assert world.nearest_obstacle_distance() == np.min(gaps)
