@@ -349,21 +349,62 @@ def _cw_state(
     """The Clohessy–Wiltshire closed form; components of ``position`` (m) and ``velocity``
     (m/s) at the epoch broadcast with τ (s); ``n`` is the mean motion, rad/s.
 
-    With floats for ``n`` and ``τ`` (one model, or models sharing them, at one time) the
-    coefficients stay in Python floats: the same IEEE operations, in the same order, as
-    numpy's element by element, without its per-call overhead.
+    Each coordinate is a sum of the initial components times coefficients of ``nτ``,
+    added in one order whatever the layout (a difference is the sum of the negated
+    term, the same IEEE operation). With floats for ``n`` and ``τ`` (one model, or models
+    sharing them, at one time) the coefficients stay in Python floats: the same
+    operations as numpy's element by element, without its per-call overhead; many
+    models at one time are then summed as rows of two arrays (:func:`_cw_rows`).
     """
     nt = n * tau
     s, c = _sin_cos(nt)
+    k = 2 / n * (1 - c)
+    # coefficients of x0, u0 and v0 in x, y, vx and vy (y adds y0 after its x0 term)
+    plane = (
+        (4 - 3 * c, s / n, k),
+        (6 * (s - nt), -k, (4 * s - 3 * nt) / n),
+        (3 * n * s, c, 2 * s),
+        (-6 * n * (1 - c), -(2 * s), 4 * c - 3),
+    )
+    normal = ((c, s / n), (-n * s, c))  # coefficients of z0 and w0 in z and vz
+    if isinstance(nt, float) and isinstance(position, np.ndarray):
+        return _cw_rows(plane, normal, position, np.asarray(velocity))
     x0, y0, z0 = position
     u0, v0, w0 = velocity
-    x = (4 - 3 * c) * x0 + s / n * u0 + 2 / n * (1 - c) * v0
-    y = 6 * (s - nt) * x0 + y0 - 2 / n * (1 - c) * u0 + (4 * s - 3 * nt) / n * v0
-    z = c * z0 + s / n * w0
-    vx = 3 * n * s * x0 + c * u0 + 2 * s * v0
-    vy = -6 * n * (1 - c) * x0 - 2 * s * u0 + (4 * c - 3) * v0
-    vz = -n * s * z0 + c * w0
+    (ax, bx, cx), (ay, by, cy), (au, bu, cu), (av, bv, cv) = plane
+    (az, bz), (aw, bw) = normal
+    x = ax * x0 + bx * u0 + cx * v0
+    y = ay * x0 + y0 + by * u0 + cy * v0
+    z = az * z0 + bz * w0
+    vx = au * x0 + bu * u0 + cu * v0
+    vy = av * x0 + bv * u0 + cv * v0
+    vz = aw * z0 + bw * w0
     return _columns(x, y, z), _columns(vx, vy, vz)
+
+
+def _cw_rows(
+    plane: tuple[tuple[_Scalars, ...], ...],
+    normal: tuple[tuple[_Scalars, ...], ...],
+    position: Vector,
+    velocity: Vector,
+) -> tuple[Vector, Vector]:
+    """:func:`_cw_state`'s sums for N models at one time: ``position`` and ``velocity``
+    (3, N) at the epoch, m and m/s, and the coefficients as floats; positions and
+    velocities (N, 3), each element the same sum in the same order as one model's."""
+    x0, y0, z0 = position
+    u0, v0, w0 = velocity
+    a, b, c = np.array(plane).T[:, :, None]  # (4, 1) each: x, y, vx, vy
+    rows = a * x0
+    rows[1] += y0
+    rows += b * u0
+    rows += c * v0
+    d, e = np.array(normal).T[:, :, None]  # (2, 1) each: z, vz
+    across = d * z0
+    across += e * w0
+    states = np.empty((2, x0.shape[-1], 3))
+    states[:, :, :2] = rows.reshape(2, 2, -1).transpose(0, 2, 1)
+    states[:, :, 2] = across
+    return states[0], states[1]
 
 
 @overload

@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from dcsim.geometry import row_lengths
+from dcsim.geometry import cross, row_lengths
 from dcsim.scenario.model import ActuatorsSpec
 from dcsim.world.environment import Propellant
 from dcsim.world.thrusters import Thrusters
@@ -211,7 +211,7 @@ class Actuators:
             body_torque = (
                 rotation.T @ torque if self.wheels is None else self._unloading_torque(time)
             )
-            body_torque = body_torque + np.cross(centre, body_force)
+            body_torque = body_torque + cross(centre, body_force)
             firing = thrusters.allocate(body_force, body_torque)
             self._note_shortfall(time, firing.shortfall, body_force, body_torque)
             on_times = thrusters.modulate(firing.on_times)
@@ -224,7 +224,7 @@ class Actuators:
         mean_force = forces.mean(axis=0)
         propellant.book_thrust(row_lengths(forces), rotation @ mean_force, mass)
         self._split_propellant(float(needed @ allowed), mean_force, centre)
-        mean_torque = torques.mean(axis=0) - np.cross(centre, mean_force)
+        mean_torque = torques.mean(axis=0) - cross(centre, mean_force)
         return ThrustProfile(forces, torques, mean_torque)
 
     def note_saturations(self, time: float) -> None:
@@ -269,6 +269,6 @@ class Actuators:
         if used == 0.0:
             return
         assert self.thrusters is not None
-        alone = self.thrusters.allocate(mean_force, np.cross(centre, mean_force)).on_times
+        alone = self.thrusters.allocate(mean_force, cross(centre, mean_force)).on_times
         translation = float(alone @ self.thrusters.mass_flow)
         self.attitude_propellant += min(max(used - translation, 0.0), used)

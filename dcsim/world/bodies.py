@@ -6,10 +6,12 @@ orientation wherever it is placed. :func:`create_body` makes the free flyer's sp
 too.
 
 Every body has collision filtering off: contacts are detected by closest-point queries
-(:func:`surface_gap`), never resolved, so bodies pass through each other. A free
-object's body is static and is moved to its motion model's position only when a query
-needs it (:meth:`ObjectBodies.place`), so a large field costs little; a grabbed target
-gets a dynamic body of its mass.
+(:func:`surface_gap`), never resolved, so bodies pass through each other. Free objects
+of one shape (kind and dimensions) share one static body, moved to an object's model
+pose only when a query about that object needs it (:meth:`ObjectBodies.place`): a
+PyBullet step costs about 50 ns for every body in the world, even a static one that
+collides with nothing, so a field of a thousand spheres of one size steps as fast as one
+of a single sphere. A grabbed target gets a dynamic body of its own, of its mass.
 """
 
 from __future__ import annotations
@@ -102,32 +104,41 @@ def surface_gap(client: int, body_a: int, body_b: int, within: float) -> float:
 
 
 class ObjectBodies:
-    """The PyBullet body of every space object, by the object's index in the field.
+    """The PyBullet body each space object is queried with, by the object's index in the
+    field.
 
     Parameters
     ----------
     client : int
         PyBullet client id.
     field : ObjectField
-        The objects; each gets a static body at its position at t = 0.
+        The objects; those of one shape share a static body.
 
     Attributes
     ----------
     ids : list of int
-        Body id of each object (a carried target's dynamic body once grabbed).
+        Body id of each object: the static body of its shape, or a carried target's own
+        dynamic body once grabbed.
     """
 
     def __init__(self, client: int, field: ObjectField) -> None:
         self._client = client
         self._field = field
         self._orientations = [obj.shape.orientation.tolist() for obj in field.objects]
-        self.ids = [
-            create_body(client, obj.shape, 0.0, field.free_states(0.0)[0][index], True)
-            for index, obj in enumerate(field.objects)
-        ]
+        shared: dict[tuple[object, ...], int] = {}
+        self.ids = [self._shape_body(shared, obj.shape) for obj in field.objects]
+
+    def _shape_body(self, shared: dict[tuple[object, ...], int], shape: Shape) -> int:
+        """The static body ``shared`` holds for ``shape``'s kind and dimensions, created
+        on first use."""
+        key = (shape.kind, shape.radius, shape.height, *shape.half_extents.tolist())
+        if key not in shared:
+            shared[key] = create_body(self._client, shape, 0.0, np.zeros(3), True)
+        return shared[key]
 
     def place(self, index: int, time: float) -> int:
-        """Move free object ``index``'s static body to its model pose at ``time`` (s).
+        """Move free object ``index``'s static body to its model pose at ``time`` (s), for
+        a query about that object (another of its shape may be placed there next).
 
         Returns
         -------
@@ -142,7 +153,8 @@ class ObjectBodies:
         return body
 
     def make_dynamic(self, index: int, position: np.ndarray, velocity: np.ndarray) -> int:
-        """Replace object ``index``'s static body by a dynamic one of its mass and shape.
+        """Give object ``index`` a dynamic body of its own, of its mass and shape, in place
+        of its shape's static one.
 
         Parameters
         ----------
@@ -156,7 +168,6 @@ class ObjectBodies:
         int
             The new body id.
         """
-        pb.removeBody(self.ids[index], physicsClientId=self._client)
         obj = self._field.objects[index]
         body = create_body(self._client, obj.shape, obj.mass, position, False)
         pb.resetBaseVelocity(body, velocity.tolist(), [0, 0, 0], physicsClientId=self._client)

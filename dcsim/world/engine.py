@@ -210,6 +210,8 @@ class World:
         self._state_cache: (
             tuple[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] | None
         ) = None
+        self._cargo_cache: tuple[tuple[int, int], list[tuple[np.ndarray, float]]] | None = None
+        self._kinds_cache: tuple[int, tuple[np.ndarray, np.ndarray]] | None = None
         pb.setTimeStep(self.physics_step, physicsClientId=self._client)
         self._robot = _build_robot_body(self._client, robot)
         self.actuators = _build_actuators(robot, self.control_period, self.physics_step)
@@ -384,12 +386,13 @@ class World:
         if not obstacles.size:
             return float("inf")
         positions = self.field.free_states(self.time)[0][obstacles]
-        parts = self._assembly_spheres()
-        centres = np.array([centre for centre, _ in parts])
-        part_radii = np.array([radius for _, radius in parts])
+        if not self._payload.held and spheres.all():  # the robot alone, every pair exact
+            gaps = row_lengths(positions - self.base_state()[0]) - radii - self.robot.radius
+            return float(gaps.min())
+        centres = np.array([centre for centre, _ in self._assembly_spheres()])
+        part_radii, is_sphere = self._assembly_kinds()
         distances = row_lengths(positions - centres[:, None])  # (parts, obstacles)
         bounds = distances - radii - part_radii[:, None]
-        is_sphere = self._assembly_is_sphere()
         if spheres.all() and is_sphere.all():  # every pair exact: sphere to sphere
             return float(bounds.min())
         exact = np.outer(is_sphere, spheres)
@@ -432,12 +435,36 @@ class World:
 
     def _assembly_spheres(self) -> list[tuple[np.ndarray, float]]:
         """Centre and bounding radius of the robot, then of each object it carries."""
-        return [(self.base_state()[0], self.robot.radius), *self._payload.spheres()]
+        return [(self.base_state()[0], self.robot.radius), *self._cargo_spheres()]
 
-    def _assembly_is_sphere(self) -> np.ndarray:
-        """Whether each part of :meth:`_assembly_spheres` is a sphere (the robot's part is
-        its bounding sphere)."""
-        return np.array([True, *self.field.is_sphere[list(self._payload.held)]])
+    def _cargo_spheres(self) -> list[tuple[np.ndarray, float]]:
+        """Centre (m, world frame, read-only) and bounding radius (m) of each object
+        carried, read from PyBullet once per physics step and payload."""
+        key = (self._steps, self._payload.changes)
+        if self._cargo_cache is None or self._cargo_cache[0] != key:
+            spheres = self._payload.spheres()
+            for centre, _ in spheres:
+                centre.setflags(write=False)
+            self._cargo_cache = (key, spheres)
+        return self._cargo_cache[1]
+
+    def _assembly_reach(self, position: np.ndarray) -> float:
+        """How far the assembly's bounding spheres reach from ``position``, the base's
+        centre (m): the robot's radius, or a carried object's farther reach."""
+        reaches = (length(c - position) + r for c, r in self._cargo_spheres())
+        return max([self.robot.radius, *reaches])
+
+    def _assembly_kinds(self) -> tuple[np.ndarray, np.ndarray]:
+        """The bounding radius (m) of each part of :meth:`_assembly_spheres` and whether
+        it is a sphere (the robot's part is its bounding sphere), kept until the payload
+        changes."""
+        changes = self._payload.changes
+        if self._kinds_cache is None or self._kinds_cache[0] != changes:
+            held = list(self._payload.held)
+            radii = np.array([self.robot.radius, *self.field.radii[held]])
+            spheres = np.array([True, *self.field.is_sphere[held]])
+            self._kinds_cache = (changes, (radii, spheres))
+        return self._kinds_cache[1]
 
     def parameters(self) -> dict[str, float]:
         """Named scalar parameters of the world as a system (fixed for its lifetime)."""
@@ -520,17 +547,14 @@ class World:
         if self._exact_forces is not None:
             self._linearise_orbital_forces()
         self._update_broad_phase(force)
-        disturbance = tuple(float(f) for f in self.inputs.disturbance_force)
+        disturbance = tuple(np.asarray(self.inputs.disturbance_force, dtype=float).tolist())
+        other_torque = np.asarray(self.inputs.disturbance_torque, dtype=float)
         if self.actuators is not None and self.actuators.thrusters is not None:
             profile = self._fire_thrusters(force)
-            torque = tuple(float(q) for q in self.inputs.disturbance_torque)
+            torque = tuple(other_torque.tolist())
             started = self._fly_period(None, disturbance, torque, profile)
         else:
-            commanded = self._torque_on_base()
-            torque = tuple(
-                float(q)
-                for q in commanded + np.asarray(self.inputs.disturbance_torque, dtype=float)
-            )
+            torque = tuple((self._torque_on_base() + other_torque).tolist())
             thrusts = self._propellant.burn(force, self._period_mass)
             started = self._fly_period(thrusts, disturbance, torque)
         self._set_body_mass(self.base_mass())
@@ -617,7 +641,7 @@ class World:
         get_pose, get_velocity = pb.getBasePositionAndOrientation, pb.getBaseVelocity
         apply_force, step = pb.applyExternalForce, pb.stepSimulation
         cargo = [(c, self.field.objects[i].mass) for i, (c, _) in self._payload.held.items()]
-        robot, links = self._robot, self._robot.links
+        robot, links, joints = self._robot, self._robot.links, self._robot.n_joints > 0
         exact, dt = self._exact_forces, self.physics_step
         parts = exact is not None and exact.has_parts
         wheels, actuators = self.wheels, self.actuators
@@ -628,36 +652,43 @@ class World:
             moments = (ix, iy, iz)
         apply_torque = torque != (0.0, 0.0, 0.0) or profile is not None
         check_contacts = len(self._candidates) > 0
+        # each step reads the base's state once: the rotation for the thrusters' and the
+        # wheels' body-frame torques, the velocity for the orbital force and the wheels
+        turns = profile is not None or wheels is not None
+        moves = n is not None or exact is not None or wheels is not None
         dx, dy, dz = disturbance
         started: list[CollisionEvent] = []
         for k in range(self.steps_per_control):
             position, attitude = get_pose(body, client)
+            if turns:
+                rotation = pb.getMatrixFromQuaternion(attitude)
+            if moves:
+                velocity, angular = get_velocity(body, client)
             if thrusts is not None:
                 tx, ty, tz = thrusts[k]
                 step_torque = torque
             else:
-                rotation = pb.getMatrixFromQuaternion(attitude)
                 tx, ty, tz = turn(rotation, body_forces[k])
                 qx, qy, qz = turn(rotation, body_torques[k])
                 step_torque = (qx + torque[0], qy + torque[1], qz + torque[2])
             fx, fy, fz = tx + dx, ty + dy, tz + dz
             if n is not None:
-                ax, ay, az = cw_acceleration(n, position, get_velocity(body, client)[0])
+                ax, ay, az = cw_acceleration(n, position, velocity)
                 fx, fy, fz = fx + mass * ax, fy + mass * ay, fz + mass * az
                 for carried, carried_mass in cargo:
                     apply_cw_force(client, carried, carried_mass, n)
                 for link, link_mass in links:
                     apply_cw_force_on_link(client, body, link, link_mass, n)
             elif exact is not None:
-                velocity = get_velocity(body, client)[0]
                 ax, ay, az = exact.base_acceleration(k * dt, body, position, velocity)
                 fx, fy, fz = fx + mass * ax, fy + mass * ay, fz + mass * az
                 if parts:
                     exact.apply_to_parts(k * dt)
-            robot.apply_joint_torques(self._joint_torques)
+            if joints:
+                robot.apply_joint_torques(self._joint_torques)
             apply_force(body, -1, (fx, fy, fz), position, pb.WORLD_FRAME, client)
             if wheels is not None:
-                self._apply_wheel_torque(attitude, moments, step_torque)
+                self._apply_wheel_torque(rotation, angular, moments, step_torque)
             elif apply_torque:
                 pb.applyExternalTorque(body, -1, step_torque, pb.WORLD_FRAME, client)
             step(client)
@@ -670,17 +701,19 @@ class World:
 
     def _apply_wheel_torque(
         self,
-        attitude: tuple[float, ...],
+        rotation: tuple[float, ...],
+        angular_velocity: tuple[float, ...],
         moments: tuple[float, float, float],
         disturbance: tuple[float, ...],
     ) -> None:
         """Step the reaction wheels and put their reaction, with ``disturbance`` (world
-        frame, N·m), on the base for the coming physics step; ``attitude`` is the base's
-        now ``[x, y, z, w]``, ``moments`` its principal moments of inertia (kg·m²)."""
+        frame, N·m), on the base for the coming physics step; ``rotation`` is the base's
+        body-to-world rotation now (nine floats, row by row), ``angular_velocity`` its
+        angular velocity (world frame, rad/s), ``moments`` its principal moments of
+        inertia (kg·m²)."""
         assert self.wheels is not None
         client, body = self._client, self.robot_id
-        rotation = pb.getMatrixFromQuaternion(attitude)
-        wx, wy, wz = pb.getBaseVelocity(body, client)[1]
+        wx, wy, wz = angular_velocity
         dx, dy, dz = disturbance
         rx, ry, rz = self.wheels.step(
             rotation, (wx, wy, wz), moments, (dx, dy, dz), self.physics_step
@@ -689,14 +722,13 @@ class World:
 
     def _update_broad_phase(self, force: np.ndarray) -> None:
         """Find the free objects that could touch the assembly in the coming period."""
-        free = np.flatnonzero(self.field.free_mask())
+        field = self.field
+        free = field.free_indices()
         if free.size == 0:
             self._candidates = free
             return
         period = self.control_period
         position, velocity, _, _ = self.base_state()
-        spheres = self._assembly_spheres()
-        reach = max(length(c - position) + r for c, r in spheres)
         push = length(force) + length(self.inputs.disturbance_force)
         accel = push / self._period_mass
         if self._mean_motion is not None:
@@ -704,12 +736,13 @@ class World:
         elif self._exact_forces is not None:
             accel += 2 * length(np.array(self._exact_forces.base.base))
         sweep = length(velocity) * period + accel * period**2
-        now = self.field.free_states(self.time)[0][free]
-        later = self.field.free_states((self._steps + self.steps_per_control) * self.physics_step)[
-            0
-        ][free]
+        now = field.free_states(self.time)[0]
+        later = field.free_states((self._steps + self.steps_per_control) * self.physics_step)[0]
+        radii = field.radii
+        if free.size < len(field):
+            now, later, radii = now[free], later[free], radii[free]
         moves = row_lengths(later - now)
-        gaps = row_lengths(now - position) - reach - self.field.radii[free]
+        gaps = row_lengths(now - position) - self._assembly_reach(position) - radii
         self._candidates = free[gaps <= 1.5 * (moves + sweep) + _BROAD_PHASE_SLACK]
 
     def _detect_collisions(self) -> list[CollisionEvent]:

@@ -55,12 +55,12 @@ def apply_cw_force(client: int, body: int, mass: float, mean_motion: float) -> N
     The force, ``mass`` times :func:`cw_acceleration` at the body's current state, acts
     at its centre of mass in the world (LVLH) frame.
     """
-    p, _ = pb.getBasePositionAndOrientation(body, physicsClientId=client)
-    v, _ = pb.getBaseVelocity(body, physicsClientId=client)
+    # the client id is passed by position: PyBullet parses a keyword more slowly, and this
+    # runs for every carried object every physics step
+    p, _ = pb.getBasePositionAndOrientation(body, client)
+    v, _ = pb.getBaseVelocity(body, client)
     cx, cy, cz = cw_acceleration(mean_motion, p, v)
-    pb.applyExternalForce(
-        body, -1, (mass * cx, mass * cy, mass * cz), p, pb.WORLD_FRAME, physicsClientId=client
-    )
+    pb.applyExternalForce(body, -1, (mass * cx, mass * cy, mass * cz), p, pb.WORLD_FRAME, client)
 
 
 def apply_cw_force_on_link(

@@ -183,6 +183,14 @@ class ObjectField:
             mask = self._derived.free = _read_only(self.status == _FREE)
         return mask
 
+    def free_indices(self) -> np.ndarray:
+        """Indices of the objects that are free, ascending (read-only, kept until a status
+        changes)."""
+        indices = self._derived.indices
+        if indices is None:
+            indices = self._derived.indices = _read_only(np.flatnonzero(self.free_mask()))
+        return indices
+
     def free_obstacles(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Indices of the free obstacles, their bounding radii (m) and whether each is a
         sphere (read-only arrays, kept until a status changes)."""
@@ -216,6 +224,8 @@ class _Derived:
     ----------
     free : ndarray of bool or None
         :meth:`ObjectField.free_mask`, once asked for.
+    indices : ndarray of int or None
+        :meth:`ObjectField.free_indices`, once asked for.
     obstacles : tuple of 3 ndarray or None
         :meth:`ObjectField.free_obstacles`, once asked for.
     counts : dict of (int, bool) to int
@@ -223,6 +233,7 @@ class _Derived:
     """
 
     free: np.ndarray | None = None
+    indices: np.ndarray | None = None
     obstacles: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
     counts: dict[tuple[int, bool], int] = field(default_factory=dict)
 

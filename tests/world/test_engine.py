@@ -18,7 +18,7 @@ from dcsim.api import (
 from dcsim.missions.debris.services import GrabResult, grab, release
 from dcsim.scenario import ScenarioDocument, validate
 from dcsim.world import World, WorldInputs
-from dcsim.world.environment import STANDARD_GRAVITY
+from dcsim.world.environment import STANDARD_GRAVITY, cw_acceleration
 from dcsim.world.pybullet_client import pb
 
 N = mean_motion(6_778_137.0)
@@ -337,3 +337,90 @@ def test_the_spec_inertia_is_the_assembly_s_about_its_centre_of_mass():
     expected = base_rotation.T @ expected @ base_rotation
     np.testing.assert_allclose(world.robot_spec().inertia, expected, rtol=1e-9, atol=0)
     assert world.robot_spec().mass == pytest.approx(base_mass + 5.0)
+
+
+def swept_sphere_candidates(world: World, force: np.ndarray) -> np.ndarray:
+    """The broad phase's rule written out: a free object is a candidate when the gap
+    between its bounding sphere and the assembly's reach (each part's centre distance
+    from the base's centre plus its radius) is within 1.5 times its own move over the
+    period plus the assembly's sweep, plus 1 mm."""
+    position, velocity, _, _ = world.base_state()
+    client, field = world.client, world.field
+    reaches = [world.robot.radius]
+    for index, (body, _) in world._payload.held.items():
+        centre = np.array(pb.getBasePositionAndOrientation(body, physicsClientId=client)[0])
+        reaches.append(np.linalg.norm(centre - position) + field.radii[index])
+    accel = (np.linalg.norm(force) + np.linalg.norm(world.inputs.disturbance_force)) / (
+        world.assembly_mass()
+    )
+    accel += 2 * np.linalg.norm(cw_acceleration(N, position, velocity))
+    period = world.control_period
+    sweep = np.linalg.norm(velocity) * period + accel * period**2
+    end = (round(world.time / world.physics_step) + world.steps_per_control) * world.physics_step
+    free = np.flatnonzero(field.status == 0)
+    now, later = field.free_states(world.time)[0][free], field.free_states(end)[0][free]
+    moves = np.linalg.norm(later - now, axis=1)
+    gaps = np.linalg.norm(now - position, axis=1) - max(reaches) - field.radii[free]
+    return free[gaps <= 1.5 * (moves + sweep) + 1e-3]
+
+
+BROAD_PHASE = """\
+    world: {frame: lvlh, physics_step: 0.01, control_period: 0.1}
+    robot: {radius: 0.5, grab_distance: 1.0, capacity: 1, initial: {velocity: [0.5, 0, 0]}}
+    mission:
+      targets:
+        - {id: 1, radius: 0.5, mass: 5, motion: {type: static, position: [0, 1.9, 0]}}
+        - {id: 2, radius: 0.5, mass: 5, motion: {type: static, position: [-2.8, 0, 0]}}
+    obstacles:
+      - {id: 7, radius: 0.5, motion: {type: static, position: [1.05, 0, 0]}}
+      - {id: 8, radius: 0.5, motion: {type: cw, position: [0, 0, -1.1], velocity: [0, 0, 0.5]}}
+    """
+
+
+def test_the_broad_phase_keeps_every_free_object_the_swept_spheres_may_reach():
+    # Obstacle 7 is in reach by the robot's sweep, 8 by its own move, target 2 only once
+    # the robot carries target 1 (its reach grows to 2.4 m); a carried target is no
+    # candidate.
+    world = world_from(BROAD_PHASE)
+    force = np.array([5.0, 1.0, 0.0])
+    world.inputs = WorldInputs(force=force, disturbance_force=np.array([0.0, 0.0, 0.3]))
+    world._update_broad_phase(force)
+    np.testing.assert_array_equal(world._candidates, [2, 3])
+    np.testing.assert_array_equal(world._candidates, swept_sphere_candidates(world, force))
+    assert grab_target(world, 1).success
+    for _ in range(2):
+        world.step()
+        world._update_broad_phase(force)
+        np.testing.assert_array_equal(world._candidates, [1, 2, 3])
+        np.testing.assert_array_equal(world._candidates, swept_sphere_candidates(world, force))
+
+
+def test_the_nearest_obstacle_gap_is_the_least_sphere_to_sphere_gap():
+    world = world_from(FIELD)
+    for _ in range(20):
+        world.step(WorldInputs(force=np.array([-5.0, 1.0, 0.0])))
+    position = world.base_state()[0]
+    obstacles = np.flatnonzero(~world.field.is_target)
+    centres = world.object_states()[0][obstacles]
+    gaps = np.linalg.norm(centres - position, axis=1) - world.field.radii[obstacles] - 0.5
+    assert world.nearest_obstacle_distance() == gaps.min()
+
+
+def test_the_nearest_obstacle_gap_counts_the_cargo():
+    # Target 1 (0.5 m) carried beside the collector passes nearer the obstacle at x = 2.
+    text = BROAD_PHASE.replace("[1.05, 0, 0]", "[2.0, 2.2, 0]").replace(
+        "[0, 0, -1.1]", "[0, 0, -4]"
+    )
+    world = world_from(text)
+    assert grab_target(world, 1).success
+    for _ in range(3):
+        world.step()
+        parts = [(world.base_state()[0], 0.5), (world.object_states()[0][0], 0.5)]
+        obstacles = [2, 3]
+        centres = world.object_states()[0][obstacles]
+        gaps = [
+            np.linalg.norm(centres - centre, axis=1) - world.field.radii[obstacles] - radius
+            for centre, radius in parts
+        ]
+        assert np.argmin(np.min(gaps, axis=1)) == 1  # the cargo is the nearer part
+        assert world.nearest_obstacle_distance() == np.min(gaps)

@@ -205,3 +205,26 @@ def test_a_shape_s_uniform_solid_inertia_is_pybullet_s(shape, moments):
         pb.disconnect(client)
     np.testing.assert_allclose(shape.moments_of_inertia(3.0), moments, rtol=1e-12)
     np.testing.assert_allclose(held, moments, rtol=1e-12)
+
+
+def test_objects_of_one_shape_share_one_static_body_and_keep_their_own_gaps():
+    # Two unit spheres, two boxes of one size turned differently, a thinner box: three
+    # static bodies besides the collector's (PyBullet steps every body, even a static one).
+    text = """\
+        world: {frame: geocentric, physics_step: 0.01, control_period: 0.1}
+        robot: {radius: 0.5}
+        obstacles:
+          - {id: 1, radius: 1.0, motion: {type: static, position: [3, 0, 0]}}
+          - {id: 2, radius: 1.0, motion: {type: static, position: [0, -4, 0]}}
+          - {id: 3, shape: {type: box, half_extents: [0.5, 1, 1]}, motion: {type: static, position: [0, 0, 5]}}
+          - id: 4
+            shape: {type: box, half_extents: [0.5, 1, 1], orientation: [0, 0.7071068, 0, 0.7071068]}
+            motion: {type: static, position: [0, 0, -6]}
+          - {id: 5, shape: {type: box, half_extents: [0.25, 1, 1]}, motion: {type: static, position: [7, 0, 0]}}
+        """
+    scenario = validate(ScenarioDocument.from_text(textwrap.dedent(text), "shared.yaml"))
+    world = World(scenario, np.random.default_rng(0))
+    assert pb.getNumBodies(physicsClientId=world.client) == 1 + 3
+    gaps = [world.surface_gap(i, 10.0) for i in (1, 2, 3, 4, 5)]
+    # The turned box shows the collector its 0.5 m half extent along z, the other its 1 m.
+    np.testing.assert_allclose(gaps, [1.5, 2.5, 3.5, 5.0, 6.25], atol=1e-9)
