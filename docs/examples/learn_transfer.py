@@ -334,4 +334,10 @@ def main(argv: Sequence[str] | None = None) -> dict[str, Any]:
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except ModuleNotFoundError as missing:  # the rl extra is not installed
+        raise SystemExit(
+            f"{missing.name} is missing: training needs the rl extra (see the module's "
+            "docstring: a CPU PyTorch first, then pip install 'dcsim[rl]')"
+        ) from None
