@@ -65,17 +65,27 @@ class WorldBenchRow:
         The full runner.
     phases : dict of str to float
         The closed loop split by phase of the run loop.
+    localiser : float
+        The scenario's localiser plugin alone (predict, update, estimate once per
+        control period, standing still with the ranges read at the start).
     """
 
     objects: int
     bare: float
     closed_loop: float
     phases: dict[str, float]
+    localiser: float
 
     @property
     def overhead(self) -> float:
         """Closed-loop time over bare stepping, minus one (0.5 is 50 % more)."""
         return self.closed_loop / self.bare - 1.0
+
+    @property
+    def floor_ratio(self) -> float:
+        """Closed-loop time over bare stepping and the localiser alone (the project's
+        target at 100 and 1,000 objects: at most 3)."""
+        return self.closed_loop / (self.bare + self.localiser)
 
 
 def field_scenario(
@@ -146,6 +156,17 @@ def closed_loop(scenario: Scenario, registry: PluginRegistry) -> tuple[float, di
     return elapsed / duration, {p: runner.laps.totals.get(p, 0.0) / duration for p in PHASES}
 
 
+def localiser_alone(scenario: Scenario, registry: PluginRegistry) -> float:
+    """Wall seconds per simulated second of the scenario's localiser plugin alone."""
+    setup = RunSetup.from_scenario(scenario, registry)
+    localiser = setup.plugins["localiser"]
+    assert isinstance(localiser, Localiser)  # the field scenarios fly one
+    with World(scenario, component_rng(0, "world")) as world:
+        ticks = round(scenario.world.duration / world.control_period)
+        timed = _time_localiser(localiser, world, ticks, repeats=1)
+    return timed / scenario.world.duration
+
+
 def bench_world(
     sizes: list[int],
     duration: float,
@@ -163,7 +184,8 @@ def bench_world(
         scenario = field_scenario(objects, duration, orbit_model=orbit_model, sensing=sensing)
         bare = bare_stepping(scenario)
         loop, phases = closed_loop(scenario, registry)
-        rows.append(WorldBenchRow(objects, bare, loop, phases))
+        alone = localiser_alone(scenario, registry)
+        rows.append(WorldBenchRow(objects, bare, loop, phases, alone))
         progress(
             f"{objects} objects: bare stepping {1e3 * bare:.1f} ms, "
             f"closed loop {1e3 * loop:.1f} ms per simulated second"
@@ -176,14 +198,15 @@ def markdown_table(rows: list[WorldBenchRow]) -> str:
     head = (
         "| objects | bare stepping | closed loop | overhead | real-time factor | "
         + " | ".join(PHASES)
-        + " |"
+        + " | localiser alone | loop / (bare + localiser alone) |"
     )
-    lines = [head, "|" + "---:|" * (5 + len(PHASES))]
+    lines = [head, "|" + "---:|" * (7 + len(PHASES))]
     for r in rows:
         phases = " | ".join(f"{1e3 * r.phases[p]:.2f}" for p in PHASES)
         lines.append(
             f"| {r.objects} | {1e3 * r.bare:.2f} | {1e3 * r.closed_loop:.2f} | "
-            f"{100 * r.overhead:.0f} % | {1 / r.closed_loop:.0f} | {phases} |"
+            f"{100 * r.overhead:.0f} % | {1 / r.closed_loop:.0f} | {phases} | "
+            f"{1e3 * r.localiser:.2f} | {r.floor_ratio:.1f}× |"
         )
     return "\n".join(lines)
 
@@ -262,14 +285,9 @@ def loop_floor(
         steps = ticks * world.steps_per_control
         stepping = _best(lambda: _step_bare(world, steps), repeats)
         forced = _best(lambda: _step_with_forces(world, steps), repeats)
-        ranges = list(world.beacon_ranges())
         localiser = setup.plugins["localiser"]
         assert isinstance(localiser, Localiser)  # the run set it up for the localiser role
-        position = world.base_state()[0]
-        _localise(localiser, ranges, position, 1, world.control_period)  # imports on first use
-        timed = _best(
-            lambda: _localise(localiser, ranges, position, ticks, world.control_period), repeats
-        )
+        timed = _time_localiser(localiser, world, ticks, repeats)
     return LoopFloor(sim_time, stepping, max(forced - stepping, 0.0), timed, closed_loop)
 
 
@@ -295,6 +313,17 @@ def _step_with_forces(world: World, steps: int) -> None:
             body, -1, (0.0, 0.0, 0.0), position, pb.WORLD_FRAME, physicsClientId=client
         )
         pb.stepSimulation(physicsClientId=client)
+
+
+def _time_localiser(localiser: Localiser, world: World, ticks: int, repeats: int) -> float:
+    """Shortest wall time (s) of ``ticks`` control periods of ``localiser`` alone, standing
+    still where the world's robot starts with the beacon ranges it reads there."""
+    ranges = list(world.beacon_ranges())
+    position = world.base_state()[0]
+    _localise(localiser, ranges, position, 1, world.control_period)  # imports on first use
+    return _best(
+        lambda: _localise(localiser, ranges, position, ticks, world.control_period), repeats
+    )
 
 
 def _localise(

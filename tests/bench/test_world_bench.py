@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from dcsim.bench.world import bench_world, field_scenario
+from dcsim.bench.world import bench_world, field_scenario, markdown_table
 from dcsim.errors import PlannerModelWarning
 from dcsim.run.seeding import component_rng
 from dcsim.world import World
@@ -29,3 +29,8 @@ def test_the_bench_measures_a_j2_field():
     with pytest.warns(PlannerModelWarning, match="not the world's j2"):  # they model cw
         rows = bench_world([5], 1.0, progress=lambda line: None, orbit_model="j2")
     assert [row.objects for row in rows] == [5] and rows[0].closed_loop > rows[0].bare > 0
+    # the localiser alone is part of the loop, so the loop costs more than it and stepping
+    assert rows[0].closed_loop > rows[0].localiser > 0 and rows[0].floor_ratio > 1
+    table = markdown_table(rows)
+    assert "loop / (bare + localiser alone)" in table.splitlines()[0]
+    assert table.splitlines()[2].endswith(f"| {rows[0].floor_ratio:.1f}× |")
