@@ -20,7 +20,6 @@ from typing import Any
 import numpy as np
 
 from dcsim.gym.free_flyer import FreeFlyerEnv
-from dcsim.registry.discovery import PluginRegistry
 from dcsim.run.setup import Overrides, ScenarioInput
 from dcsim.world.objects import ObjectStatus
 
@@ -48,12 +47,11 @@ class DebrisEnv(FreeFlyerEnv):
         *,
         grab_reward: float = 1.0,
         delivery_reward: float = 1.0,
-        registry: PluginRegistry | None = None,
         **options: Any,
     ) -> None:
         self.grab_reward = float(grab_reward)
         self.delivery_reward = float(delivery_reward)
-        super().__init__(scenario, overrides, registry=registry, **options)
+        super().__init__(scenario, overrides, **options)
 
     def _mission_weights(self) -> np.ndarray:
         return np.array([1.0, 0.0, 0.0])

@@ -267,9 +267,3 @@ class MissionEnv(gymnasium.Env[np.ndarray, np.ndarray]):
         if runner.ended:
             info.update(status=runner.status, reason=runner.reason)
         return info
-
-
-def nearest_first(distances: np.ndarray, count: int) -> np.ndarray:
-    """Indices of the ``count`` smallest ``distances`` (fewer if there are fewer), nearest
-    first; ties keep their order."""
-    return np.argsort(distances, kind="stable")[:count]

@@ -38,9 +38,8 @@ from typing import Any
 
 import numpy as np
 
-from dcsim.gym.environment import MissionEnv, nearest_first
+from dcsim.gym.environment import MissionEnv
 from dcsim.messages import Command
-from dcsim.registry.discovery import PluginRegistry
 from dcsim.run.seeding import component_rng
 from dcsim.run.setup import Overrides, ScenarioInput
 from dcsim.scenario import Scenario
@@ -78,8 +77,9 @@ class FreeFlyerEnv(MissionEnv):
     speed_weight : float
         Weight of the speed-limit term (1/m): reward taken away per m/s above
         ``robot.max_speed`` per second.
-    goal_reward, collision_penalty, progress_weight, registry
-        As for :class:`MissionEnv`.
+    **options
+        ``goal_reward``, ``collision_penalty``, ``progress_weight``, ``registry``: as
+        for :class:`MissionEnv`.
     """
 
     def __init__(
@@ -92,10 +92,7 @@ class FreeFlyerEnv(MissionEnv):
         start_spread: float = 0.0,
         cost_weights: Sequence[float] | None = None,
         speed_weight: float = 10.0,
-        goal_reward: float = 10.0,
-        collision_penalty: float = 10.0,
-        progress_weight: float = 1.0,
-        registry: PluginRegistry | None = None,
+        **options: Any,
     ) -> None:
         if attitude not in ATTITUDE_CHOICES:
             choices = ", ".join(ATTITUDE_CHOICES)
@@ -106,17 +103,10 @@ class FreeFlyerEnv(MissionEnv):
         self.attitude = attitude
         self.start_spread = float(start_spread)
         self.speed_weight = float(speed_weight)
-        self._given_weights = None if cost_weights is None else np.asarray(cost_weights, float)
-        super().__init__(
-            scenario,
-            overrides,
-            goal_reward=goal_reward,
-            collision_penalty=collision_penalty,
-            progress_weight=progress_weight,
-            registry=registry,
+        super().__init__(scenario, overrides, **options)
+        self.cost_weights = (
+            self._mission_weights() if cost_weights is None else np.asarray(cost_weights, float)
         )
-        weights = self._given_weights
-        self.cost_weights = self._mission_weights() if weights is None else weights
         robot = self.scenario.robot
         self._force_limit = float(robot.max_force)
         self._speed_limit = float(robot.max_speed)
@@ -174,7 +164,7 @@ class FreeFlyerEnv(MissionEnv):
         radii = np.array([track.radius for track in tracks])
         offsets = positions - position
         gaps = np.linalg.norm(offsets, axis=1) - radii
-        chosen = nearest_first(gaps, self.obstacle_count)
+        chosen = np.argsort(gaps, kind="stable")[: self.obstacle_count]  # nearest first
         count = len(chosen)
         rows[:count, 0:3] = offsets[chosen]
         rows[:count, 3:6] = velocities[chosen] - velocity

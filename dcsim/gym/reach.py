@@ -34,7 +34,6 @@ import numpy as np
 from dcsim.gym.environment import MissionEnv
 from dcsim.messages import Command, RobotState
 from dcsim.missions.reach.settings import ReachMissionSection
-from dcsim.registry.discovery import PluginRegistry
 from dcsim.robots.manipulator import ManipulatorModel
 from dcsim.run.setup import Overrides, ScenarioInput
 from dcsim.scenario.model import ManipulatorSection
@@ -54,8 +53,9 @@ class ReachEnv(MissionEnv):
         Whether the base floats free or the scenario's controller holds it.
     effort_weight : float
         Weight of the effort term of the reward (1/s).
-    goal_reward, collision_penalty, progress_weight, registry
-        As for :class:`MissionEnv`.
+    **options
+        ``goal_reward``, ``collision_penalty``, ``progress_weight``, ``registry``: as
+        for :class:`MissionEnv`.
     """
 
     mission_type = "reach"
@@ -68,23 +68,13 @@ class ReachEnv(MissionEnv):
         *,
         base: str = "free",
         effort_weight: float = 0.0,
-        goal_reward: float = 10.0,
-        collision_penalty: float = 10.0,
-        progress_weight: float = 1.0,
-        registry: PluginRegistry | None = None,
+        **options: Any,
     ) -> None:
         if base not in BASE_CHOICES:
             raise ValueError(f"base must be one of {', '.join(BASE_CHOICES)}, not {base!r}")
         self.base = base
         self.effort_weight = float(effort_weight)
-        super().__init__(
-            scenario,
-            overrides,
-            goal_reward=goal_reward,
-            collision_penalty=collision_penalty,
-            progress_weight=progress_weight,
-            registry=registry,
-        )
+        super().__init__(scenario, overrides, **options)
         robot = self.scenario.robot
         assert isinstance(robot, ManipulatorSection)  # the reach mission flies only manipulators
         limits = [link.torque_limit for link in robot.links]
