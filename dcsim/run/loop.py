@@ -516,13 +516,13 @@ class Runner:
         self._command = None
         if not self.controller_on_demand:
             self._controller_command()
-            laps.lap("controller")
         self._record(t, estimate, mission.mode)
         self._check_stop(t)
         laps.lap("recording")
 
     def _controller_command(self) -> Command:
-        """The controller's command for the current control period, asked once."""
+        """The controller's command for the current control period, asked once (its time
+        charged to the ``controller`` phase)."""
         if self._command is None:
             world = self._opened_world
             assert self.estimate is not None and self._reference is not None  # decided
@@ -536,6 +536,7 @@ class Runner:
                 self.surroundings,
                 actuators=self._actuators,
             )
+            self.laps.lap("controller")
         return self._command
 
     def _localise(self, observations: Observations) -> StateEstimate:
@@ -582,13 +583,17 @@ class Runner:
         if isinstance(command, Command):
             chosen = command
         else:
-            unknown = sorted(set(command) - set(Command.__dataclass_fields__))
+            fields = Command.__dataclass_fields__.keys()
+            unknown = sorted(set(command) - fields)
             if unknown:
-                fields = ", ".join(Command.__dataclass_fields__)
-                raise ValueError(f"a Command has no field {', '.join(unknown)} (it has {fields})")
+                raise ValueError(
+                    f"a Command has no field {', '.join(unknown)} (it has {', '.join(fields)})"
+                )
+            # the controller gives the fields the mapping leaves out (none: not asked)
+            rest = self._controller_command() if fields - set(command) else _NO_COMMAND
             try:
                 values = {name: np.asarray(value, dtype=float) for name, value in command.items()}
-                chosen = dataclasses.replace(self._controller_command(), **values)
+                chosen = dataclasses.replace(rest, **values)
             except (TypeError, ValueError) as error:
                 raise ValueError(f"the command is not a Command: {error}") from None
         problem = command_problem(chosen, self._actuators)
@@ -609,8 +614,8 @@ class Runner:
         flown = self._command
         if flown is None:  # asked on demand: no command was given
             flown = self.outputs["command"] = self._controller_command()
-            self.laps.lap("controller")
         self._commit_row()
+        self.laps.lap("recording")
         inputs = WorldInputs(
             force=flown.force,
             torque=flown.torque,

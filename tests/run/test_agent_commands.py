@@ -113,12 +113,15 @@ def test_a_controller_asked_on_demand_flies_the_same_run_and_is_not_asked_for_wh
     assert not on_demand.telemetry[command_columns].iloc[-1].any()
     assert "controller" in on_demand.summary["wall_time_by_phase_s"]
 
-    agent = Runner(
-        setup_run(FFSR, ["path_planner=null", "world.duration=3"]), controller_on_demand=True
-    )
-    agent.open()
-    assert agent.outputs["command"] is None  # not asked yet
-    while not agent.ended:
-        agent.advance(command=Command(force=np.array([0.1, 0.0, 0.0])))
-    phases = close_run(agent).summary["wall_time_by_phase_s"]
-    assert "controller" not in phases and "agent" in phases
+    whole = Command(force=np.array([0.1, 0.0, 0.0]))
+    every_field = {name: getattr(whole, name) for name in Command.__dataclass_fields__}
+    for command, asked in ((whole, False), (every_field, False), ({"force": whole.force}, True)):
+        agent = Runner(
+            setup_run(FFSR, ["path_planner=null", "world.duration=3"]), controller_on_demand=True
+        )
+        agent.open()
+        assert agent.outputs["command"] is None  # not asked yet
+        while not agent.ended:
+            agent.advance(command=command)
+        phases = close_run(agent).summary["wall_time_by_phase_s"]
+        assert ("controller" in phases) == asked and "agent" in phases
