@@ -32,10 +32,9 @@ Messages
     :class:`BeaconRange`, :class:`Observations`, :class:`Surroundings`; the readings of
     sensor models, :class:`AttitudeReading`, :class:`RateReading`, :class:`Detection`,
     and what they read, :class:`SensorSetup`, :class:`SensedTruth`, :class:`KnownObject`.
-    Path planning: :class:`PathProblem`, :class:`GoalRegion`, :class:`FrameDynamics`,
-    :class:`FrameKind`, :class:`ChiefOrbit`, :class:`OrbitModel`, :class:`Bounds`,
-    :class:`CostWeights`, :class:`Trajectory`,
-    :class:`NoPath`.
+    Path planning: :class:`PathProblem`, :class:`GoalRegion`, :class:`GraspGoal`,
+    :class:`FrameDynamics`, :class:`FrameKind`, :class:`ChiefOrbit`, :class:`OrbitModel`,
+    :class:`Bounds`, :class:`CostWeights`, :class:`Trajectory`, :class:`NoPath`.
     Task planning (debris): :class:`TaskRequest`, :class:`PlanTask`, :class:`DropVisit`,
     :class:`Plan`, :class:`DropPoint`.
     Your own messages: :class:`Message`, :func:`message`, :func:`array_field`.
@@ -49,7 +48,9 @@ Plan cost
     :func:`plan_delta_v`, :func:`plan_duration`, :func:`plan_cost`, :func:`legs_delta_v`,
     :func:`leg_delta_v`.
 Kinematics
-    :func:`rest_to_rest_time`, :func:`shortest_leg`, :func:`cruise_speed`.
+    :func:`rest_to_rest_time`, :func:`shortest_leg`, :func:`cruise_speed`; the
+    minimum-jerk (quintic) rest-to-rest law: :func:`shortest_duration`,
+    :func:`minimum_jerk_profile`, :func:`minimum_jerk_move`, :func:`minimum_jerk_legs`.
 Space manipulator model (DH kinematics and dynamics of the space manipulator thesis)
     :class:`ManipulatorModel` (forward kinematics, generalised and free-floating
     Jacobians, inverse kinematics, det(J Jᵀ), M(q), C(q, q̇)), built by
@@ -57,14 +58,18 @@ Space manipulator model (DH kinematics and dynamics of the space manipulator the
     :class:`DHLink` rows); :func:`thesis_manipulator` (the thesis's robot),
     :func:`manipulator_urdf`, :func:`load_robot_model` (the model of a scenario file's
     manipulator), :func:`load_reach_problem` (the path problem of a reach scenario);
-    results :class:`ForwardKinematics`, :class:`InverseKinematicsResult`.
+    results :class:`ForwardKinematics`, :class:`InverseKinematicsResult`;
+    :class:`PosePath` (joint references along an end-effector pose trajectory, with
+    their :class:`PoseTracking` figures).
+Rigid-body rotation
+    :class:`TorqueFreeRotation` (a body's torque-free tumble, fourth-order accurate).
 Geometry
     :func:`spherical_to_cartesian`, :func:`quaternion_between`, :func:`rotate`,
     :func:`cross`, :func:`length`, :func:`row_lengths`, :func:`unit`, :func:`clip_norm`,
     :func:`quaternion_multiply`,
     :func:`quaternion_conjugate`, :func:`rotation_vector`,
-    :func:`quaternion_from_rotation_vector`, :func:`slerp`, :func:`facing_axis`,
-    :func:`sight_angle`.
+    :func:`quaternion_from_rotation_vector`, :func:`quaternion_from_matrix`,
+    :func:`slerp`, :func:`facing_axis`, :func:`sight_angle`.
 FMUs (FMI 2.0 co-simulation, through fmpy)
     :class:`FmuDescription`, :class:`FmuInstance`, :class:`FmuError`,
     :class:`FmuCallError`.
@@ -120,6 +125,7 @@ from dcsim.geometry import (
     length,
     quaternion_between,
     quaternion_conjugate,
+    quaternion_from_matrix,
     quaternion_from_rotation_vector,
     quaternion_multiply,
     rotate,
@@ -143,6 +149,7 @@ from dcsim.messages import (
     FrameDynamics,
     FrameKind,
     GoalRegion,
+    GraspGoal,
     KnownObject,
     Message,
     MotionInput,
@@ -169,6 +176,12 @@ from dcsim.messages import (
     Trajectory,
     array_field,
     message,
+)
+from dcsim.minimum_jerk import (
+    minimum_jerk_legs,
+    minimum_jerk_move,
+    minimum_jerk_profile,
+    shortest_duration,
 )
 from dcsim.missions import Mission, register_mission
 from dcsim.motion import (
@@ -204,10 +217,12 @@ from dcsim.robots.manipulator import (
     manipulator_model,
 )
 from dcsim.robots.model import RobotModel
+from dcsim.robots.pose_path import PosePath, PoseTracking
 from dcsim.robots.urdf import urdf_text as manipulator_urdf
 from dcsim.run.scripting import RunResult, close_run, load_scenario, open_run, read_run, run
 from dcsim.scenario.loader import packaged_scenario_path
 from dcsim.scenario.model import MissionSettings
+from dcsim.torque_free import TorqueFreeRotation
 from dcsim.yardsticks.clearance import (
     Clearance,
     body_surface_distance,
@@ -314,6 +329,7 @@ __all__ = [
     "FrameDynamics",
     "FrameKind",
     "GoalRegion",
+    "GraspGoal",
     "hookimpl",
     "InverseKinematicsResult",
     "leg_delta_v",
@@ -330,6 +346,9 @@ __all__ = [
     "Message",
     "message",
     "min_clearance",
+    "minimum_jerk_legs",
+    "minimum_jerk_move",
+    "minimum_jerk_profile",
     "Mission",
     "MissionSettings",
     "MotionInput",
@@ -348,6 +367,8 @@ __all__ = [
     "plan_delta_v",
     "plan_duration",
     "PlanTask",
+    "PosePath",
+    "PoseTracking",
     "Plugin",
     "PLUGIN_KINDS",
     "CwValidityWarning",
@@ -366,6 +387,7 @@ __all__ = [
     "quantity",
     "quaternion_between",
     "quaternion_conjugate",
+    "quaternion_from_matrix",
     "quaternion_from_rotation_vector",
     "quaternion_multiply",
     "Reference",
@@ -385,6 +407,7 @@ __all__ = [
     "ScenarioError",
     "Shape",
     "ShapeKind",
+    "shortest_duration",
     "shortest_leg",
     "slerp",
     "spherical_to_cartesian",
@@ -396,6 +419,7 @@ __all__ = [
     "TaskPlanner",
     "TaskRequest",
     "thesis_manipulator",
+    "TorqueFreeRotation",
     "Trajectory",
     "unit",
 ]

@@ -189,6 +189,28 @@ def rotation_vector(q: ArrayLike) -> Vector:
     return q[..., :3] * scale
 
 
+def quaternion_from_matrix(matrix: ArrayLike) -> Vector:
+    """Unit quaternion ``[x, y, z, w]`` of a rotation matrix (3, 3), by Shepperd's method
+    (the largest of the four candidate components is computed first, so it is exact
+    for every rotation)."""
+    m = np.asarray(matrix, dtype=float)
+    trace = m[0, 0] + m[1, 1] + m[2, 2]
+    if trace > 0.0:
+        s = 2.0 * math.sqrt(1.0 + trace)
+        q = (m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1], 0.25 * s * s)
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
+        q = (0.25 * s * s, m[0, 1] + m[1, 0], m[0, 2] + m[2, 0], m[2, 1] - m[1, 2])
+    elif m[1, 1] > m[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
+        q = (m[0, 1] + m[1, 0], 0.25 * s * s, m[1, 2] + m[2, 1], m[0, 2] - m[2, 0])
+    else:
+        s = 2.0 * math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
+        q = (m[0, 2] + m[2, 0], m[1, 2] + m[2, 1], 0.25 * s * s, m[1, 0] - m[0, 1])
+    quaternion = np.array(q) / s
+    return quaternion / np.linalg.norm(quaternion)
+
+
 def quaternion_from_rotation_vector(r: ArrayLike) -> Vector:
     """Unit quaternion ``[x, y, z, w]`` of rotation vector(s) ``r`` (..., 3) (axis times
     angle, rad); the inverse of :func:`rotation_vector` for angles up to π."""

@@ -80,7 +80,8 @@ def test_unknown_name_suggests_the_closest():
     registry = PluginRegistry.discover()
     with pytest.raises(
         PluginNotFoundError,
-        match=r"available: ant-colony, end-effector-line, grid-astar, multi-burn, ompl-control, "
+        match=r"available: ant-colony, end-effector-line, fixture-intercept, grid-astar, multi-burn, "
+        r"ompl-control, "
         r"ompl-geometric, q-learning, straight-line\); "
         r"did you mean 'straight-line'\?",
     ):

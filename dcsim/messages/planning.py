@@ -205,6 +205,43 @@ class FrameDynamics(Message):
 
 
 @message
+class GraspGoal(Message):
+    """A grapple fixture on a tumbling body, for a manipulator's end effector to meet.
+
+    The fixture is a bar on the body; a gripper holds it when the gripper's grasp point
+    (``tool_offset`` ahead of DH frame n along x_n) is on the bar's centre, x_n points
+    along ``-approach_axis`` and z_n along ``bar_axis``, with the end effector moving as
+    the fixture does.
+
+    Attributes
+    ----------
+    target : ObjectTrack
+        The body's track, with its attitude, angular velocity and inertia (its
+        torque-free tumble predicts the fixture's motion).
+    fixture : ndarray (3,)
+        The bar's centre, body frame, m.
+    approach_axis, bar_axis : ndarray (3,)
+        Unit axes of the fixture, body frame.
+    tool_offset : float
+        Distance from DH frame n to the grasp point along x_n, m.
+    """
+
+    target: ObjectTrack
+    fixture: Vector = array_field()
+    approach_axis: Vector = array_field()
+    bar_axis: Vector = array_field()
+    tool_offset: float = 0.0
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        track = self.target
+        if track.attitude is None or track.angular_velocity is None or track.inertia is None:
+            raise ValueError(
+                "GraspGoal.target must carry the body's attitude, angular velocity and inertia"
+            )
+
+
+@message
 class PathProblem(Message):
     """What a path planner is asked to solve.
 
@@ -257,6 +294,10 @@ class PathProblem(Message):
     deadline : float or None
         When the answer is due, in ``time.monotonic()`` seconds; None: ``time_budget``
         after the planner is called (see :meth:`due`).
+    grasp : GraspGoal or None
+        For a manipulator's end effector meeting a moving grapple fixture: the fixture
+        and the body's track (``goal`` then gives the tolerance and the arrival time
+        ``goal.time``, if any); None for every other problem.
 
     Raises
     ------
@@ -283,6 +324,7 @@ class PathProblem(Message):
     model: RobotModel | None = None
     safety_margin: float = 0.0
     deadline: float | None = None
+    grasp: GraspGoal | None = None
 
     def __post_init__(self) -> None:
         super().__post_init__()

@@ -111,6 +111,14 @@ class ObjectTrack(Message):
     covariance : ndarray (6, 6) or None
         Covariance of the state ``[position, velocity]`` at ``time``, m² and m²/s², m²/s
         off the diagonal blocks; None when the state is exact (ideal sensing).
+    attitude : ndarray (4,) or None
+        Body-to-world rotation ``[x, y, z, w]`` at ``time`` of an object whose rotation
+        is tracked (a tumbling body); None otherwise.
+    angular_velocity : ndarray (3,) or None
+        Its angular velocity at ``time``, world frame, rad/s; None when not tracked.
+    inertia : ndarray (3, 3) or None
+        Its inertia tensor about the centre of mass, body axes, kg·m², when known (it
+        predicts the torque-free tumble); None otherwise.
     """
 
     id: int
@@ -125,6 +133,9 @@ class ObjectTrack(Message):
     # attribute is always a Shape (mypy cannot type a field's converter).
     shape: Shape = None  # type: ignore[assignment]
     covariance: Vector | None = array_field(shape=(6, 6), default=None, optional=True)
+    attitude: Vector | None = array_field(shape=(4,), default=None, optional=True)
+    angular_velocity: Vector | None = array_field(shape=(3,), default=None, optional=True)
+    inertia: Vector | None = array_field(shape=(3, 3), default=None, optional=True)
 
     def __post_init__(self) -> None:
         super().__post_init__()

@@ -256,6 +256,9 @@ class RobotSpec(Message):
         The robot's model for model-based plugins (for a manipulator its
         :class:`~dcsim.robots.manipulator.ManipulatorModel`: kinematics, ``det(J Jᵀ)``,
         mass and Coriolis matrices); None for a free flyer.
+    held_mass : float
+        Mass of a body a manipulator's end effector holds rigidly (a captured target),
+        kg; 0 when it holds none. It is part of ``mass`` but not of ``model``.
 
     Raises
     ------
@@ -276,6 +279,7 @@ class RobotSpec(Message):
     thruster_torques: Vector = array_field(shape=(3, -1), default=np.zeros((3, 0)))
     wheel_axes: Vector = array_field(shape=(3, -1), default=np.zeros((3, 0)))
     model: RobotModel | None = None
+    held_mass: float = 0.0
 
     def __post_init__(self) -> None:
         super().__post_init__()

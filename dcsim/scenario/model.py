@@ -24,6 +24,7 @@ from pydantic import (
     ModelWrapValidatorHandler,
     Tag,
     create_model,
+    field_validator,
     model_validator,
 )
 
@@ -767,6 +768,57 @@ class DHLinkSpec(Section):
         )
 
 
+class GripperSpec(Section):
+    """A two-pad gripper at the arm's end effector: a palm and two pads that close on a
+    grapple bar with PyBullet contact and friction (docs/architecture.md, Capture).
+
+    The palm's back face sits on DH frame n; the pads' centres are ``reach`` ahead of it
+    along x_n and close towards each other along y_n, so a bar held between them lies
+    along z_n.
+    """
+
+    palm_mass: float = quantity(2.0, unit="kg", gt=0, description="Mass of the palm.")
+    palm_size: PositiveVec3 = quantity(
+        (0.05, 0.24, 0.10),
+        unit="m",
+        description="Edge lengths of the palm's box along x_n, y_n and z_n.",
+    )
+    pad_mass: float = quantity(0.5, unit="kg", gt=0, description="Mass of each pad.")
+    pad_size: PositiveVec3 = quantity(
+        (0.08, 0.02, 0.08),
+        unit="m",
+        description="Edge lengths of each pad's box along x_n, y_n (its thickness) and z_n.",
+    )
+    reach: float = quantity(
+        0.15, unit="m", gt=0, description="Distance from DH frame n to the pads' centres along x_n."
+    )
+    opening: float = quantity(0.16, unit="m", gt=0, description="Gap between the pads when open.")
+    closing_time: float = quantity(
+        1.0, unit="s", gt=0, description="Time the pads take from open to touching."
+    )
+    grip_force: float = quantity(
+        150.0, unit="N", gt=0, description="Largest force each pad's drive pushes with."
+    )
+    friction: float = quantity(
+        0.8, unit="1", gt=0, description="Coefficient of friction between pad and bar."
+    )
+    force_limit: float = quantity(
+        1500.0,
+        unit="N",
+        gt=0,
+        description="Largest contact or latch force the gripper is built to take; a run "
+        "records whether it was exceeded.",
+    )
+
+    @model_validator(mode="after")
+    def _pads_fit(self) -> GripperSpec:
+        if self.reach <= 0.5 * self.palm_size[0] + 0.5 * self.pad_size[0]:
+            raise ValueError("`reach` must put the pads ahead of the palm's front face")
+        if self.opening + 2.0 * self.pad_size[1] > self.palm_size[1] + 1e-12:
+            raise ValueError("the open pads must fit within the palm's width (`palm_size[1]`)")
+        return self
+
+
 class ManipulatorSection(RobotBaseSection):
     """The robot: a space manipulator, a satellite base carrying an arm of revolute joints.
 
@@ -800,6 +852,9 @@ class ManipulatorSection(RobotBaseSection):
     )
     initial: ManipulatorInitialSpec = Field(
         default_factory=ManipulatorInitialSpec, description="State at t = 0."
+    )
+    gripper: GripperSpec | None = Field(
+        None, description="A gripper at the end effector; null: a bare end effector."
     )
 
     grab_distance: ClassVar[float] = 0.0
@@ -975,6 +1030,107 @@ class SpaceObjectSpec(Section):
         return self.shape.build()
 
 
+def _inertia_tensor(value: Any) -> Any:
+    """Three principal moments, or a symmetric 3x3 tensor, checked as a rigid body's."""
+    if isinstance(value, list | tuple) and len(value) == 3:
+        rows = [row if isinstance(row, list | tuple) else None for row in value]
+        if all(row is not None for row in rows):
+            matrix = np.array(value, dtype=float)
+            if matrix.shape != (3, 3) or not np.all(np.isfinite(matrix)):
+                raise ValueError("give three principal moments or a 3x3 tensor of numbers")
+            if not np.allclose(matrix, matrix.T, rtol=1e-9, atol=0.0):
+                raise ValueError("the inertia tensor must be symmetric")
+            moments = np.linalg.eigvalsh(matrix)
+            if moments[0] <= 0.0:
+                raise ValueError("the inertia tensor must be positive definite")
+            _rigid((float(moments[0]), float(moments[1]), float(moments[2])))
+            return value
+    return _rigid(value)
+
+
+InertiaSpec = Annotated[PositiveVec3 | tuple[Vec3, Vec3, Vec3], AfterValidator(_inertia_tensor)]
+"""A rigid body's inertia about its centre of mass: principal moments along its body axes,
+or a full symmetric tensor in its body axes, kg·m²."""
+
+
+class FixtureSpec(Section):
+    """A grapple fixture: a bar on a target's body that a gripper closes on.
+
+    The bar is a cylinder centred on ``position`` along ``bar_axis``; a gripper comes to
+    it from outside along ``approach_axis`` (pointing out of the body), so the gripper's
+    x_n points along ``-approach_axis`` and its z_n along ``bar_axis`` when it holds it.
+    """
+
+    position: Vec3 = quantity(unit="m", description="Bar centre, body frame.")
+    approach_axis: Annotated[Vec3, AfterValidator(_nonzero_axis)] = quantity(
+        description="Direction, body frame, from which the gripper comes (out of the body)."
+    )
+    bar_axis: Annotated[Vec3, AfterValidator(_nonzero_axis)] = quantity(
+        description="The bar's long axis, body frame; at right angles to `approach_axis`."
+    )
+    radius: float = quantity(0.02, unit="m", gt=0, description="Bar radius.")
+    length: float = quantity(0.2, unit="m", gt=0, description="Bar length.")
+
+    @model_validator(mode="after")
+    def _square(self) -> FixtureSpec:
+        approach, bar = np.array(self.approach_axis), np.array(self.bar_axis)
+        cosine = abs(approach @ bar) / (np.linalg.norm(approach) * np.linalg.norm(bar))
+        if cosine > 1e-6:
+            raise ValueError("`bar_axis` must be at right angles to `approach_axis`")
+        return self
+
+
+class TumblingBodySpec(Section):
+    """A free rigid body that tumbles torque-free until something holds it (a capture
+    target): its shape, mass, inertia, initial state and grapple fixture."""
+
+    id: int = quantity(1, ge=0, description="Id of the body in tracks and events.")
+    shape: BoxShapeSpec | CylinderShapeSpec = Field(
+        discriminator="type",
+        description="Collision shape (box or cylinder), centred on the centre of mass, "
+        "along the body axes (its `orientation` must be the identity: turn the body "
+        "with `attitude`).",
+    )
+    mass: float = quantity(unit="kg", gt=0, description="Mass.")
+    inertia: InertiaSpec | None = quantity(
+        None,
+        unit="kg*m^2",
+        description="Inertia about the centre of mass in body axes: three principal moments "
+        "or a full tensor; null: a uniform solid of `shape`.",
+    )
+    position: Vec3 = quantity(unit="m", description="Centre of mass at t = 0, world frame.")
+    velocity: Vec3 = quantity(
+        (0.0, 0.0, 0.0), unit="m/s", description="Velocity, world frame (constant while free)."
+    )
+    attitude: Quaternion = quantity(
+        (0.0, 0.0, 0.0, 1.0), description="Body-to-world rotation [x, y, z, w] at t = 0."
+    )
+    angular_velocity_deg_s: Vec3 = quantity(
+        (0.0, 0.0, 0.0), unit="deg/s", description="Angular velocity at t = 0, body axes."
+    )
+    fixture: FixtureSpec = Field(description="The grapple fixture.")
+
+    @field_validator("shape")
+    @classmethod
+    def _unturned(cls, shape: BoxShapeSpec | CylinderShapeSpec) -> BoxShapeSpec | CylinderShapeSpec:
+        if not np.allclose(_unit(shape.orientation), (0.0, 0.0, 0.0, 1.0), atol=1e-12):
+            raise ValueError(
+                "a tumbling body's shape lies along its body axes: turn it with `attitude`"
+            )
+        return shape
+
+    def inertia_tensor(self) -> Vector:
+        """The inertia tensor (3, 3) about the centre of mass, body axes, kg·m²."""
+        if self.inertia is None:
+            return np.diag(self.shape.build().moments_of_inertia(self.mass))
+        matrix = np.array(self.inertia, dtype=float)
+        return matrix if matrix.ndim == 2 else np.diag(matrix)
+
+    def unit_attitude(self) -> Vector:
+        """``attitude`` normalised, [x, y, z, w]."""
+        return _unit(self.attitude)
+
+
 class BeaconsSection(Section):
     """Fixed localisation beacons and their range sensor."""
 
@@ -1077,6 +1233,11 @@ class MissionSettings(Section):
         """The objects the mission puts into the world as its targets, beside the
         scenario's obstacles: its field named by :attr:`targets_key` (none without one)."""
         return [] if self.targets_key is None else list(getattr(self, self.targets_key))
+
+    def tumbling_body(self) -> TumblingBodySpec | None:
+        """The free rigid body with contact the mission puts into the world (a capture
+        target); None for a mission without one."""
+        return None
 
 
 class StopSection(Section):

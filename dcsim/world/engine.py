@@ -12,7 +12,9 @@ composes its pieces:
 - :mod:`~dcsim.world.sensors`: beacon ranges, object tracks, attitude and rate;
 - :mod:`~dcsim.world.payload`: objects held by the robot (a mission attaches them);
 - :mod:`~dcsim.world.objects`: the targets and obstacles and their motion;
-- :mod:`~dcsim.world.actuators`: the free flyer's thrusters and reaction wheels.
+- :mod:`~dcsim.world.actuators`: the free flyer's thrusters and reaction wheels;
+- :mod:`~dcsim.world.capture_rig`: a manipulator's gripper and a tumbling body it may
+  grasp (:mod:`~dcsim.world.gripper`, :mod:`~dcsim.world.tumbling_body`), with contact.
 
 - **Robot**: its base is driven by thrust and torque: ideal (thrust clipped to
   ``max_force`` and to the propellant left, torque to ``max_torque``, using none), or
@@ -50,6 +52,7 @@ from dcsim.registry.discovery import PluginRegistry
 from dcsim.scenario.model import ManipulatorSection, RobotSection, Scenario
 from dcsim.world.actuators import Actuators, ThrustProfile
 from dcsim.world.bodies import ObjectBodies, surface_gap
+from dcsim.world.capture_rig import CaptureRig
 from dcsim.world.environment import (
     Propellant,
     apply_cw_force,
@@ -68,6 +71,15 @@ from dcsim.world.sensors import Sensing, build_sensor_models
 from dcsim.world.vector3 import turn
 
 _BROAD_PHASE_SLACK = 1e-3  # m added to the swept reach of each control period
+
+
+def _build_capture_rig(scenario: Scenario, client: int, robot: RobotBody) -> CaptureRig | None:
+    """The gripper and the tumbling body, when the robot has one and the mission the other."""
+    target = scenario.mission.tumbling_body()
+    gripper = getattr(scenario.robot, "gripper", None)
+    if target is None or gripper is None or not isinstance(robot, ManipulatorBody):
+        return None
+    return CaptureRig(client, robot, gripper, target, scenario.world.physics_step)
 
 
 def _build_robot_body(client: int, robot: RobotSection | ManipulatorSection) -> RobotBody:
@@ -178,6 +190,9 @@ class World:
         force and torque are ideal.
     wheels : ReactionWheels or None
         The free flyer's reaction wheels; None for ideal (or thrusters') torque.
+    capture : CaptureRig or None
+        The manipulator's gripper and the mission's tumbling body; None unless the robot
+        has a gripper and the mission a tumbling body.
     """
 
     def __init__(
@@ -220,6 +235,7 @@ class World:
         self.robot_id = self._robot.body
         self._joint_torques = np.zeros(0)
         self._bodies = ObjectBodies(self._client, self.field)
+        self.capture = _build_capture_rig(scenario, self._client, self._robot)
         self._payload = Payload(self._client, self.robot_id, robot.radius, self.field, self._bodies)
         self._contacts: set[tuple[int, int]] = set()
         self._candidates = np.zeros(0, dtype=int)
@@ -265,11 +281,13 @@ class World:
 
     @property
     def robot_changes(self) -> int:
-        """How many times the robot's mass or shape changed by an object attached or removed.
+        """How many times the robot's mass or shape changed by an object attached or removed
+        (a capture's latch included).
 
         Its :meth:`robot_spec` is new after each change.
         """
-        return self._payload.changes
+        latched = int(self.capture is not None and self.capture.latched)
+        return self._payload.changes + latched
 
     def base_state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """True ``(position, velocity, attitude [x, y, z, w], angular velocity)`` of the
@@ -296,7 +314,12 @@ class World:
     def assembly_mass(self) -> float:
         """Mass of the robot (a manipulator's arm included) and every object it carries,
         kg."""
-        return self.base_mass() + self._payload.mass + self._links_mass
+        return self.base_mass() + self._payload.mass + self._links_mass + self._held_mass()
+
+    def _held_mass(self) -> float:
+        """Mass of the tumbling body the gripper's latch holds, kg (0 if none)."""
+        rig = self.capture
+        return rig.target.mass if rig is not None and rig.latched else 0.0
 
     @property
     def robot_body(self) -> RobotBody:
@@ -342,6 +365,8 @@ class World:
         spec = self._robot.spec(self.assembly_mass(), self.base_mass(), self.cargo_protrusion())
         if self.actuators is not None:
             spec = self._with_actuators(spec)
+        if self._held_mass():
+            spec = dataclasses.replace(spec, held_mass=self._held_mass())
         if not self._payload.held:
             return spec
         position, _, attitude, _ = self.base_state()
@@ -652,6 +677,9 @@ class World:
             moments = (ix, iy, iz)
         apply_torque = torque != (0.0, 0.0, 0.0) or profile is not None
         check_contacts = len(self._candidates) > 0
+        rig = self.capture
+        if rig is not None:
+            rig.begin_period()
         # each step reads the base's state once: the rotation for the thrusters' and the
         # wheels' body-frame torques, the velocity for the orbital force and the wheels
         turns = profile is not None or wheels is not None
@@ -697,6 +725,8 @@ class World:
                 actuators.note_saturations(self.time)
             if check_contacts:
                 started += self._detect_collisions()
+            if rig is not None:
+                rig.after_step()
         return started
 
     def _apply_wheel_torque(
@@ -789,7 +819,12 @@ class World:
         if not self._robot.n_joints:
             return observed
         angles, rates = self._robot.joint_state()  # noise-free encoders
-        return dataclasses.replace(observed, joint_positions=angles, joint_velocities=rates)
+        tracks = observed.tracks
+        if self.capture is not None:
+            tracks = (*tracks, self.capture.target_track(self.time))
+        return dataclasses.replace(
+            observed, joint_positions=angles, joint_velocities=rates, tracks=tracks
+        )
 
     def motion_input(self) -> MotionInput:
         """Mean thrust acceleration applied over the last control period."""

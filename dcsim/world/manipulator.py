@@ -3,7 +3,8 @@
 The URDF is the one :func:`dcsim.robots.urdf.urdf_text` writes from the scenario's DH
 description, loaded with the file's inertias (``URDF_USE_INERTIA_FROM_FILE``); the base
 and every link have no damping and the joints' velocity motors are off, so joint
-torques are the only joint actuation (../shared/PITFALLS.md). PyBullet's base position
+torques are the only joint actuation (../shared/PITFALLS.md). A gripper, when the robot
+has one, adds its palm and pads (:mod:`~dcsim.world.gripper`). PyBullet's base position
 is the base's centre of mass, which is where the URDF puts the base link's origin: the
 base state read back is the model's (``q``'s base part). Collision response is off, as
 for every body of the world.
@@ -18,6 +19,7 @@ import numpy as np
 from dcsim.messages import RobotSpec
 from dcsim.robots.manipulator import ManipulatorModel
 from dcsim.scenario.model import ManipulatorSection, point_to_cartesian
+from dcsim.world.gripper import gripper_urdf
 from dcsim.world.pybullet_client import MAX_SPEED, load_urdf, pb
 from dcsim.world.robot_body import base_spec_fields
 
@@ -53,7 +55,7 @@ class ManipulatorBody:
         self.section = robot
         self.robot = robot.dh_robot()
         self.model = ManipulatorModel(self.robot)
-        self.body = load_urdf(client, self.model.urdf())
+        self.body = load_urdf(client, self._urdf(robot))
         count = pb.getNumJoints(self.body, physicsClientId=client)
         self.joints = [
             j
@@ -82,6 +84,14 @@ class ManipulatorBody:
         self._reset(robot)
         self.links = self._link_masses()
         self._base_mass = robot.mass
+
+    def _urdf(self, robot: ManipulatorSection) -> str:
+        """The model's URDF, with the gripper's links when the robot has one."""
+        text = self.model.urdf()
+        if robot.gripper is None:
+            return text
+        end = text.rindex("</robot>")
+        return f"{text[:end]}{gripper_urdf(robot.gripper)}\n{text[end:]}"
 
     def _reset(self, robot: ManipulatorSection) -> None:
         """Put the body at the scenario's initial state."""
@@ -124,6 +134,20 @@ class ManipulatorBody:
             self.joints,
             pb.TORQUE_CONTROL,
             forces=torques.tolist(),
+            physicsClientId=self._client,
+        )
+
+    def brake(self) -> None:
+        """Lock every joint with its brake: a velocity motor held at rest that gives at
+        most the joint's torque limit (a joint loaded beyond it slips). Joint torques
+        applied afterwards add to the brakes' own."""
+        limits = np.minimum(self.torque_limits, MAX_SPEED)
+        pb.setJointMotorControlArray(
+            self.body,
+            self.joints,
+            pb.VELOCITY_CONTROL,
+            targetVelocities=[0.0] * self.n_joints,
+            forces=limits.tolist(),
             physicsClientId=self._client,
         )
 

@@ -15,7 +15,6 @@ experiment, and the baseline of the learned planner.
 from __future__ import annotations
 
 import numpy as np
-from dcsim_plugins.path_planners.minimum_jerk import minimum_jerk_move, shortest_duration
 
 from dcsim.api import (
     NoPath,
@@ -24,7 +23,9 @@ from dcsim.api import (
     PathProblem,
     Trajectory,
     hookimpl,
+    minimum_jerk_move,
     quantity,
+    shortest_duration,
 )
 
 

@@ -328,6 +328,9 @@ class KalmanTracker(Tracker):
                 motion=self._motion(state),
                 shape=details.shape,
                 covariance=covariances[i],
+                attitude=None,
+                angular_velocity=None,
+                inertia=None,
             )
             for i, (track_id, details, state) in enumerate(
                 zip(self._ids.tolist(), self._details, states.tolist(), strict=True)

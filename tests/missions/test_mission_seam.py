@@ -117,7 +117,7 @@ def test_a_mission_section_is_validated_by_its_own_settings(tmp_path):
 def test_an_unknown_mission_type_names_the_known_ones(tmp_path):
     path = scenario_file(tmp_path, "mission: {type: rescue}\n")
     with pytest.raises(
-        ScenarioError, match=r"mission.type: unknown mission type 'rescue'; known: debris"
+        ScenarioError, match=r"mission.type: unknown mission type 'rescue'; known: capture, debris"
     ):
         setup_run(path, registry=PluginRegistry.discover())
 

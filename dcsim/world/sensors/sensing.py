@@ -194,6 +194,9 @@ class Sensing:
                 motion=obj.motion,
                 shape=obj.shape,
                 covariance=None,
+                attitude=None,
+                angular_velocity=None,
+                inertia=None,
             )
             for i in visible
             for obj in (self._field.objects[i],)

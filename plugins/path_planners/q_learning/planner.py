@@ -36,7 +36,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 from dcsim_plugins.path_planners.deadline import OutOfTime
 from dcsim_plugins.path_planners.end_effector_line import unreachable
-from dcsim_plugins.path_planners.minimum_jerk import minimum_jerk_legs
 from dcsim_plugins.path_planners.q_learning.cells import (
     CellEnvironment,
     CellRules,
@@ -59,6 +58,7 @@ from dcsim.api import (
     PluginError,
     Trajectory,
     hookimpl,
+    minimum_jerk_legs,
     quantity,
 )
 

@@ -6,7 +6,8 @@ Along a segment of length ``L`` travelled in ``T``,
 
 velocity and acceleration are zero at both ends and continuous in between; the peak
 speed is ``15 L / (8 T)`` and the peak acceleration ``10 L / (√3 T²)``. Used by the path
-planners that give a manipulator's end effector its path.
+planners that give a manipulator's end effector its path, and by the capture mission for
+its base's approach.
 """
 
 from __future__ import annotations
@@ -29,6 +30,17 @@ def shortest_duration(
         PEAK_SPEED * length / max_speed,
         float(np.sqrt(PEAK_ACCELERATION * length / max_acceleration)),
     )
+
+
+def minimum_jerk_profile(tau: float, duration: float) -> tuple[float, float, float]:
+    """The quintic law's fraction of the way ``s``, its rate (1/s) and its second
+    derivative (1/s²) at ``tau`` (the fraction of ``duration``, s, gone; clipped to
+    [0, 1]: at rest before and after)."""
+    tau = min(max(tau, 0.0), 1.0)
+    shape = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
+    rate = 30.0 * tau**2 * (1.0 - tau) ** 2 / duration
+    curve = 60.0 * tau * (1.0 - tau) * (1.0 - 2.0 * tau) / duration**2
+    return shape, rate, curve
 
 
 def minimum_jerk_move(

@@ -11,7 +11,7 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
-from dcsim.world.tumble import TorqueFreeRotation
+from dcsim.torque_free import TorqueFreeRotation
 
 DURATION = 60.0  # s
 SAMPLE = 0.5  # s between comparisons

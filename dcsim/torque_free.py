@@ -1,4 +1,4 @@
-"""The torque-free rotation of a rigid body: a free target's tumble, propagated by the world.
+"""The torque-free rotation of a rigid body: a free target's tumble, as the world propagates it.
 
 PyBullet's integrator is first order in the step: it drifts the angular momentum of a
 body with unequal principal moments and gets its nutation wrong. A free target's
@@ -16,12 +16,12 @@ costs more than the sums it does.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from dcsim.world.vector3 import Vec
+Vec = tuple[float, float, float]
+"""A 3-vector in plain floats."""
 
 Quaternion = tuple[float, float, float, float]
 """A unit quaternion ``[x, y, z, w]`` in plain floats (PyBullet's order)."""
@@ -68,7 +68,7 @@ def _inertia_rows(inertia: ArrayLike) -> tuple[float, ...]:
     return tuple(float(x) for x in (0.5 * (tensor + tensor.T)).ravel())
 
 
-def _unit_quaternion(attitude: Sequence[float]) -> Quaternion:
+def _unit_quaternion(attitude: ArrayLike) -> Quaternion:
     """``attitude`` ([x, y, z, w]) divided by its length.
 
     Raises
@@ -76,9 +76,10 @@ def _unit_quaternion(attitude: Sequence[float]) -> Quaternion:
     ValueError
         If it does not have four finite values or has zero length.
     """
-    if len(attitude) != 4:
-        raise ValueError(f"attitude must be a quaternion [x, y, z, w], got {len(attitude)} values")
-    x, y, z, w = (float(v) for v in attitude)
+    values = np.asarray(attitude, dtype=float).ravel()
+    if values.size != 4:
+        raise ValueError(f"attitude must be a quaternion [x, y, z, w], got {values.size} values")
+    x, y, z, w = values.tolist()
     norm = math.sqrt(x * x + y * y + z * z + w * w)
     if not math.isfinite(norm):
         raise ValueError(f"attitude quaternion must be finite, got {[x, y, z, w]}")
@@ -90,11 +91,12 @@ def _unit_quaternion(attitude: Sequence[float]) -> Quaternion:
     return (x / norm, y / norm, z / norm, w / norm)
 
 
-def _vector(values: Sequence[float], name: str) -> Vec:
+def _vector(values: ArrayLike, name: str) -> Vec:
     """Three finite floats, or a ValueError naming ``name``."""
-    if len(values) != 3:
-        raise ValueError(f"{name} must have 3 components, got {len(values)}")
-    x, y, z = (float(v) for v in values)
+    array = np.asarray(values, dtype=float).ravel()
+    if array.size != 3:
+        raise ValueError(f"{name} must have 3 components, got {array.size}")
+    x, y, z = array.tolist()
     if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
         raise ValueError(f"{name} must be finite, got {[x, y, z]}")
     return (x, y, z)
@@ -129,7 +131,7 @@ class TorqueFreeRotation:
     (best of 5 × 20 000 calls, load 0.7)::
 
         .venv/bin/python -m timeit -r 5 -n 20000 \\
-          -s "from dcsim.world.tumble import TorqueFreeRotation" \\
+          -s "from dcsim.torque_free import TorqueFreeRotation" \\
           -s "r = TorqueFreeRotation([[900, 20, 5], [20, 1100, -10], [5, -10, 1400]], \\
               [0, 0, 0, 1], [0.05, 0.06, 0.03])" "r.advance(0.0005)"
 
@@ -159,8 +161,8 @@ class TorqueFreeRotation:
     def __init__(
         self,
         inertia: ArrayLike,
-        attitude: Sequence[float],
-        angular_velocity: Sequence[float],
+        attitude: ArrayLike,
+        angular_velocity: ArrayLike,
         *,
         max_step: float = 0.01,
     ) -> None:
@@ -176,7 +178,7 @@ class TorqueFreeRotation:
         self._w: Vec = (0.0, 0.0, 0.0)
         self.set_state(attitude, angular_velocity)
 
-    def set_state(self, attitude: Sequence[float], angular_velocity: Sequence[float]) -> None:
+    def set_state(self, attitude: ArrayLike, angular_velocity: ArrayLike) -> None:
         """Restart the rotation from a state; :attr:`time` runs on.
 
         Parameters

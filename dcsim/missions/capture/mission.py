@@ -1,0 +1,494 @@
+"""The ``capture`` mission: a space manipulator grasps a tumbling body and detumbles it.
+
+Modes::
+
+    APPROACH ─base at the standoff─► OBSERVE ─watched, path planned─► INTERCEPT
+        ─end effector on the fixture─► GRASP ─grip held─► DETUMBLE ─stack still─► CAPTURED
+                                 │ no path                 │ grip not held
+                                 ▼                         ▼
+                               ABORT ◄─────────────────────┘
+
+- **APPROACH**: the base flies from its start to the standoff point, ``standoff`` from
+  the target's centre of mass on the line towards the base's start, by a minimum-jerk
+  blend within ``approach_speed`` and ``approach_acceleration``; the arm holds its
+  start configuration and the base its start attitude.
+- **OBSERVE**: the base holds there for ``observation_time`` while the target's track
+  is watched; then the path planner is asked for the end effector's trajectory onto
+  the fixture (a :class:`~dcsim.messages.PathProblem` with a
+  :class:`~dcsim.messages.GraspGoal` built from the target's track).
+- **INTERCEPT**: the planned pose trajectory becomes joint references by closed-loop
+  inverse kinematics (:class:`~dcsim.robots.pose_path.PosePath`, the base held).
+- **GRASP**: from the planned grasp time the pads close; the grip counts as held once
+  both pads have pressed with at least half the grip force and the bar has moved less
+  than ``slip_speed`` relative to them for ``hold_time``. The latch then holds the body
+  to the palm. If the planned trajectory ends first, the capture is aborted.
+- **DETUMBLE**: the base holds its attitude and position at the latch and the arm its
+  configuration (the controller's stiffness gives way to the loads); the stack is
+  detumbled when the base's and the target's angular rates both stay below
+  ``detumbled_rate_deg_s`` for one second.
+
+Telemetry (world frame, SI, true state): the bar's centre relative to the point between
+the pads and its relative velocity, the pads' normal forces, the peak contact (or
+latch) force and the contact impulse of each control period, the target's and the
+base's angular rates and the base's turn from its attitude at the standoff.
+"""
+
+from __future__ import annotations
+
+import time as wallclock
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from dcsim.geometry import (
+    attitude_error,
+    quaternion_between,
+    quaternion_multiply,
+    rotate,
+    slerp,
+)
+from dcsim.messages import (
+    GoalRegion,
+    GraspGoal,
+    NoPath,
+    ObjectTrack,
+    Observations,
+    PathProblem,
+    Reference,
+    RobotState,
+    StateEstimate,
+)
+from dcsim.minimum_jerk import minimum_jerk_profile, shortest_duration
+from dcsim.missions.base import Emit, Mission, MissionWorld
+from dcsim.missions.capture.settings import CaptureMissionSection
+from dcsim.registry.interfaces import Plugin
+from dcsim.robots.kinematics import rotation_matrix
+from dcsim.robots.manipulator import ManipulatorModel
+from dcsim.robots.pose_path import PosePath
+from dcsim.scenario.model import ManipulatorSection, Scenario
+from dcsim.world.capture_rig import CaptureRig
+from dcsim.world.tumbling_body import BodyState
+
+_STILL_TIME = 1.0
+"""Time (s) the stack's rates must stay below the detumbled rate."""
+_PRESSING = 0.5
+"""Fraction of the grip force each pad must press with for the grip to count."""
+
+
+class CaptureMission(Mission):
+    """Approaches a tumbling body, grasps its fixture, latches and detumbles the stack.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The resolved scenario; ``scenario.mission`` is a :class:`CaptureMissionSection`
+        and ``scenario.robot`` a manipulator with a gripper.
+    world : MissionWorld
+        The world; it has a :class:`~dcsim.world.capture_rig.CaptureRig` (``capture``).
+    plugins : mapping of str to Plugin
+        The path planner and the controller (and a localiser, if the scenario names one).
+    emit : callable
+        ``emit(event_name, **data)`` records an event.
+    """
+
+    type = "capture"
+    summary = "grasp a tumbling body with a space manipulator and detumble it"
+    Settings = CaptureMissionSection
+    roles = ("path_planner", "controller")
+    modes = ("APPROACH", "OBSERVE", "INTERCEPT", "GRASP", "DETUMBLE", "CAPTURED", "ABORT")
+    robots = ("manipulator",)
+    columns = (
+        "fixture_dx",
+        "fixture_dy",
+        "fixture_dz",
+        "fixture_dvx",
+        "fixture_dvy",
+        "fixture_dvz",
+        "pad_force_left",
+        "pad_force_right",
+        "contact_force",
+        "impulse_x",
+        "impulse_y",
+        "impulse_z",
+        "target_rate",
+        "base_rate",
+        "base_turn",
+    )
+    units = {
+        **dict.fromkeys(("fixture_dx", "fixture_dy", "fixture_dz"), "m"),
+        **dict.fromkeys(("fixture_dvx", "fixture_dvy", "fixture_dvz"), "mps"),
+        **dict.fromkeys(("pad_force_left", "pad_force_right", "contact_force"), "N"),
+        **dict.fromkeys(("impulse_x", "impulse_y", "impulse_z"), "Ns"),
+        **dict.fromkeys(("target_rate", "base_rate"), "radps"),
+        "base_turn": "rad",
+    }
+    summary_names = (
+        "captured",
+        "detumbled",
+        "contact_time_s",
+        "latch_time_s",
+        "detumble_time_s",
+        "planned_grasp_time_s",
+        "planning_time_s",
+        "peak_contact_force_N",
+        "force_limit_exceeded",
+        "max_base_turn_deg",
+        "final_target_rate_deg_s",
+    )
+    settings: CaptureMissionSection
+
+    def __init__(
+        self, scenario: Scenario, world: MissionWorld, plugins: Mapping[str, Plugin], emit: Emit
+    ) -> None:
+        super().__init__(scenario, world, plugins, emit)
+        rig = getattr(world, "capture", None)
+        if not isinstance(rig, CaptureRig):
+            raise TypeError("a capture needs a world with a gripper and a tumbling body")
+        self.rig = rig
+        robot = scenario.robot
+        assert isinstance(robot, ManipulatorSection) and robot.gripper is not None
+        self.gripper = robot.gripper
+        self.state = "APPROACH"
+        self.start = world.robot_state()
+        self.approach = _Approach(
+            self.start, rig.target_state(), rig.target.inertia, np.array(robot.mount), self.settings
+        )
+        self.held_since: float | None = None
+        self.still_since: float | None = None
+        self.hold_reference: Reference | None = None
+        self.path: PosePath | None = None
+        self.planned_base: RobotState | None = None
+        self.grasp_time: float | None = None
+        self.standoff_attitude = self.start.attitude
+        self.times: dict[str, float | None] = dict.fromkeys(
+            ("contact", "latch", "detumbled", "observe"), None
+        )
+        self.planning_time = 0.0
+        self.reason = ""
+        self.figures = {"peak_force": 0.0, "max_turn": 0.0, "target_rate": 0.0}
+
+    # ------------------------------------------------------------------ the tick
+    @property
+    def mode(self) -> str:
+        """The mode of the current control period."""
+        return self.state
+
+    def tick(self, time: float, estimate: StateEstimate, observations: Observations) -> Reference:
+        """Advance the mode machine and give the reference of the coming period."""
+        self._note_contact(time)
+        if self.state == "APPROACH":
+            return self._approach(time, estimate)
+        if self.state == "OBSERVE":
+            return self._observe(time, estimate, observations)
+        if self.state in ("INTERCEPT", "GRASP"):
+            return self._intercept(time, estimate)
+        if self.state == "DETUMBLE":
+            self._check_still(time)
+        assert self.hold_reference is not None  # set on the way to DETUMBLE or ABORT
+        return self.hold_reference
+
+    def _approach(self, time: float, estimate: StateEstimate) -> Reference:
+        reference = self.approach.reference(time, self.start)
+        if time >= self.approach.end_time:
+            self.times["observe"] = time
+            self.standoff_attitude = estimate.attitude
+            self._go("OBSERVE")
+        return reference
+
+    def _observe(
+        self, time: float, estimate: StateEstimate, observations: Observations
+    ) -> Reference:
+        reference = self.approach.reference(time, self.start)
+        observed = self.times["observe"]
+        assert observed is not None
+        if time - observed >= self.settings.observation_time:
+            self._plan(time, estimate, observations)
+        return reference
+
+    def _plan(self, time: float, estimate: StateEstimate, observations: Observations) -> None:
+        """Ask the path planner for the end effector's intercept of the fixture."""
+        track = self._target_track(observations)
+        if track is None:
+            self._abort("the target is not tracked")
+            return
+        start = estimate.as_state()
+        problem = self._problem(start, track)
+        began = wallclock.perf_counter()
+        result = self.call("path_planner", "plan", problem)
+        self.planning_time += wallclock.perf_counter() - began
+        if isinstance(result, NoPath):
+            self.emit("no_path", reason=result.reason)
+            self._abort(f"no path: {result.reason}")
+            return
+        try:
+            self.path = PosePath(self._model(), start.configuration, result)
+        except ValueError as error:
+            self._abort(f"the path planner's answer cannot be followed: {error}")
+            return
+        self.planned_base = start
+        self.grasp_time = float(result.statistics.get("grasp_time", result.times[-1]))
+        self.emit("path", duration=result.duration, grasp_time=self.grasp_time)
+        self.note_plan_end(time, float(result.times[-1]))
+        self._go("INTERCEPT")
+
+    def _problem(self, start: RobotState, track: ObjectTrack) -> PathProblem:
+        fixture = self.settings.target.fixture
+        return PathProblem(
+            start=start,
+            goal=GoalRegion(position=track.position, tolerance=self.settings.grasp_tolerance),
+            max_speed=self.settings.arm_speed,
+            max_acceleration=self.settings.arm_acceleration,
+            time_budget=self.settings.planning_budget,
+            model=self._model(),
+            grasp=GraspGoal(
+                target=track,
+                fixture=np.array(fixture.position),
+                approach_axis=_unit(fixture.approach_axis),
+                bar_axis=_unit(fixture.bar_axis),
+                tool_offset=self.gripper.reach,
+            ),
+        )
+
+    def _intercept(self, time: float, estimate: StateEstimate) -> Reference:
+        """The arm on its planned path (the base held as it was at planning); the pads
+        close at the grasp time and the grip is judged from then on."""
+        path, base = self.path, self.planned_base
+        assert path is not None and self.grasp_time is not None and base is not None
+        sample = path.at(time)
+        if self.state == "INTERCEPT" and time >= self.grasp_time:
+            self.rig.gripper.command(True)
+            self.emit("gripper_closing")
+            self._go("GRASP")
+        if self.state == "GRASP":
+            self._judge_grip(time, estimate)
+            if self.state == "GRASP" and time >= path.end_time:
+                self._abort("the grip did not hold before the path ended")
+        if self.hold_reference is not None:
+            return self.hold_reference
+        return Reference(
+            time=time,
+            position=base.position,
+            attitude=base.attitude,
+            joint_positions=sample.angles,
+            joint_velocities=sample.rates,
+            joint_accelerations=sample.accelerations,
+        )
+
+    def _judge_grip(self, time: float, estimate: StateEstimate) -> None:
+        """Latch once the grip has held for ``hold_time``."""
+        reading = self.rig.period.last
+        _, velocity = self.rig.fixture_from_pads()
+        pressing = reading is not None and bool(
+            np.all(reading.normal >= _PRESSING * self.gripper.grip_force)
+        )
+        holding = pressing and float(np.linalg.norm(velocity)) <= self.settings.slip_speed
+        if not holding:
+            self.held_since = None
+            return
+        if self.held_since is None:
+            self.held_since = time
+        if time - self.held_since >= self.settings.hold_time:
+            self.rig.latch()
+            self.times["latch"] = time
+            self.emit("latched", held_for=time - self.held_since)
+            self.hold_reference = self._hold(estimate.as_state())
+            self._go("DETUMBLE")
+
+    def _check_still(self, time: float) -> None:
+        """Say the stack is detumbled once both rates stay low for a second."""
+        limit = np.radians(self.settings.detumbled_rate_deg_s)
+        state = self.world.robot_state()
+        target = self.rig.target_state()
+        still = (
+            max(
+                float(np.linalg.norm(state.angular_velocity)),
+                float(np.linalg.norm(target.angular_velocity)),
+            )
+            <= limit
+        )
+        if not still:
+            self.still_since = None
+            return
+        if self.still_since is None:
+            self.still_since = time
+        if time - self.still_since >= _STILL_TIME:
+            self.times["detumbled"] = time
+            self.emit("detumbled")
+            self._go("CAPTURED")
+
+    def _note_contact(self, time: float) -> None:
+        if self.times["contact"] is None and not self.rig.target.free:
+            self.times["contact"] = time
+            self.emit("contact")
+
+    def _hold(self, state: RobotState) -> Reference:
+        """Hold the base's pose and the joints where they are, at rest."""
+        return Reference(
+            time=state.time,
+            position=state.position,
+            attitude=state.attitude,
+            joint_positions=state.joint_positions,
+        )
+
+    def _abort(self, reason: str) -> None:
+        """Stop the capture: the robot holds where it is."""
+        if self.hold_reference is None:
+            self.hold_reference = self._hold(self.world.robot_state())
+        self.reason = reason
+        self.emit("abort", reason=reason)
+        self._go("ABORT")
+
+    def _go(self, mode: str) -> None:
+        if mode != self.state:
+            self.emit("mode", previous=self.state, mode=mode)
+            self.state = mode
+
+    def _model(self) -> ManipulatorModel:
+        model = self.world.robot_spec().model
+        assert isinstance(model, ManipulatorModel)
+        return model
+
+    def _target_track(self, observations: Observations) -> ObjectTrack | None:
+        target_id = self.settings.target.id
+        for track in observations.tracks:
+            if track.id == target_id and track.attitude is not None:
+                return track
+        return None
+
+    # ------------------------------------------------------------------ records
+    def telemetry(self, outputs: Mapping[str, Any]) -> dict[str, Any]:
+        """The columns of :attr:`columns` from the true state."""
+        offset, velocity = self.rig.fixture_from_pads()
+        record = self.rig.period
+        normal = record.last.normal if record.last is not None else np.zeros(2)
+        base = self.world.robot_state()
+        target_rate = float(np.linalg.norm(self.rig.target_state().angular_velocity))
+        turn = attitude_error(base.attitude, self.standoff_attitude)
+        figures = self.figures
+        figures["peak_force"] = max(figures["peak_force"], record.peak_force)
+        if self.times["observe"] is not None:
+            figures["max_turn"] = max(figures["max_turn"], turn)
+        figures["target_rate"] = target_rate
+        row = dict(zip(("fixture_dx", "fixture_dy", "fixture_dz"), offset.tolist(), strict=True))
+        row.update(
+            zip(("fixture_dvx", "fixture_dvy", "fixture_dvz"), velocity.tolist(), strict=True)
+        )
+        row.update(pad_force_left=float(normal[0]), pad_force_right=float(normal[1]))
+        row.update(contact_force=record.peak_force)
+        row.update(
+            zip(("impulse_x", "impulse_y", "impulse_z"), record.impulse.tolist(), strict=True)
+        )
+        row.update(
+            target_rate=target_rate,
+            base_rate=float(np.linalg.norm(base.angular_velocity)),
+            base_turn=turn,
+        )
+        return row
+
+    def plot(
+        self,
+        out_dir: Path,
+        telemetry: Mapping[str, np.ndarray],
+        events: Sequence[Mapping[str, Any]],
+    ) -> list[Path]:
+        """Draw ``capture.png`` into ``out_dir/plots``
+        (:func:`dcsim.missions.capture.plots.write_capture_plots`)."""
+        from dcsim.missions.capture.plots import write_capture_plots  # loads matplotlib
+
+        return write_capture_plots(out_dir, self.scenario, telemetry, events)
+
+    def progress(self) -> str:
+        """The mode and, once held, when."""
+        if self.state == "CAPTURED":
+            return f"captured and detumbled at t = {self.times['detumbled']:.1f} s"
+        if self.state == "ABORT":
+            return f"aborted: {self.reason}"
+        return f"{self.state.lower()}"
+
+    def finished(self) -> tuple[str, str] | None:
+        """Completed once detumbled; stopped on an abort."""
+        if self.state == "CAPTURED":
+            return "completed", "target captured and detumbled"
+        if self.state == "ABORT":
+            return "stopped", self.reason
+        return None
+
+    def goal_met(self) -> bool:
+        """Whether the target was captured and detumbled."""
+        return self.state == "CAPTURED"
+
+    def summary_fields(self) -> dict[str, Any]:
+        """Capture, detumble, loads and the base's turn."""
+        figures, times = self.figures, self.times
+        latch, detumbled = times["latch"], times["detumbled"]
+        return {
+            "captured": latch is not None,
+            "detumbled": detumbled is not None,
+            "contact_time_s": times["contact"],
+            "latch_time_s": latch,
+            "detumble_time_s": None if detumbled is None or latch is None else detumbled - latch,
+            "planned_grasp_time_s": self.grasp_time,
+            "planning_time_s": self.planning_time,
+            "peak_contact_force_N": figures["peak_force"],
+            "force_limit_exceeded": figures["peak_force"] > self.gripper.force_limit,
+            "max_base_turn_deg": float(np.degrees(figures["max_turn"])),
+            "final_target_rate_deg_s": float(np.degrees(figures["target_rate"])),
+        }
+
+
+class _Approach:
+    """The base's flight to the standoff point: a minimum-jerk move at rest at both ends,
+    turning the base's arm side (its mount's direction) to face the target.
+
+    The standoff point lies on the target's angular momentum axis through its centre of
+    mass, on the fixture's side: points of a tumbling body near that axis move least.
+    A body that does not turn gives no axis; the fixture's approach axis stands in.
+    """
+
+    def __init__(
+        self,
+        start: RobotState,
+        target: BodyState,
+        inertia: np.ndarray,
+        mount: np.ndarray,
+        settings: CaptureMissionSection,
+    ) -> None:
+        rotation = rotation_matrix(target.attitude)
+        momentum = rotation @ inertia @ rotation.T @ target.angular_velocity
+        out = target.fixture - target.position
+        axis = momentum if np.linalg.norm(momentum) > 1e-9 else target.approach_axis
+        axis = axis / np.linalg.norm(axis)
+        axis = axis if axis @ out >= 0.0 else -axis
+        self.goal = target.position + settings.standoff * axis
+        self.origin = start.position
+        facing = rotate(start.attitude, mount) if np.linalg.norm(mount) > 0 else -axis
+        self.attitude = quaternion_multiply(quaternion_between(facing, -axis), start.attitude)
+        self.start_attitude = start.attitude
+        length = float(np.linalg.norm(self.goal - self.origin))
+        self.start_time = start.time
+        self.duration = max(
+            shortest_duration(length, settings.approach_speed, settings.approach_acceleration),
+            1e-9,
+        )
+        self.end_time = self.start_time + self.duration
+
+    def reference(self, time: float, start: RobotState) -> Reference:
+        """The base on its move at ``time`` (s), the joints as at the start."""
+        tau = (time - self.start_time) / self.duration
+        shape, rate, curve = minimum_jerk_profile(tau, self.duration)
+        offset = self.goal - self.origin
+        return Reference(
+            time=time,
+            position=self.origin + shape * offset,
+            velocity=rate * offset,
+            acceleration=curve * offset,
+            attitude=slerp(self.start_attitude, self.attitude, shape),
+            joint_positions=start.joint_positions,
+        )
+
+
+def _unit(vector: Sequence[float]) -> np.ndarray:
+    array = np.asarray(vector, dtype=float)
+    return array / np.linalg.norm(array)

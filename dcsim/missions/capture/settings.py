@@ -1,0 +1,94 @@
+"""The capture mission's scenario section: the tumbling target and the capture's limits."""
+
+from __future__ import annotations
+
+from typing import ClassVar, Literal
+
+from pydantic import Field
+
+from dcsim.missions.capture.rules import RULES
+from dcsim.params import quantity
+from dcsim.scenario.loader import Rule
+from dcsim.scenario.model import MissionSettings, PluginChoice, TumblingBodySpec
+
+
+class CaptureMissionSection(MissionSettings):
+    """A capture: a manipulator grasps a tumbling body's grapple fixture and detumbles it."""
+
+    rules: ClassVar[tuple[Rule, ...]] = RULES
+    role_defaults: ClassVar[dict[str, PluginChoice | None]] = {
+        "localiser": None,
+        "path_planner": PluginChoice(plugin="fixture-intercept"),
+        "controller": PluginChoice(plugin="capture-detumble"),
+    }
+
+    type: Literal["capture"] = Field(
+        "capture", description="The mission type: grasp and detumble a tumbling body."
+    )
+    target: TumblingBodySpec = Field(description="The tumbling body and its grapple fixture.")
+    standoff: float = quantity(
+        3.0,
+        unit="m",
+        gt=0,
+        description="Distance from the target's centre of mass at which the base stops.",
+    )
+    approach_speed: float = quantity(
+        0.1, unit="m/s", gt=0, description="Largest speed of the base's approach."
+    )
+    approach_acceleration: float = quantity(
+        0.01, unit="m/s^2", gt=0, description="Largest acceleration of the base's approach."
+    )
+    observation_time: float = quantity(
+        5.0,
+        unit="s",
+        ge=0,
+        description="Time the target is watched at the standoff before the arm's path is planned.",
+    )
+    arm_speed: float = quantity(
+        0.2, unit="m/s", gt=0, description="Largest end-effector speed of the arm's transfer."
+    )
+    arm_acceleration: float = quantity(
+        0.05,
+        unit="m/s^2",
+        gt=0,
+        description="Largest end-effector acceleration of the arm's transfer.",
+    )
+    grasp_tolerance: float = quantity(
+        0.005,
+        unit="m",
+        gt=0,
+        description="Largest distance the arm's joints may fall behind the planned path.",
+    )
+    hold_time: float = quantity(
+        0.5,
+        unit="s",
+        gt=0,
+        description="Time both pads must press on the bar with it not slipping before the "
+        "grip counts as holding and the latch closes.",
+    )
+    slip_speed: float = quantity(
+        0.005,
+        unit="m/s",
+        gt=0,
+        description="Speed of the bar relative to the pads above which the grip is slipping.",
+    )
+    detumbled_rate_deg_s: float = quantity(
+        0.1,
+        unit="deg/s",
+        gt=0,
+        description="Angular rate of the stack (base and target) below which it is detumbled.",
+    )
+    max_base_excursion_deg: float = quantity(
+        5.0,
+        unit="deg",
+        gt=0,
+        description="Largest turn of the base from its attitude at the standoff that counts "
+        "as held.",
+    )
+    planning_budget: float = quantity(
+        5.0, unit="s", gt=0, description="Wall time given to the path planner."
+    )
+
+    def tumbling_body(self) -> TumblingBodySpec:
+        """The target: the world gives it a body of its own, with contact."""
+        return self.target

@@ -1,0 +1,337 @@
+"""``fixture-intercept`` path planner: a manipulator's end effector onto a tumbling body's
+grapple fixture, moving with it.
+
+The problem's :class:`~dcsim.api.GraspGoal` carries the body's track (pose, velocities,
+inertia) and the fixture. The body's motion is predicted by its torque-free tumble
+(:class:`~dcsim.api.TorqueFreeRotation`) and a straight line for its centre of mass. The
+grasp pose of DH frame n at any time is then rigidly attached to the body: x_n along
+``-approach_axis``, z_n along ``bar_axis`` (or against it: a bar is held either way
+round, and the way nearer the end effector's z axis at the start is taken), the grasp
+point ``tool_offset`` ahead of the frame on the bar's centre. The end effector's
+trajectory has three phases:
+
+1. **transfer** — from the start pose (at rest) onto the *pre-grasp* pose, the grasp
+   pose moved ``approach_distance`` out along the approach axis; both poses are blended
+   by a minimum-jerk weight ``s(τ)``, so that at the transfer's end the end effector
+   moves exactly as the pre-grasp pose does (matched velocity);
+2. **insertion** — in along the approach axis onto the grasp pose, the offset falling
+   from ``approach_distance`` to 0 by the minimum-jerk law while the pose turns and
+   moves with the body;
+3. **follow** — on the grasp pose, moving with the fixture, for ``follow_time`` (the
+   gripper closes and its grip is judged meanwhile).
+
+Grasp times are tried from the earliest the transfer's length allows, every
+``candidate_step``, up to ``horizon``. A candidate whose fixture, over insertion and
+follow, stays within the arm's reach from the shoulder and faces it is flown by the
+framework's closed-loop inverse kinematics (:class:`~dcsim.api.PosePath`, the base
+held); it is accepted when the joints stay ``limit_margin_deg`` from their limits,
+``det(J Jᵀ)`` of the 6 × n arm Jacobian stays above ``min_det_jjt`` (away from
+singularities) and the joints follow the path within the goal's tolerance. The first
+accepted candidate is the answer; none by the deadline is a "no path" with the reason
+of the last one refused.
+"""
+
+from __future__ import annotations
+
+import time as wallclock
+from dataclasses import dataclass
+
+import numpy as np
+
+from dcsim.api import (
+    ForwardKinematics,
+    GraspGoal,
+    ManipulatorModel,
+    NoPath,
+    PathPlanner,
+    PathPlannerParams,
+    PathProblem,
+    PosePath,
+    TorqueFreeRotation,
+    Trajectory,
+    hookimpl,
+    quantity,
+    quaternion_conjugate,
+    quaternion_from_matrix,
+    quaternion_multiply,
+    rotation_vector,
+    shortest_duration,
+    slerp,
+)
+
+
+class FixtureInterceptParams(PathPlannerParams):
+    """Parameters of :class:`FixtureInterceptPlanner`."""
+
+    approach_distance: float = quantity(
+        0.15,
+        unit="m",
+        gt=0,
+        description="Distance out along the fixture's approach axis at which the end "
+        "effector lines up before moving in.",
+    )
+    insertion_time: float = quantity(
+        3.0, unit="s", gt=0, description="Duration of the move in along the approach axis."
+    )
+    follow_time: float = quantity(
+        4.0,
+        unit="s",
+        gt=0,
+        description="Time the end effector follows the fixture after reaching it.",
+    )
+    candidate_step: float = quantity(
+        1.0, unit="s", gt=0, description="Spacing of the grasp times tried."
+    )
+    horizon: float = quantity(
+        120.0, unit="s", gt=0, description="Latest grasp time tried, after the start."
+    )
+    limit_margin_deg: float = quantity(
+        5.0, unit="deg", ge=0, description="Least distance kept from every joint limit."
+    )
+    min_det_jjt: float = quantity(
+        1e-4,
+        gt=0,
+        description="Least det(J Jᵀ) of the 6 × n arm Jacobian along the path (away from "
+        "singularities).",
+    )
+    sample_step: float = quantity(
+        0.05, unit="s", gt=0, description="Spacing of the trajectory's samples."
+    )
+    ik_damping: float = quantity(
+        0.02,
+        gt=0,
+        description="Damping λ of the checking inverse kinematics' pseudo-inverse "
+        "(bounds the joint rates near a singularity).",
+    )
+    ik_gain: float = quantity(
+        10.0, unit="1/s", gt=0, description="Gain of the inverse kinematics that checks a path."
+    )
+
+
+@dataclass(frozen=True)
+class BodyPrediction:
+    """A tumbling body's predicted motion at sample times (world frame).
+
+    Attributes
+    ----------
+    centres : ndarray (N, 3)
+        Centre of mass, m.
+    rotations : ndarray (N, 3, 3)
+        Body-to-world rotations.
+    """
+
+    centres: np.ndarray
+    rotations: np.ndarray
+
+    def points(self, body_point: np.ndarray) -> np.ndarray:
+        """World positions (N, 3) of a point fixed in the body (body frame, m)."""
+        return self.centres + self.rotations @ body_point
+
+    def axes(self, body_axis: np.ndarray) -> np.ndarray:
+        """World directions (N, 3) of a body-fixed direction."""
+        return self.rotations @ body_axis
+
+
+def predict_body(grasp: GraspGoal, times: np.ndarray) -> BodyPrediction:
+    """The body's torque-free motion at ``times`` (s, increasing, not before its track)."""
+    track = grasp.target
+    assert track.attitude is not None and track.angular_velocity is not None
+    assert track.inertia is not None  # GraspGoal refuses a track without them
+    rotation = TorqueFreeRotation(track.inertia, track.attitude, track.angular_velocity)
+    rotations = np.empty((len(times), 3, 3))
+    now = track.time
+    for i, t in enumerate(times):
+        rotation.advance(max(t - now, 0.0))
+        now = max(t, now)
+        rotations[i] = _matrix(rotation.attitude)
+    centres = track.position + np.outer(times - track.time, track.velocity)
+    return BodyPrediction(centres, rotations)
+
+
+def _matrix(quaternion: tuple[float, float, float, float]) -> np.ndarray:
+    x, y, z, w = quaternion
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def _minimum_jerk(tau: np.ndarray) -> np.ndarray:
+    """The quintic weight ``10 τ³ − 15 τ⁴ + 6 τ⁵`` on ``τ`` clipped to [0, 1]."""
+    tau = np.clip(tau, 0.0, 1.0)
+    return tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
+
+
+class FixtureInterceptPlanner(PathPlanner):
+    """End-effector pose trajectory onto a tumbling body's grapple fixture."""
+
+    name = "fixture-intercept"
+    summary = "A manipulator's end effector onto a tumbling body's fixture, velocity matched"
+    Params = FixtureInterceptParams
+    params: FixtureInterceptParams
+    robots = ("manipulator",)
+
+    def plan(self, problem: PathProblem) -> Trajectory | NoPath:
+        """The earliest feasible intercept of the fixture, or why there is none."""
+        due = problem.due()
+        grasp, model = problem.grasp, problem.model
+        if grasp is None or not isinstance(model, ManipulatorModel):
+            return NoPath("this planner needs a manipulator's model and a grasp goal")
+        start = problem.start
+        frame = model.forward_kinematics(start.configuration)
+        shoulder = frame.origins[0]
+        p = self.params
+        refusals: dict[str, tuple[int, str]] = {}
+        for grasp_time in self._grasp_times(problem, frame.end_effector, grasp):
+            times = self._times(start.time, grasp_time)
+            body = predict_body(grasp, times)
+            refusal = _out_of_reach(
+                body, grasp, shoulder, model.reach, times >= grasp_time - p.insertion_time
+            )
+            if refusal is None:
+                trajectory = self._trajectory(times, grasp_time, body, grasp, frame)
+                refusal = self._check(problem, trajectory)
+                if refusal is None:
+                    return trajectory
+            kind, detail = refusal
+            refusals[kind] = (refusals.get(kind, (0, ""))[0] + 1, detail)
+            if wallclock.monotonic() > due:
+                refusals["the planning budget ran out"] = (1, f"{problem.time_budget:g} s")
+                break
+        return NoPath(_summary(refusals))
+
+    def _grasp_times(
+        self, problem: PathProblem, origin: np.ndarray, grasp: GraspGoal
+    ) -> np.ndarray:
+        """Candidate grasp times, s: from the earliest the transfer's straight length
+        allows within the speed and acceleration limits."""
+        p = self.params
+        fixture = predict_body(grasp, np.array([problem.start.time])).points(
+            np.asarray(grasp.fixture)
+        )
+        distance = float(np.linalg.norm(fixture[0] - origin))
+        transfer = shortest_duration(distance, problem.max_speed, problem.max_acceleration)
+        first = problem.start.time + transfer + p.insertion_time
+        return np.arange(first, problem.start.time + p.horizon, p.candidate_step)
+
+    def _times(self, start: float, grasp_time: float) -> np.ndarray:
+        """Sample times from ``start`` to the end of the follow phase, s."""
+        end = grasp_time + self.params.follow_time
+        count = int(np.ceil((end - start) / self.params.sample_step)) + 1
+        return np.linspace(start, end, count)
+
+    def _trajectory(
+        self,
+        times: np.ndarray,
+        grasp_time: float,
+        body: BodyPrediction,
+        grasp: GraspGoal,
+        frame: ForwardKinematics,
+    ) -> Trajectory:
+        """The three phases' poses at ``times`` as a trajectory of DH frame n."""
+        p = self.params
+        approach = np.asarray(grasp.approach_axis)
+        lined_up = grasp_time - p.insertion_time
+        offset = p.approach_distance * (1.0 - _minimum_jerk((times - lined_up) / p.insertion_time))
+        grasp_point = np.asarray(grasp.fixture) + grasp.tool_offset * approach
+        positions = body.points(grasp_point) + offset[:, None] * body.axes(approach)
+        x_axis = -body.axes(approach)
+        z_axis = body.axes(np.asarray(grasp.bar_axis))
+        # a bar is held either way round: the way nearer the end effector's z at the start
+        at_grasp = int(np.searchsorted(times, grasp_time))
+        if z_axis[min(at_grasp, len(times) - 1)] @ frame.end_effector_rotation[:, 2] < 0.0:
+            z_axis = -z_axis
+        rotations = np.stack([x_axis, np.cross(z_axis, x_axis), z_axis], axis=-1)
+        attitudes = np.array([quaternion_from_matrix(r) for r in rotations])
+        start_position = frame.end_effector
+        start_attitude = quaternion_from_matrix(frame.end_effector_rotation)
+        weight = _minimum_jerk((times - times[0]) / (lined_up - times[0]))
+        positions = (1.0 - weight[:, None]) * start_position + weight[:, None] * positions
+        attitudes = np.array(
+            [
+                slerp(start_attitude, _near(q, start_attitude), w)
+                for q, w in zip(attitudes, weight, strict=True)
+            ]
+        )
+        return Trajectory(
+            times=times,
+            positions=positions,
+            velocities=np.gradient(positions, times, axis=0),
+            attitudes=attitudes,
+            angular_velocities=_angular_velocities(attitudes, times),
+            length=float(np.linalg.norm(np.diff(positions, axis=0), axis=1).sum()),
+            duration=float(times[-1] - times[0]),
+            statistics={"grasp_time": grasp_time},
+        )
+
+    def _check(self, problem: PathProblem, trajectory: Trajectory) -> tuple[str, str] | None:
+        """Why the arm cannot fly ``trajectory`` (None when it can)."""
+        assert isinstance(problem.model, ManipulatorModel)  # plan() refuses other models
+        path = PosePath(
+            problem.model,
+            problem.start.configuration,
+            trajectory,
+            gain=self.params.ik_gain,
+            damping=self.params.ik_damping,
+            step=self.params.sample_step,
+        )
+        figures = path.tracking
+        margin = np.radians(self.params.limit_margin_deg)
+        if figures.min_limit_margin < margin:
+            return "a joint near its limit", f"{np.degrees(figures.min_limit_margin):.1f} deg"
+        if figures.min_det_jjt < self.params.min_det_jjt:
+            return "near a singularity", f"det(J Jᵀ) {figures.min_det_jjt:.2e}"
+        if figures.max_error > problem.goal.tolerance:
+            return "the joints fall behind the path", f"{figures.max_error:.3g} m"
+        return None
+
+
+def _out_of_reach(
+    body: BodyPrediction, grasp: GraspGoal, shoulder: np.ndarray, reach: float, judged: np.ndarray
+) -> tuple[str, str] | None:
+    """Why the fixture cannot be held at the times ``judged`` (insertion and follow):
+    out of the arm's reach from the shoulder, or facing away from it."""
+    fixture = body.points(np.asarray(grasp.fixture))[judged]
+    approach = body.axes(np.asarray(grasp.approach_axis))[judged]
+    offset = shoulder - fixture
+    distance = np.linalg.norm(offset, axis=1)
+    if np.any(distance > 0.95 * reach):
+        return "out of the arm's reach", f"{distance.max():.2f} m of {reach:.2f} m"
+    facing = np.einsum("ij,ij->i", offset, approach) / distance
+    if np.any(facing < 0.5):
+        return "the fixture faces away", f"{np.degrees(np.arccos(facing.min())):.0f} deg"
+    return None
+
+
+def _summary(refusals: dict[str, tuple[int, str]]) -> str:
+    """Why no grasp time was accepted: each kind of refusal, how many times, and the
+    figure of its last case."""
+    if not refusals:
+        return "no grasp time within the horizon"
+    return "; ".join(
+        f"{kind} ({count}x, last {detail})" for kind, (count, detail) in refusals.items()
+    )
+
+
+def _near(q: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """``q`` or ``-q``, whichever is nearer ``reference`` (the shorter slerp)."""
+    return q if float(q @ reference) >= 0.0 else -q
+
+
+def _angular_velocities(attitudes: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """World angular velocities (N, 3) of sampled attitudes, by central differences."""
+    rates = np.empty((len(times), 3))
+    for i in range(len(times)):
+        before, after = max(i - 1, 0), min(i + 1, len(times) - 1)
+        turn = quaternion_multiply(attitudes[after], quaternion_conjugate(attitudes[before]))
+        rates[i] = rotation_vector(turn) / (times[after] - times[before])
+    return rates
+
+
+@hookimpl
+def dcsim_plugin_classes() -> list[type]:
+    """Register the fixture intercept planner."""
+    return [FixtureInterceptPlanner]
