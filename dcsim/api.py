@@ -69,6 +69,7 @@ Geometry
     :func:`quaternion_multiply`,
     :func:`quaternion_conjugate`, :func:`rotation_vector`,
     :func:`quaternion_from_rotation_vector`, :func:`quaternion_from_matrix`,
+    :func:`rotation_matrix`,
     :func:`slerp`, :func:`facing_axis`, :func:`sight_angle`.
 FMUs (FMI 2.0 co-simulation, through fmpy)
     :class:`FmuDescription`, :class:`FmuInstance`, :class:`FmuError`,
@@ -209,6 +210,7 @@ from dcsim.registry.interfaces import (
 )
 from dcsim.rest_to_rest import cruise_speed, rest_to_rest_time, shortest_leg
 from dcsim.robots.dh import DHLink, DHRobot, ManipulatorBase, thesis_manipulator
+from dcsim.robots.kinematics import rotation_matrix
 from dcsim.robots.loading import load_reach_problem, load_robot_model
 from dcsim.robots.manipulator import (
     ForwardKinematics,
@@ -403,6 +405,7 @@ __all__ = [
     "row_lengths",
     "facing_axis",
     "sight_angle",
+    "rotation_matrix",
     "rotation_vector",
     "ScenarioError",
     "Shape",

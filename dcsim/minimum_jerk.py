@@ -12,7 +12,10 @@ its base's approach.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 PEAK_SPEED = 15.0 / 8.0
 """Peak speed of the quintic law, in units of L / T."""
@@ -32,11 +35,11 @@ def shortest_duration(
     )
 
 
-def minimum_jerk_profile(tau: float, duration: float) -> tuple[float, float, float]:
+def minimum_jerk_profile(tau: ArrayLike, duration: float) -> tuple[Any, Any, Any]:
     """The quintic law's fraction of the way ``s``, its rate (1/s) and its second
-    derivative (1/s²) at ``tau`` (the fraction of ``duration``, s, gone; clipped to
-    [0, 1]: at rest before and after)."""
-    tau = min(max(tau, 0.0), 1.0)
+    derivative (1/s²) at ``tau``, the fraction of ``duration`` (s) gone, clipped to
+    [0, 1] (at rest before and after); floats for a float, arrays for an array."""
+    tau = np.clip(tau, 0.0, 1.0)
     shape = tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
     rate = 30.0 * tau**2 * (1.0 - tau) ** 2 / duration
     curve = 60.0 * tau * (1.0 - tau) * (1.0 - 2.0 * tau) / duration**2

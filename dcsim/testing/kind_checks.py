@@ -12,6 +12,7 @@ import numpy as np
 
 from dcsim.geometry import (
     quaternion_conjugate,
+    quaternion_from_matrix,
     quaternion_from_rotation_vector,
     quaternion_multiply,
     rotation_vector,
@@ -695,7 +696,8 @@ def _reach_path(plugin_class: type[Plugin]) -> tuple[Trajectory, PathProblem]:
 @contract(
     "reaches_the_target",
     "on the reach problem (a manipulator's end effector 0.3 m to a target), the trajectory "
-    f"starts at the end effector of the start state (within {_START_TEXT}) and its final "
+    f"starts at the end effector of the start state (its position and, when the trajectory "
+    f"gives attitudes, its attitude, within {_START_TEXT}) and its final "
     "state is inside the goal region (`GoalRegion.contains`) and at rest (within 1e-9 m/s)",
     kinds=("path_planner",),
     robots=("manipulator",),
@@ -705,8 +707,10 @@ def check_reach_endpoints(plugin_class: type[Plugin]) -> None:
     start = problem.start
     q = start.configuration
     assert problem.model is not None  # the reach problem carries the manipulator's model
-    end_effector = problem.model.forward_kinematics(q).end_effector
-    _check_start(trajectory, dataclasses.replace(start, position=end_effector), "the reach problem")
+    frame = problem.model.forward_kinematics(q)
+    attitude = quaternion_from_matrix(frame.end_effector_rotation)
+    end_effector = dataclasses.replace(start, position=frame.end_effector, attitude=attitude)
+    _check_start(trajectory, end_effector, "the reach problem")
     final = trajectory.end_state()
     if not problem.goal.contains(final) or np.linalg.norm(final.velocity) > 1e-9:
         fail(

@@ -2,7 +2,9 @@
 grapple fixture, moving with it.
 
 The problem's :class:`~dcsim.api.GraspGoal` carries the body's track (pose, velocities,
-inertia) and the fixture. The body's motion is predicted by its torque-free tumble
+inertia) and the fixture; a problem without one (a reach) is met as a fixture that does
+not move, at the goal region's centre, with the end effector's attitude at the start.
+The body's motion is predicted by its torque-free tumble
 (:class:`~dcsim.api.TorqueFreeRotation`) and a straight line for its centre of mass. The
 grasp pose of DH frame n at any time is then rigidly attached to the body: x_n along
 ``-approach_axis``, z_n along ``bar_axis`` (or against it: a bar is held either way
@@ -26,7 +28,8 @@ follow, stays within the arm's reach from the shoulder and faces it is flown by 
 framework's closed-loop inverse kinematics (:class:`~dcsim.api.PosePath`, the base
 held); it is accepted when the joints stay ``limit_margin_deg`` from their limits,
 ``det(J Jᵀ)`` of the 6 × n arm Jacobian stays above ``min_det_jjt`` (away from
-singularities) and the joints follow the path within the goal's tolerance. The first
+singularities; an arm that starts nearer one must not come to half its value at the
+start) and the joints follow the path within the goal's tolerance. The first
 accepted candidate is the answer; none by the deadline is a "no path" with the reason
 of the last one refused.
 """
@@ -43,6 +46,8 @@ from dcsim.api import (
     GraspGoal,
     ManipulatorModel,
     NoPath,
+    ObjectKind,
+    ObjectTrack,
     PathPlanner,
     PathPlannerParams,
     PathProblem,
@@ -50,10 +55,12 @@ from dcsim.api import (
     TorqueFreeRotation,
     Trajectory,
     hookimpl,
+    minimum_jerk_profile,
     quantity,
     quaternion_conjugate,
     quaternion_from_matrix,
     quaternion_multiply,
+    rotation_matrix,
     rotation_vector,
     shortest_duration,
     slerp,
@@ -143,26 +150,9 @@ def predict_body(grasp: GraspGoal, times: np.ndarray) -> BodyPrediction:
     for i, t in enumerate(times):
         rotation.advance(max(t - now, 0.0))
         now = max(t, now)
-        rotations[i] = _matrix(rotation.attitude)
+        rotations[i] = rotation_matrix(rotation.attitude)
     centres = track.position + np.outer(times - track.time, track.velocity)
     return BodyPrediction(centres, rotations)
-
-
-def _matrix(quaternion: tuple[float, float, float, float]) -> np.ndarray:
-    x, y, z, w = quaternion
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
-def _minimum_jerk(tau: np.ndarray) -> np.ndarray:
-    """The quintic weight ``10 τ³ − 15 τ⁴ + 6 τ⁵`` on ``τ`` clipped to [0, 1]."""
-    tau = np.clip(tau, 0.0, 1.0)
-    return tau**3 * (10.0 - 15.0 * tau + 6.0 * tau**2)
 
 
 class FixtureInterceptPlanner(PathPlanner):
@@ -177,19 +167,21 @@ class FixtureInterceptPlanner(PathPlanner):
     def plan(self, problem: PathProblem) -> Trajectory | NoPath:
         """The earliest feasible intercept of the fixture, or why there is none."""
         due = problem.due()
-        grasp, model = problem.grasp, problem.model
-        if grasp is None or not isinstance(model, ManipulatorModel):
-            return NoPath("this planner needs a manipulator's model and a grasp goal")
+        model = problem.model
+        if not isinstance(model, ManipulatorModel):
+            return NoPath("the problem carries no manipulator model: this planner moves an arm")
         start = problem.start
         frame = model.forward_kinematics(start.configuration)
+        grasp = problem.grasp or _still_goal(problem, frame)
         shoulder = frame.origins[0]
         p = self.params
         refusals: dict[str, tuple[int, str]] = {}
         for grasp_time in self._grasp_times(problem, frame.end_effector, grasp):
             times = self._times(start.time, grasp_time)
             body = predict_body(grasp, times)
+            judged = times >= grasp_time - p.insertion_time
             refusal = _out_of_reach(
-                body, grasp, shoulder, model.reach, times >= grasp_time - p.insertion_time
+                body, grasp, shoulder, model.reach, judged, problem.grasp is not None
             )
             if refusal is None:
                 trajectory = self._trajectory(times, grasp_time, body, grasp, frame)
@@ -198,6 +190,8 @@ class FixtureInterceptPlanner(PathPlanner):
                     return trajectory
             kind, detail = refusal
             refusals[kind] = (refusals.get(kind, (0, ""))[0] + 1, detail)
+            if problem.grasp is None:  # a fixture that does not move: later is no better
+                break
             if wallclock.monotonic() > due:
                 refusals["the planning budget ran out"] = (1, f"{problem.time_budget:g} s")
                 break
@@ -235,7 +229,9 @@ class FixtureInterceptPlanner(PathPlanner):
         p = self.params
         approach = np.asarray(grasp.approach_axis)
         lined_up = grasp_time - p.insertion_time
-        offset = p.approach_distance * (1.0 - _minimum_jerk((times - lined_up) / p.insertion_time))
+        offset = p.approach_distance * (
+            1.0 - minimum_jerk_profile((times - lined_up) / p.insertion_time, p.insertion_time)[0]
+        )
         grasp_point = np.asarray(grasp.fixture) + grasp.tool_offset * approach
         positions = body.points(grasp_point) + offset[:, None] * body.axes(approach)
         x_axis = -body.axes(approach)
@@ -248,7 +244,7 @@ class FixtureInterceptPlanner(PathPlanner):
         attitudes = np.array([quaternion_from_matrix(r) for r in rotations])
         start_position = frame.end_effector
         start_attitude = quaternion_from_matrix(frame.end_effector_rotation)
-        weight = _minimum_jerk((times - times[0]) / (lined_up - times[0]))
+        weight = minimum_jerk_profile((times - times[0]) / (lined_up - times[0]), 1.0)[0]
         positions = (1.0 - weight[:, None]) * start_position + weight[:, None] * positions
         attitudes = np.array(
             [
@@ -282,7 +278,8 @@ class FixtureInterceptPlanner(PathPlanner):
         margin = np.radians(self.params.limit_margin_deg)
         if figures.min_limit_margin < margin:
             return "a joint near its limit", f"{np.degrees(figures.min_limit_margin):.1f} deg"
-        if figures.min_det_jjt < self.params.min_det_jjt:
+        start_det = problem.model.det_jjt(problem.start.configuration)
+        if figures.min_det_jjt < min(self.params.min_det_jjt, 0.5 * start_det):
             return "near a singularity", f"det(J Jᵀ) {figures.min_det_jjt:.2e}"
         if figures.max_error > problem.goal.tolerance:
             return "the joints fall behind the path", f"{figures.max_error:.3g} m"
@@ -290,10 +287,16 @@ class FixtureInterceptPlanner(PathPlanner):
 
 
 def _out_of_reach(
-    body: BodyPrediction, grasp: GraspGoal, shoulder: np.ndarray, reach: float, judged: np.ndarray
+    body: BodyPrediction,
+    grasp: GraspGoal,
+    shoulder: np.ndarray,
+    reach: float,
+    judged: np.ndarray,
+    facing_matters: bool,
 ) -> tuple[str, str] | None:
     """Why the fixture cannot be held at the times ``judged`` (insertion and follow):
-    out of the arm's reach from the shoulder, or facing away from it."""
+    out of the arm's reach from the shoulder, or (when ``facing_matters``) facing away
+    from it."""
     fixture = body.points(np.asarray(grasp.fixture))[judged]
     approach = body.axes(np.asarray(grasp.approach_axis))[judged]
     offset = shoulder - fixture
@@ -301,9 +304,33 @@ def _out_of_reach(
     if np.any(distance > 0.95 * reach):
         return "out of the arm's reach", f"{distance.max():.2f} m of {reach:.2f} m"
     facing = np.einsum("ij,ij->i", offset, approach) / distance
-    if np.any(facing < 0.5):
+    if facing_matters and np.any(facing < 0.5):
         return "the fixture faces away", f"{np.degrees(np.arccos(facing.min())):.0f} deg"
     return None
+
+
+def _still_goal(problem: PathProblem, frame: ForwardKinematics) -> GraspGoal:
+    """A problem without a grasp as one: the goal region's centre a fixture that does not
+    move, to be met with the end effector's attitude at the start."""
+    rotation = frame.end_effector_rotation
+    track = ObjectTrack(
+        id=-1,
+        kind=ObjectKind.TARGET,
+        time=problem.start.time,
+        position=problem.goal.position,
+        velocity=np.zeros(3),
+        radius=problem.goal.tolerance,
+        attitude=np.array([0.0, 0.0, 0.0, 1.0]),
+        angular_velocity=np.zeros(3),
+        inertia=np.eye(3),
+    )
+    return GraspGoal(
+        target=track,
+        fixture=np.zeros(3),
+        approach_axis=-rotation[:, 0],
+        bar_axis=rotation[:, 2],
+        tool_offset=0.0,
+    )
 
 
 def _summary(refusals: dict[str, tuple[int, str]]) -> str:
