@@ -186,11 +186,14 @@ class Gripper:
             if point[9] <= 0.0:  # within the contact margin, not touching
                 continue
             pushing += 1
-            # PyBullet's normal (index 7) points from the other body to the gripper
-            force -= (
-                point[9] * np.asarray(point[7])
-                + point[10] * np.asarray(point[11])
+            # PyBullet's normal (index 7) points from the other body to the gripper; its
+            # friction forces along the lateral directions (indices 10-13) are the ones on
+            # the other body (measured: so summed, the impulse is the body's momentum
+            # change to 1e-15)
+            force += (
+                point[10] * np.asarray(point[11])
                 + point[12] * np.asarray(point[13])
+                - point[9] * np.asarray(point[7])
             )
             if point[3] in self.pads:
                 normal[self.pads.index(point[3])] += point[9]
