@@ -122,7 +122,7 @@ def close_until_held(w: World, settle: float = 0.0) -> None:
 
 # ---------------------------------------------------------------- torque-free tumble
 def test_a_free_axisymmetric_target_follows_the_closed_form():
-    """Read back from PyBullet over 60 s (120,000 physics steps, about 7 s of wall time),
+    """Read back from PyBullet over 60 s (120,000 physics steps, 7-9 s of wall time here),
     the untouched cylinder's attitude is the closed form's for an axisymmetric
     torque-free body to 1e-6 rad."""
     rate = np.radians(OBLIQUE_DEG_S)
@@ -234,23 +234,22 @@ TUMBLE_DEG_S = (3.0, 0.3, 0.0)  # deg/s, body axes: the shipped flat spin
 
 
 def momentum_errors(physics_step: float) -> tuple[float, float, float]:
-    """Largest change of the system's momentum from just before the first contact to
-    0.5 s after the pads have closed on a tumbling bar (zero command, the arm's joints
-    and the base free), read every control period: linear (relative to the target's
-    mass times its bar's speed before contact), angular about the world origin and about the
+    """Largest change of the system's momentum over the whole closing, from the pads'
+    command until 0.5 s after they first touch a tumbling bar (zero command, the arm's
+    joints and the base free), read every control period: linear (relative to the
+    target's mass times its bar's speed), angular about the world origin and about the
     system's centre of mass (each relative to the system's |L| there)."""
     origin = np.zeros(3)
     with gripped_world(TUMBLE_DEG_S, physics_step=physics_step) as w:
         rig = w.capture
-        rig.gripper.command(True)
         before = momentum(w, origin), momentum(w)
         scale = rig.target.mass * np.linalg.norm(rig.target_state().fixture_velocity)
-        while rig.target.free:
-            before = momentum(w, origin), momentum(w)
-            w.step(WorldInputs())
-        worst = np.zeros(3)
-        settled = w.time + 0.5
+        rig.gripper.command(True)
+        worst, settled = np.zeros(3), np.inf
         while w.time < settled:
+            w.step(WorldInputs())
+            if not rig.target.free:
+                settled = min(settled, w.time + 0.5)
             now = momentum(w, origin), momentum(w)
             linear = np.linalg.norm(now[0][:3] - before[0][:3]) / scale
             angular = [
@@ -258,7 +257,6 @@ def momentum_errors(physics_step: float) -> tuple[float, float, float]:
                 for a, b in zip(now, before, strict=True)
             ]
             worst = np.maximum(worst, [linear, *angular])
-            w.step(WorldInputs())
         assert rig.period.last.normal.min() > 0.9 * w.robot.gripper.grip_force
     return tuple(worst)
 
@@ -268,7 +266,11 @@ def momentum_errors(physics_step: float) -> tuple[float, float, float]:
     reason="PyBullet's multibody step: at the scenario's 0.5 ms, while the pads close on "
     "the bar, the linear momentum moves by 8.9e-5, the angular by 1.8e-5 (about the "
     "origin) and 2.8e-6 (about the centre of mass); at 0.25 ms 4.5e-5, 9.1e-6, 1.5e-6; "
-    "at 0.1 ms 1.8e-5, 3.7e-6, 1.1e-6",
+    "at 0.1 ms 1.8e-5, 3.7e-6, 1.1e-6. The step's part falls to first order; about the "
+    "centre of mass a floor of about 1e-6 stays: PyBullet applies a contact's friction at "
+    "the pad's and the bar's own contact points, 1-2e-5 m apart (the penetration); once "
+    "the grip has settled, at 0.1 ms, that offset's torque accounts for the change to "
+    "within 2e-8 of |L|",
 )
 def test_contact_keeps_the_momentum_to_the_target():
     """The target: linear and angular momentum kept to 1e-6 across the grasp."""
