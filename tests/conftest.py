@@ -1,4 +1,5 @@
-"""Shared fixtures: the console script, throw-away plugins, the default run, the wheel.
+"""Shared fixtures: the console script, throw-away plugins, the default run, the wheel;
+the shipped capture cut short.
 
 A set-up shared by tests of several modules is made once per pytest-xdist worker; the
 tests that read it carry its ``xdist_group`` mark so that ``--dist loadgroup`` runs
@@ -16,8 +17,10 @@ import venv
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+from dcsim.api import TorqueFreeRotation, load_scenario, quaternion_between, rotation_matrix
 from dcsim.registry.discovery import PluginRegistry
 from dcsim.run.loop import Runner
 from dcsim.run.setup import setup_run
@@ -27,6 +30,51 @@ DCSIM = Path(sys.executable).with_name("dcsim")
 
 SHARES_DEFAULT_RUN = pytest.mark.xdist_group("default-run")
 SHARES_WHEEL = pytest.mark.xdist_group("wheel")
+
+CAPTURE = REPO / "scenarios" / "debris_capture.yaml"
+CAPTURE_PLANNED_AT = 69.44
+"""Time (s) the shipped capture asks its path planner (its ``path`` event)."""
+
+
+def short_capture(observation: float, duration: float) -> dict[str, object]:
+    """Overrides that cut the shipped capture's approach and most of its observation.
+
+    The base starts where the approach ends: ``standoff`` from the target's centre of
+    mass on its angular momentum axis (fixed while it tumbles free), its mount facing
+    the target (the shipped base starts unturned). The target starts turned as it is
+    ``observation`` before the shipped run plans, so the planner meets the same geometry.
+
+    Parameters
+    ----------
+    observation : float
+        ``mission.observation_time`` of the short run, s.
+    duration : float
+        ``world.duration`` of the short run, s.
+
+    Returns
+    -------
+    dict
+        Scenario key paths and their values, for ``dcsim.api.run``'s ``overrides``.
+    """
+    scenario = load_scenario(CAPTURE)
+    target, mount = scenario.mission.target, np.array(scenario.robot.mount)
+    attitude = target.unit_attitude()
+    rotation = rotation_matrix(attitude)
+    rate = rotation @ np.radians(target.angular_velocity_deg_s)  # world frame, rad/s
+    axis = rotation @ target.inertia_tensor() @ rotation.T @ rate
+    axis /= np.linalg.norm(axis)
+    if axis @ (rotation @ np.array(target.fixture.position)) < 0.0:
+        axis = -axis
+    standoff = np.array(target.position) + scenario.mission.standoff * axis
+    tumble = TorqueFreeRotation(target.inertia_tensor(), attitude, rate)
+    tumble.advance(CAPTURE_PLANNED_AT - observation)
+    return {
+        "robot.initial.position": standoff.tolist(),
+        "robot.initial.attitude": quaternion_between(mount, -axis).tolist(),
+        "mission.target.attitude": list(tumble.attitude),
+        "mission.observation_time": observation,
+        "world.duration": duration,
+    }
 
 
 @dataclass

@@ -1,0 +1,102 @@
+"""The capture scenario (scenarios/debris_capture.yaml) cut short: the base starts at its
+standoff and the target is turned as it is when the shipped run asks its planner, so
+the whole capture (observe, intercept, grasp, latch, detumble) flies in about 20 s of
+simulated time instead of 88; then the capture's refusals and aborts."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from dcsim.api import RunResult, ScenarioError, load_scenario, run
+from tests.conftest import CAPTURE, short_capture
+
+OBSERVATION = 0.5
+"""Observation time (s) of the short run."""
+DURATION = 22.0
+"""Duration (s) of the short run: it is detumbled at about 19 s."""
+MODES = ("APPROACH", "OBSERVE", "INTERCEPT", "GRASP", "DETUMBLE", "CAPTURED")
+GRIP_DISTANCE = 0.005
+"""Largest distance (m) of the bar from the pads' centre at latch time."""
+GRIP_SPEED = 0.005
+"""Largest speed (m/s) of the bar relative to the pads at latch time."""
+
+
+@pytest.fixture(scope="module")
+def capture(tmp_path_factory) -> RunResult:
+    """The short capture, run into a run directory."""
+    out = tmp_path_factory.mktemp("capture") / "run"
+    return run(CAPTURE, short_capture(OBSERVATION, DURATION), out=out)
+
+
+def named(result: RunResult, event: str) -> list[dict]:
+    return [e for e in result.events if e["event"] == event]
+
+
+def test_the_capture_passes_every_mode_in_order(capture):
+    modes = [e["mode"] for e in named(capture, "mode")]
+    assert [named(capture, "mode")[0]["previous"], *modes] == list(MODES)
+    order = [e["event"] for e in capture.events if e["event"] != "mode"]
+    assert order == ["path", "gripper_closing", "contact", "latched", "detumbled"]
+    assert capture.status == "completed"
+    assert capture.summary["reason"] == "target captured and detumbled"
+    assert capture.summary["sim_time_s"] < DURATION
+
+
+def test_the_summary_says_captured_within_the_limits(capture):
+    summary = capture.summary
+    gripper = load_scenario(CAPTURE).robot.gripper
+    assert summary["goal_met"] and summary["captured"] and summary["detumbled"]
+    assert 0.0 < summary["peak_contact_force_N"] < gripper.force_limit
+    assert summary["force_limit_exceeded"] is False
+    assert summary["max_base_turn_deg"] <= 5.0
+    assert np.isfinite(summary["detumble_time_s"]) and summary["detumble_time_s"] > 0.0
+    assert summary["contact_time_s"] < summary["latch_time_s"]
+
+
+def test_the_bar_sits_between_the_pads_and_moves_with_them_at_latch_time(capture):
+    telemetry = capture.telemetry
+    units = telemetry.attrs["units"]
+    offset = [f"fixture_d{a}_m" for a in "xyz"]
+    velocity = [f"fixture_dv{a}_mps" for a in "xyz"]
+    assert {units[c] for c in offset} == {"m"} and {units[c] for c in velocity} == {"m/s"}
+    latched = named(capture, "latched")[0]["t"]
+    row = telemetry[np.isclose(telemetry["time_s"], latched, rtol=0.0, atol=1e-9)]
+    assert len(row) == 1
+    assert np.linalg.norm(row[offset].to_numpy()) < GRIP_DISTANCE
+    assert np.linalg.norm(row[velocity].to_numpy()) < GRIP_SPEED
+
+
+def test_the_capture_plot_is_written(capture):
+    assert capture.run_dir is not None
+    plot = Path(capture.run_dir) / "plots" / "capture.png"
+    assert plot.stat().st_size > 10_000  # bytes: a drawn figure, not an empty file
+
+
+def test_a_planner_that_finds_nothing_aborts_the_capture_with_its_reason():
+    overrides = {**short_capture(OBSERVATION, DURATION), "path_planner.params.horizon": 0.01}
+    result = run(CAPTURE, overrides)
+    refusal = named(result, "no_path")[0]["reason"]
+    assert refusal == "no grasp time within the horizon"
+    assert [refusal in e["reason"] for e in named(result, "abort")] == [True]
+    assert named(result, "mode")[-1]["mode"] == "ABORT"
+    assert result.status == "stopped" and refusal in result.summary["reason"]
+    assert result.summary["captured"] is False and result.summary["goal_met"] is False
+
+
+def test_a_capture_without_a_gripper_is_refused_naming_the_key():
+    data = yaml.safe_load(CAPTURE.read_text(encoding="utf-8"))
+    del data["robot"]["gripper"]
+    with pytest.raises(ScenarioError) as refused:
+        load_scenario(data)
+    assert "robot.gripper: a capture needs a gripper: add `gripper: {}`" in str(refused.value)
+
+
+def test_a_capture_in_the_lvlh_frame_is_refused_by_the_cli(dcsim_cli):
+    done = dcsim_cli("run", str(CAPTURE), "--set", "world.frame=lvlh")
+    assert done.returncode == 2
+    assert "world.frame: a capture's tumbling body moves in free space" in done.stderr
+    assert "use `geocentric`" in done.stderr and "Traceback" not in done.stderr
