@@ -32,7 +32,9 @@ SHARES_DEFAULT_RUN = pytest.mark.xdist_group("default-run")
 SHARES_WHEEL = pytest.mark.xdist_group("wheel")
 
 CAPTURE = REPO / "scenarios" / "debris_capture.yaml"
-CAPTURE_PLANNED_AT = 69.44
+CAPTURE_TURNED_AT = 104.0
+"""Time (s) into the shipped capture whose target attitude a short capture starts from:
+its earliest grasp then meets the bar turned about as the shipped run grasps it."""
 """Time (s) the shipped capture asks its path planner (its ``path`` event)."""
 
 
@@ -40,9 +42,10 @@ def short_capture(observation: float, duration: float) -> dict[str, object]:
     """Overrides that cut the shipped capture's approach and most of its observation.
 
     The base starts where the approach ends: ``standoff`` from the target's centre of
-    mass on its angular momentum axis (fixed while it tumbles free), its mount facing
-    the target (the shipped base starts unturned). The target starts turned as it is
-    ``observation`` before the shipped run plans, so the planner meets the same geometry.
+    mass on its angular momentum axis (fixed while it tumbles free) and
+    ``standoff_height`` below it, its mount facing the target (the shipped base starts
+    unturned). The target starts turned as it is :data:`CAPTURE_TURNED_AT` less
+    ``observation`` into the shipped run.
 
     Parameters
     ----------
@@ -65,12 +68,15 @@ def short_capture(observation: float, duration: float) -> dict[str, object]:
     axis /= np.linalg.norm(axis)
     if axis @ (rotation @ np.array(target.fixture.position)) < 0.0:
         axis = -axis
-    standoff = np.array(target.position) + scenario.mission.standoff * axis
+    facing = quaternion_between(mount, -axis)
+    up = rotation_matrix(facing)[:, 2]
+    mission = scenario.mission
+    standoff = np.array(target.position) + mission.standoff * axis - mission.standoff_height * up
     tumble = TorqueFreeRotation(target.inertia_tensor(), attitude, rate)
-    tumble.advance(CAPTURE_PLANNED_AT - observation)
+    tumble.advance(CAPTURE_TURNED_AT - observation)
     return {
         "robot.initial.position": standoff.tolist(),
-        "robot.initial.attitude": quaternion_between(mount, -axis).tolist(),
+        "robot.initial.attitude": facing.tolist(),
         "mission.target.attitude": list(tumble.attitude),
         "mission.observation_time": observation,
         "world.duration": duration,

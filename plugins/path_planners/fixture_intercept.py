@@ -22,16 +22,17 @@ trajectory has three phases:
 3. **follow** — on the grasp pose, moving with the fixture, for ``follow_time`` (the
    gripper closes and its grip is judged meanwhile).
 
-Grasp times are tried from the earliest the transfer's length allows, every
-``candidate_step``, up to ``horizon``. A candidate whose fixture, over insertion and
-follow, stays within the arm's reach from the shoulder and faces it is flown by the
-framework's closed-loop inverse kinematics (:class:`~dcsim.api.PosePath`, the base
-held); it is accepted when the joints stay ``limit_margin_deg`` from their limits,
-``det(J Jᵀ)`` of the 6 × n arm Jacobian stays above ``min_det_jjt`` (away from
-singularities; an arm that starts nearer one must not come to half its value at the
-start) and the joints follow the path within the goal's tolerance. The first
-accepted candidate is the answer; none by the deadline is a "no path" with the reason
-of the last one refused.
+Grasp times are tried every ``candidate_step`` from the earliest the transfer's length
+allows up to ``horizon``, those that need the end effector to roll least about its own x
+axis first (a roll is what an arm without a wrist roll joint does worst). A candidate
+whose fixture, over insertion and follow, stays within the arm's reach from the shoulder
+and faces it is flown by the framework's closed-loop inverse kinematics
+(:class:`~dcsim.api.PosePath`, the base held); it is accepted when the joints stay
+``limit_margin_deg`` from their limits, ``det(J Jᵀ)`` of the 6 × n arm Jacobian stays
+above ``min_det_jjt`` (away from singularities; an arm that starts nearer one must not
+come to half its value at the start) and the joints follow the path within the goal's
+tolerance. The first accepted candidate is the answer; none by the deadline is a "no
+path" that counts the refusals of each kind.
 """
 
 from __future__ import annotations
@@ -77,6 +78,9 @@ class FixtureInterceptParams(PathPlannerParams):
         description="Distance out along the fixture's approach axis at which the end "
         "effector lines up before moving in.",
     )
+    min_transfer_time: float = quantity(
+        1.0, unit="s", gt=0, description="Shortest transfer onto the pre-grasp pose."
+    )
     insertion_time: float = quantity(
         3.0, unit="s", gt=0, description="Duration of the move in along the approach axis."
     )
@@ -91,6 +95,13 @@ class FixtureInterceptParams(PathPlannerParams):
     )
     horizon: float = quantity(
         120.0, unit="s", gt=0, description="Latest grasp time tried, after the start."
+    )
+    roll_resolution: float = quantity(
+        0.1,
+        unit="rad",
+        gt=0,
+        description="Bins of the end effector's roll to the bar by which grasp times are "
+        "ordered (least roll first, then earliest).",
     )
     limit_margin_deg: float = quantity(
         5.0, unit="deg", ge=0, description="Least distance kept from every joint limit."
@@ -123,16 +134,26 @@ class BodyPrediction:
     ----------
     centres : ndarray (N, 3)
         Centre of mass, m.
+    velocity : ndarray (3,)
+        Velocity of the centre of mass, m/s.
     rotations : ndarray (N, 3, 3)
         Body-to-world rotations.
+    angular_velocities : ndarray (N, 3)
+        rad/s.
     """
 
     centres: np.ndarray
+    velocity: np.ndarray
     rotations: np.ndarray
+    angular_velocities: np.ndarray
 
     def points(self, body_point: np.ndarray) -> np.ndarray:
         """World positions (N, 3) of a point fixed in the body (body frame, m)."""
         return self.centres + self.rotations @ body_point
+
+    def point_velocities(self, body_point: np.ndarray) -> np.ndarray:
+        """World velocities (N, 3) of a point fixed in the body, m/s."""
+        return self.velocity + np.cross(self.angular_velocities, self.rotations @ body_point)
 
     def axes(self, body_axis: np.ndarray) -> np.ndarray:
         """World directions (N, 3) of a body-fixed direction."""
@@ -146,13 +167,15 @@ def predict_body(grasp: GraspGoal, times: np.ndarray) -> BodyPrediction:
     assert track.inertia is not None  # GraspGoal refuses a track without them
     rotation = TorqueFreeRotation(track.inertia, track.attitude, track.angular_velocity)
     rotations = np.empty((len(times), 3, 3))
+    rates = np.empty((len(times), 3))
     now = track.time
     for i, t in enumerate(times):
         rotation.advance(max(t - now, 0.0))
         now = max(t, now)
         rotations[i] = rotation_matrix(rotation.attitude)
+        rates[i] = rotation.angular_velocity
     centres = track.position + np.outer(times - track.time, track.velocity)
-    return BodyPrediction(centres, rotations)
+    return BodyPrediction(centres, np.asarray(track.velocity), rotations, rates)
 
 
 class FixtureInterceptPlanner(PathPlanner):
@@ -175,8 +198,14 @@ class FixtureInterceptPlanner(PathPlanner):
         grasp = problem.grasp or _still_goal(problem, frame)
         shoulder = frame.origins[0]
         p = self.params
+        candidates = self._grasp_times(problem, frame, grasp)
+        if len(candidates) == 0:
+            return NoPath(
+                f"the fixture is too far to reach by the horizon of {p.horizon:g} s at the "
+                "problem's speed and acceleration limits"
+            )
         refusals: dict[str, tuple[int, str]] = {}
-        for grasp_time in self._grasp_times(problem, frame.end_effector, grasp):
+        for grasp_time in candidates:
             times = self._times(start.time, grasp_time)
             body = predict_body(grasp, times)
             judged = times >= grasp_time - p.insertion_time
@@ -198,18 +227,27 @@ class FixtureInterceptPlanner(PathPlanner):
         return NoPath(_summary(refusals))
 
     def _grasp_times(
-        self, problem: PathProblem, origin: np.ndarray, grasp: GraspGoal
+        self, problem: PathProblem, frame: ForwardKinematics, grasp: GraspGoal
     ) -> np.ndarray:
-        """Candidate grasp times, s: from the earliest the transfer's straight length
-        allows within the speed and acceleration limits."""
+        """Candidate grasp times, s: every ``candidate_step`` from the earliest the
+        transfer's straight length allows within the speed and acceleration limits, up to
+        ``horizon``; those that need the end effector to roll least about its x axis
+        first (the roll is what an arm without a wrist roll joint does worst), the
+        earlier first among equals."""
         p = self.params
-        fixture = predict_body(grasp, np.array([problem.start.time])).points(
-            np.asarray(grasp.fixture)
+        start = problem.start.time
+        fixture = predict_body(grasp, np.array([start])).points(np.asarray(grasp.fixture))
+        distance = float(np.linalg.norm(fixture[0] - frame.end_effector))
+        transfer = shortest_duration(
+            distance, problem.max_speed, problem.max_acceleration, p.min_transfer_time
         )
-        distance = float(np.linalg.norm(fixture[0] - origin))
-        transfer = shortest_duration(distance, problem.max_speed, problem.max_acceleration)
-        first = problem.start.time + transfer + p.insertion_time
-        return np.arange(first, problem.start.time + p.horizon, p.candidate_step)
+        times = np.arange(start + transfer + p.insertion_time, start + p.horizon, p.candidate_step)
+        if len(times) == 0:
+            return times
+        bars = predict_body(grasp, times).axes(np.asarray(grasp.bar_axis))
+        # the bar is held either way round: the roll is at most 90 degrees
+        roll = np.arccos(np.clip(np.abs(bars @ frame.end_effector_rotation[:, 2]), 0.0, 1.0))
+        return times[np.lexsort((times, np.round(roll / p.roll_resolution)))]
 
     def _times(self, start: float, grasp_time: float) -> np.ndarray:
         """Sample times from ``start`` to the end of the follow phase, s."""
@@ -229,33 +267,44 @@ class FixtureInterceptPlanner(PathPlanner):
         p = self.params
         approach = np.asarray(grasp.approach_axis)
         lined_up = grasp_time - p.insertion_time
-        offset = p.approach_distance * (
-            1.0 - minimum_jerk_profile((times - lined_up) / p.insertion_time, p.insertion_time)[0]
+        inserted, insert_rate, _ = minimum_jerk_profile(
+            (times - lined_up) / p.insertion_time, p.insertion_time
+        )
+        offset, offset_rate = (
+            p.approach_distance * (1.0 - inserted),
+            -p.approach_distance * insert_rate,
         )
         grasp_point = np.asarray(grasp.fixture) + grasp.tool_offset * approach
-        positions = body.points(grasp_point) + offset[:, None] * body.axes(approach)
-        x_axis = -body.axes(approach)
+        out = body.axes(approach)
+        # the grasp pose moved out along the approach axis by the offset
+        held = body.points(grasp_point) + offset[:, None] * out
+        held_velocity = (
+            body.point_velocities(grasp_point)
+            + offset_rate[:, None] * out
+            + offset[:, None] * np.cross(body.angular_velocities, out)
+        )
         z_axis = body.axes(np.asarray(grasp.bar_axis))
         # a bar is held either way round: the way nearer the end effector's z at the start
-        at_grasp = int(np.searchsorted(times, grasp_time))
-        if z_axis[min(at_grasp, len(times) - 1)] @ frame.end_effector_rotation[:, 2] < 0.0:
+        at_grasp = min(int(np.searchsorted(times, grasp_time)), len(times) - 1)
+        if z_axis[at_grasp] @ frame.end_effector_rotation[:, 2] < 0.0:
             z_axis = -z_axis
-        rotations = np.stack([x_axis, np.cross(z_axis, x_axis), z_axis], axis=-1)
-        attitudes = np.array([quaternion_from_matrix(r) for r in rotations])
-        start_position = frame.end_effector
+        rotations = np.stack([-out, np.cross(z_axis, -out), z_axis], axis=-1)
         start_attitude = quaternion_from_matrix(frame.end_effector_rotation)
-        weight = minimum_jerk_profile((times - times[0]) / (lined_up - times[0]), 1.0)[0]
-        positions = (1.0 - weight[:, None]) * start_position + weight[:, None] * positions
+        transfer = lined_up - times[0]
+        weight, weight_rate, _ = minimum_jerk_profile((times - times[0]) / transfer, transfer)
+        start = frame.end_effector
+        positions = start + weight[:, None] * (held - start)
+        velocities = weight_rate[:, None] * (held - start) + weight[:, None] * held_velocity
         attitudes = np.array(
             [
-                slerp(start_attitude, _near(q, start_attitude), w)
-                for q, w in zip(attitudes, weight, strict=True)
+                slerp(start_attitude, _near(quaternion_from_matrix(r), start_attitude), w)
+                for r, w in zip(rotations, weight, strict=True)
             ]
         )
         return Trajectory(
             times=times,
             positions=positions,
-            velocities=np.gradient(positions, times, axis=0),
+            velocities=velocities,
             attitudes=attitudes,
             angular_velocities=_angular_velocities(attitudes, times),
             length=float(np.linalg.norm(np.diff(positions, axis=0), axis=1).sum()),

@@ -106,10 +106,10 @@ def test_simulate_fmu_flies_the_capture_as_dcsim_run_does(capture_fmu):
 
 @pytest.mark.slow
 def test_the_fmu_grasps_latches_and_detumbles_as_dcsim_run_does(tmp_path):
-    overrides = short_capture(observation=0.5, duration=22.0)
+    overrides = short_capture(observation=0.5, duration=26.0)
     texts = [f"{key}={json.dumps(value)}" for key, value in overrides.items()]
     fmu = export_fmu(CAPTURE, tmp_path / "short.fmu", overrides=texts)
-    result = simulate(fmu, 20.0)
+    result = simulate(fmu, 24.0)
     rows = native(overrides)
     assert_flown_alike(result, rows)
     captured = CaptureMission.modes.index("CAPTURED")

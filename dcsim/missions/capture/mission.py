@@ -9,9 +9,10 @@ Modes::
                                ABORT ◄─────────────────────┘
 
 - **APPROACH**: the base flies from its start to the standoff point, ``standoff`` from
-  the target's centre of mass on the line towards the base's start, by a minimum-jerk
-  blend within ``approach_speed`` and ``approach_acceleration``; the arm holds its
-  start configuration and the base its start attitude.
+  the target's centre of mass along its angular momentum (the fixture's side) and
+  ``standoff_height`` below it along the base's z axis, by a minimum-jerk move within
+  ``approach_speed`` and ``approach_acceleration``, turning its arm side to face the
+  target; the arm holds its start configuration.
 - **OBSERVE**: the base holds there for ``observation_time`` while the target's track
   is watched; then the path planner is asked for the end effector's trajectory onto
   the fixture (a :class:`~dcsim.messages.PathProblem` with a
@@ -461,10 +462,11 @@ class _Approach:
         axis = momentum if np.linalg.norm(momentum) > 1e-9 else target.approach_axis
         axis = axis / np.linalg.norm(axis)
         axis = axis if axis @ out >= 0.0 else -axis
-        self.goal = target.position + settings.standoff * axis
         self.origin = start.position
         facing = rotate(start.attitude, mount) if np.linalg.norm(mount) > 0 else -axis
         self.attitude = quaternion_multiply(quaternion_between(facing, -axis), start.attitude)
+        up = rotate(self.attitude, [0.0, 0.0, 1.0])
+        self.goal = target.position + settings.standoff * axis - settings.standoff_height * up
         self.start_attitude = start.attitude
         length = float(np.linalg.norm(self.goal - self.origin))
         self.start_time = start.time

@@ -32,6 +32,13 @@ class CaptureMissionSection(MissionSettings):
         gt=0,
         description="Distance from the target's centre of mass at which the base stops.",
     )
+    standoff_height: float = quantity(
+        0.3,
+        unit="m",
+        description="Height of the target's centre of mass above the base's centre at the "
+        "standoff, along the base's z axis: an arm reaching straight ahead at its shoulder's "
+        "height is near a singularity.",
+    )
     approach_speed: float = quantity(
         0.1, unit="m/s", gt=0, description="Largest speed of the base's approach."
     )
