@@ -17,7 +17,7 @@ from dcsim.report.viewer.scene import build_scene, frame_rows
 from dcsim.run.loop import Runner
 from dcsim.run.setup import setup_run
 from dcsim.world.objects import build_objects
-from tests.conftest import REPO, SHARES_DEFAULT_RUN
+from tests.conftest import CAPTURE, REPO, SHARES_DEFAULT_RUN, short_capture
 
 QUARTER_TURN_X = [0.5**0.5, 0.0, 0.0, 0.5**0.5]
 
@@ -218,6 +218,31 @@ def test_a_manipulator_s_arm_runs_from_its_base_through_its_joints_to_its_end_ef
     names = {t["name"] for t in scene["static"]}
     assert {"reach target", "planned end-effector path"} <= names
     assert "base speed" in {r["label"] for r in scene["readouts"]}
+
+
+@pytest.fixture(scope="module")
+def capture_records(tmp_path_factory):
+    """The shipped capture, cut short: grasped, latched and detumbled in 21 s."""
+    out = tmp_path_factory.mktemp("capture")
+    overrides = [f"{k}={json.dumps(v)}" for k, v in short_capture(0.5, 22.0).items()]
+    return run_into(out, CAPTURE, *overrides)
+
+
+def test_a_capture_shows_the_tumbling_body_as_it_turned_and_the_arm(capture_records):
+    scene = build_scene(capture_records, max_frames=40)
+    rows = frame_rows(len(capture_records.telemetry["time"]), 40)
+    telemetry = capture_records.telemetry
+    (body,) = group(scene, "targets")["members"]
+    assert body["label"] == "T1"
+    centre = np.column_stack([telemetry[f"target_{a}"] for a in "xyz"])[rows]
+    attitude = np.column_stack([telemetry[f"target_q{a}"] for a in "xyzw"])[rows]
+    np.testing.assert_allclose(body["positions"], centre, atol=1e-12)
+    np.testing.assert_allclose(body["turns"], attitude, atol=1e-12)
+    turned = Rotation.from_quat(attitude[-1]) * Rotation.from_quat(attitude[0]).inv()
+    assert turned.magnitude() > np.radians(10.0)  # it tumbled while the run went on
+    (arm,) = [line["frames"] for line in scene["polylines"] if line["trace"]["name"] == "arm links"]
+    assert arm.shape[0] == len(rows)
+    assert "reach target" not in {t["name"] for t in scene["static"]}
 
 
 @pytest.fixture(scope="module")

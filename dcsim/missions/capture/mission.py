@@ -72,6 +72,17 @@ from dcsim.scenario.model import ManipulatorSection, Scenario
 from dcsim.world.capture_rig import CaptureRig
 from dcsim.world.tumbling_body import BodyState
 
+TARGET_POSE_COLUMNS = (
+    "target_x",
+    "target_y",
+    "target_z",
+    "target_qx",
+    "target_qy",
+    "target_qz",
+    "target_qw",
+)
+"""Telemetry columns of the target's centre of mass (m) and attitude (body to world,
+``[x, y, z, w]``): what the viewer draws it from."""
 _STILL_TIME = 1.0
 """Time (s) the stack's rates must stay below the detumbled rate."""
 _PRESSING = 0.5
@@ -116,6 +127,7 @@ class CaptureMission(Mission):
         "target_rate",
         "base_rate",
         "base_turn",
+        *TARGET_POSE_COLUMNS,
     )
     units = {
         **dict.fromkeys(("fixture_dx", "fixture_dy", "fixture_dz"), "m"),
@@ -124,7 +136,19 @@ class CaptureMission(Mission):
         **dict.fromkeys(("impulse_x", "impulse_y", "impulse_z"), "Ns"),
         **dict.fromkeys(("target_rate", "base_rate"), "radps"),
         "base_turn": "rad",
+        **dict.fromkeys(TARGET_POSE_COLUMNS[:3], "m"),
     }
+
+    @classmethod
+    def telemetry_columns(cls, scenario: Scenario) -> tuple[str, ...]:
+        """:attr:`columns`, then each joint's angle (``joint_1`` … ``joint_n``)."""
+        return (*cls.columns, *_joint_columns(scenario))
+
+    @classmethod
+    def telemetry_units(cls, scenario: Scenario) -> dict[str, str]:
+        """:attr:`units`, and radians for the joints."""
+        return {**cls.units, **dict.fromkeys(_joint_columns(scenario), "rad")}
+
     summary_names = (
         "captured",
         "detumbled",
@@ -230,7 +254,9 @@ class CaptureMission(Mission):
             return
         self.planned_base = start
         self.grasp_time = float(result.statistics.get("grasp_time", result.times[-1]))
-        self.emit("path", duration=result.duration, grasp_time=self.grasp_time)
+        self.emit(
+            "path", duration=result.duration, length=result.length, grasp_time=self.grasp_time
+        )
         self.note_plan_end(time, float(result.times[-1]))
         self._go("INTERCEPT")
 
@@ -365,7 +391,8 @@ class CaptureMission(Mission):
         record = self.rig.period
         normal = record.last.normal if record.last is not None else np.zeros(2)
         base = self.world.robot_state()
-        target_rate = float(np.linalg.norm(self.rig.target_state().angular_velocity))
+        target = self.rig.target_state()
+        target_rate = float(np.linalg.norm(target.angular_velocity))
         turn = attitude_error(base.attitude, self.standoff_attitude)
         figures = self.figures
         figures["peak_force"] = max(figures["peak_force"], record.peak_force)
@@ -386,6 +413,10 @@ class CaptureMission(Mission):
             base_rate=float(np.linalg.norm(base.angular_velocity)),
             base_turn=turn,
         )
+        pose = (*target.position.tolist(), *target.attitude.tolist())
+        row.update(zip(TARGET_POSE_COLUMNS, pose, strict=True))
+        angles = base.joint_positions.tolist()
+        row.update(zip(_joint_columns(self.scenario), angles, strict=True))
         return row
 
     def plot(
@@ -437,6 +468,13 @@ class CaptureMission(Mission):
             "max_base_turn_deg": float(np.degrees(figures["max_turn"])),
             "final_target_rate_deg_s": float(np.degrees(figures["target_rate"])),
         }
+
+
+def _joint_columns(scenario: Scenario) -> tuple[str, ...]:
+    """``joint_1`` … ``joint_n``: the arm's angles, as the reach mission records them."""
+    robot = scenario.robot
+    links = robot.links if isinstance(robot, ManipulatorSection) else []
+    return tuple(f"joint_{i}" for i in range(1, len(links) + 1))
 
 
 class _Approach:

@@ -3,7 +3,9 @@
 A free object is where its motion model puts it (the world moves it exactly so). A
 grabbed target is held as it was at the grab, fixed to the robot's base (the world's
 grab service attaches it so): it moves and turns with the base until it is delivered,
-when it leaves the world. Grabs and deliveries come from the run's event log.
+when it leaves the world. Grabs and deliveries come from the run's event log. A
+capture's tumbling body is where its telemetry columns put it (``target_x`` … and
+``target_qx`` …), shown carried from its ``latched`` event on.
 """
 
 from __future__ import annotations
@@ -15,7 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from dcsim.motion import MotionSet
+from dcsim.messages import ObjectKind
+from dcsim.motion import MotionSet, StaticMotion
 from dcsim.report.viewer.robot import RobotPath
 from dcsim.scenario.model import Scenario
 from dcsim.world.objects import SpaceObject, build_objects
@@ -91,9 +94,15 @@ class Handling:
 
 
 def object_tracks(
-    scenario: Scenario, times: np.ndarray, robot: RobotPath, handling: Handling
+    scenario: Scenario,
+    times: np.ndarray,
+    robot: RobotPath,
+    handling: Handling,
+    telemetry: Mapping[str, np.ndarray],
+    events: Sequence[Mapping[str, Any]] = (),
 ) -> list[ObjectTrack]:
-    """Every target and obstacle at ``times``, targets first.
+    """Every target and obstacle at ``times``, targets first (a capture's tumbling body
+    first of all).
 
     Parameters
     ----------
@@ -105,16 +114,43 @@ def object_tracks(
         The robot's base at every telemetry row (a carried target follows it).
     handling : Handling
         Grab and delivery times.
+    telemetry : mapping of str to ndarray
+        The run's telemetry (a tumbling body's pose).
+    events : sequence of mapping
+        The run's events (a tumbling body's latch).
     """
+    tumbling = _tumbling_track(scenario, times, robot, telemetry, events)
     objects = build_objects(scenario)
     if not objects:
-        return []
+        return tumbling
     motions = MotionSet([o.motion for o in objects])
     free = np.stack([motions.state_at(float(t))[0] for t in times], axis=1)  # (N, F, 3)
-    return [
+    return tumbling + [
         _track(obj, times, positions, robot, handling)
         for obj, positions in zip(objects, free, strict=True)
     ]
+
+
+def _tumbling_track(
+    scenario: Scenario,
+    times: np.ndarray,
+    robot: RobotPath,
+    telemetry: Mapping[str, np.ndarray],
+    events: Sequence[Mapping[str, Any]],
+) -> list[ObjectTrack]:
+    """A capture's tumbling body at ``times`` from its pose columns (none without)."""
+    spec = scenario.mission.tumbling_body()
+    if spec is None or "target_x" not in telemetry:
+        return []
+    rows = robot.row_at(times)
+    position = np.column_stack([telemetry[f"target_{a}"] for a in "xyz"])[rows]
+    attitude = np.column_stack([telemetry[f"target_q{a}"] for a in "xyzw"])[rows]
+    latched = min((float(e["t"]) for e in events if e["event"] == "latched"), default=np.inf)
+    status = np.where(times >= latched, Status.CARRIED, Status.FREE).astype(int)
+    body = SpaceObject(
+        spec.id, ObjectKind.TARGET, spec.shape.build(), spec.mass, StaticMotion(spec.position)
+    )
+    return [ObjectTrack(body, position.astype(float), attitude.astype(float), status)]
 
 
 def _track(

@@ -90,7 +90,7 @@ def build_scene(records: RunRecords, max_frames: int = MAX_FRAMES) -> dict[str, 
     rows = frame_rows(len(path.times), max_frames)
     times = path.times[rows]
     handling = Handling.from_events(records.events)
-    tracks = object_tracks(records.scenario, times, path, handling)
+    tracks = object_tracks(records.scenario, times, path, handling, telemetry, records.events)
     arm = arm_polylines(records.scenario, telemetry, path, rows)
     thrusters = Thrusters.of(records.scenario, telemetry, rows)
     context = _Context(records, path, rows, times, tracks, arm, thrusters)
@@ -400,7 +400,7 @@ def _goal(context: _Context) -> list[dict[str, Any]]:
             shape = Shape(ShapeKind.SPHERE, radius=goal.radius)
         traces.append(_placed_mesh(shape, np.asarray(goal.position), "goal region", _GOAL, 0.25))
     target = getattr(settings, "target", None)
-    if target is not None:
+    if isinstance(target, tuple | list) and len(target) == 3:  # a point (a capture's is a body)
         trace = _line_trace("reach target", _GOAL, mode="markers")
         trace["marker"] = {"color": _GOAL, "size": 12, "symbol": "cross"}
         traces.append(_polyline(trace, np.asarray(target, dtype=float)[None]))
