@@ -26,5 +26,18 @@ def frame_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
     ]
 
 
-RULES = (gripper_rule, frame_rule)
+def path_planner_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
+    """A capture plans its arm's intercept: it needs a path planner."""
+    if get("path_planner") is not None:
+        return []
+    return [
+        (
+            ("path_planner",),
+            "a capture needs a path planner for the arm's intercept of the fixture: "
+            "`fixture-intercept` (the default) or one of your own",
+        )
+    ]
+
+
+RULES = (gripper_rule, frame_rule, path_planner_rule)
 """The capture mission's rules, in the order their messages are listed."""
