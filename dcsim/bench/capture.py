@@ -34,8 +34,8 @@ from dcsim.scenario.model import ManipulatorSection, Scenario
 if TYPE_CHECKING:
     import pandas
 
-DEFAULT_CAMPAIGN = "scenarios/campaigns/debris_capture_dispersed.yaml"
-"""The bench's campaign, relative to the checkout's root."""
+DEFAULT_CAMPAIGN = "debris_capture_dispersed.yaml"
+"""The bench's campaign: a file of the checkout's ``scenarios/campaigns``."""
 TARGET_SUCCESSES = 0.95
 """The share of cases that must succeed (at least 95 of 100)."""
 
@@ -146,6 +146,7 @@ FIGURES = (
 """The figures summarised: summary field, label, and the cases it is taken over (a run
 has a force and a turn even when it never touched; the times only when they happened)."""
 TOUCHED = FIGURES[0][2]
+"""The cases the force and the turn are taken over."""
 
 
 def judge(campaign: Campaign, cases: Sequence[Case], table: pandas.DataFrame) -> list[CaptureCase]:

@@ -351,7 +351,7 @@ def bench_capture_command(
             limits = bench.limits_of(loaded)
             run = resume_campaign(resume, options)
         else:
-            path = campaign or checkout_campaign("debris_capture_dispersed.yaml")
+            path = campaign or checkout_campaign(bench.DEFAULT_CAMPAIGN)
             if duration is not None:
                 path = with_duration(path, Path(scratch), duration)
             loaded = load_campaign(path)
