@@ -106,7 +106,7 @@ def bench_campaign(
     ``duration`` (s) replaces ``world.duration`` in every case (the campaign's own when
     None). Run directories go under ``out``.
     """
-    campaign = load_campaign(_with_duration(path, out, duration))
+    campaign = load_campaign(with_duration(path, out, duration))
     registry = PluginRegistry.discover()
     selected = campaign_cases(campaign, registry, cases)
     before = _run_directly(campaign, selected, registry, out / "direct")
@@ -172,8 +172,9 @@ def _run_directly(
     return walls
 
 
-def _with_duration(path: Path, out: Path, duration: float | None) -> Path:
-    """A copy of campaign ``path`` in ``out`` whose cases run for ``duration`` s."""
+def with_duration(path: Path, out: Path, duration: float | None) -> Path:
+    """A copy of campaign ``path`` in folder ``out`` whose cases run for ``duration`` s
+    (the campaign's own when None); its base scenario is named by absolute path."""
     data = yaml.safe_load(path.read_text(encoding="utf-8"))
     data["scenario"] = str((path.parent / data["scenario"]).resolve())
     if duration is not None:

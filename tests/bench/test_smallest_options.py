@@ -5,7 +5,7 @@ allowed value (one run, one instance, zero of what may be zero) and every budget
 duration at its least or a tiny allowed value, its plot written where it has one.
 Where a bench at those values still runs long, the case says so and shortens it with
 an option it has. ``world``, ``manipulator`` and ``localisers`` run at their least
-values in tests/test_cli.py; ``task-planners`` has fixed problem sizes (5 to 15
+values in tests/test_cli.py, ``capture`` in tests/bench/test_capture_bench.py; ``task-planners`` has fixed problem sizes (5 to 15
 targets) that take a minute even at one instance, so its functions run here on the
 smallest size with the command's least counts.
 """

@@ -2,8 +2,8 @@
 
 Every bench prints its results as Markdown for docs/benchmarks.md on stdout and its
 progress on stderr. The benches of dcsim's engine are in :mod:`~dcsim.cli.bench.engine`,
-those of the built-in localisers, task planners, controllers and tracker in
-:mod:`~dcsim.cli.bench.algorithms`, those of the path planners in
+those of the built-in localisers, task planners, controllers and tracker, and the
+capture's, in :mod:`~dcsim.cli.bench.algorithms`, those of the path planners in
 :mod:`~dcsim.cli.bench.path_planners`. Plugin packages add their own benches
 (``dcsim bench ant-colony``) through the ``dcsim_register_commands`` hook
 (:mod:`dcsim.cli.plugin_commands`).
@@ -36,5 +36,6 @@ bench_group.add_command(algorithms.bench_localisers_command)
 bench_group.add_command(algorithms.bench_task_planners_command)
 bench_group.add_command(algorithms.bench_controllers_command)
 bench_group.add_command(algorithms.bench_tracking_command)
+bench_group.add_command(algorithms.bench_capture_command)
 bench_group.add_command(path_planners.bench_grid_search_command)
 bench_group.add_command(path_planners.bench_path_planners_command)

@@ -1,19 +1,23 @@
 """Benches of the built-in localisers (``localisers``), task planners
 (``task-planners``), controllers (``controllers``) and tracker (``tracking``) against
-their references."""
+their references, and of the capture of a tumbling target over dispersed cases
+(``capture``) against its targets."""
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import click
 
 from dcsim.bench.options import comma_words
-from dcsim.cli.common import progress
+from dcsim.cli.campaign import EXIT_INTERRUPTED
+from dcsim.cli.common import checkout_campaign, progress
 from dcsim.cli.options import (
     cluster_choice,
     cluster_options,
     count_option,
+    out_dir_option,
     overrides_option,
     plot_option,
     positive_option,
@@ -282,3 +286,98 @@ def bench_tracking_command(
         chosen, range(first_seed, first_seed + seeds), duration, overrides, progress=progress
     )
     click.echo(markdown_table(runs))
+
+
+@click.command("capture", short_help="A tumbling target's capture over dispersed cases, judged.")
+@click.argument(
+    "campaign", required=False, type=click.Path(dir_okay=False, exists=True, path_type=Path)
+)
+@count_option("--cases", 100, "Cases run: the campaign's first N.")
+@click.option(
+    "--duration",
+    type=click.FloatRange(min=0, min_open=True),
+    help="world.duration of every case, s  [default: the scenario's]",
+)
+@out_dir_option("Campaign directory to keep. Default: a temporary folder, removed after.")
+@click.option(
+    "--resume",
+    type=click.Path(file_okay=False, exists=True, path_type=Path),
+    help="Run the cases of this campaign directory (an earlier --out) that have no result "
+    "yet, after Ctrl-C, and judge them all.",
+)
+@cluster_options
+@plot_option("Save the figures' histograms and the cases' tumbles here.")
+def bench_capture_command(
+    campaign: Path | None,
+    cases: int,
+    duration: float | None,
+    out: Path | None,
+    resume: Path | None,
+    scheduler: str | None,
+    connect_timeout: float | None,
+    workers: int | None,
+    worker_deaths: int,
+    plot_path: Path | None,
+) -> None:
+    """The capture of a tumbling target over the cases of CAMPAIGN, judged.
+
+    CAMPAIGN (default: scenarios/campaigns/debris_capture_dispersed.yaml of this
+    checkout, 100 cases) is a campaign of a capture scenario; its first CASES cases run
+    on Dask (a local cluster unless --scheduler). A case succeeds when it captured the
+    target and detumbled the stack to the mission's detumbled_rate_deg_s, with no
+    contact force above the gripper's force_limit and the base turned at most
+    max_base_excursion_deg. Prints as Markdown for docs/benchmarks.md the success rate,
+    the median, 95th percentile and maximum of the peak contact force, the base's turn,
+    the detumble time and the capture time, the failures by cause and each failed
+    case's tumble and start.
+    """
+    import tempfile
+
+    from dcsim.bench import capture as bench
+    from dcsim.bench.campaign import with_duration
+    from dcsim.campaign import campaign_cases, load_campaign, resume_campaign, run_campaign
+    from dcsim.campaign.run import load_campaign_directory
+
+    options = cluster_choice(scheduler, workers, worker_deaths, connect_timeout)
+    if resume is not None and (campaign, out, duration) != (None, None, None):
+        raise click.BadParameter(
+            "--resume completes the campaign stored in its directory: drop CAMPAIGN, "
+            "--out and --duration",
+            param_hint="--resume",
+        )
+    with tempfile.TemporaryDirectory(prefix="dcsim-capture-") as scratch:
+        if resume is not None:
+            loaded, count = load_campaign_directory(resume)
+            limits = bench.limits_of(loaded)
+            run = resume_campaign(resume, options)
+        else:
+            path = campaign or checkout_campaign(bench.DEFAULT_CAMPAIGN)
+            if duration is not None:
+                path = with_duration(path, Path(scratch), duration)
+            loaded = load_campaign(path)
+            limits = bench.limits_of(loaded)  # another mission is refused before any run
+            count = loaded.spec.total_cases
+            if cases > count:
+                raise click.BadParameter(
+                    f"the campaign has {count} cases: raise its `cases:` to run more",
+                    param_hint="--cases",
+                )
+            count = cases
+            folder = out if out is not None else Path(scratch) / "campaign"
+            progress(f"campaign {loaded.spec.name}: {count} cases → {folder}")
+            run = run_campaign(loaded, folder, options, count)
+        selected = campaign_cases(loaded, PluginRegistry.discover(), count)
+        judged = bench.judge(loaded, selected, run.table)
+        click.echo(bench.markdown(judged, limits))
+        if plot_path is not None:
+            bench.plot(judged, limits, plot_path)
+            click.echo(f"\nplot: {plot_path}")
+    if run.interrupted:
+        again = resume or out
+        click.echo(
+            f"interrupted: dcsim bench capture --resume {again} runs the rest"
+            if again is not None
+            else "interrupted (the campaign was in a temporary folder: give --out to keep it)",
+            err=True,
+        )
+        sys.exit(EXIT_INTERRUPTED)

@@ -12,7 +12,7 @@ from pathlib import Path
 import click
 
 from dcsim.bench.options import comma_numbers, comma_words
-from dcsim.cli.common import plugin_registry, progress
+from dcsim.cli.common import checkout_campaign, plugin_registry, progress
 from dcsim.cli.options import (
     count_option,
     duration_option,
@@ -272,11 +272,7 @@ def bench_campaign_command(
     from dcsim.bench.campaign import bench_campaign, markdown_table
 
     if campaign is None:
-        campaign = (
-            Path(__file__).resolve().parents[3] / "scenarios/campaigns/default_dispersed.yaml"
-        )
-        if not campaign.exists():
-            raise click.BadParameter("name a campaign file", param_hint="CAMPAIGN")
+        campaign = checkout_campaign("default_dispersed.yaml")
     counts = [int(n) for n in comma_numbers(workers, "--workers") if n >= 1]
     with tempfile.TemporaryDirectory() as scratch:
         folder = out if out is not None else Path(scratch)
