@@ -62,6 +62,7 @@ def test_plugins_json_and_kind_filter(dcsim_cli):
     assert result.returncode == 0
     entries = json.loads(result.stdout)
     assert [e["name"] for e in entries] == [
+        "capture-detumble",
         "computed-torque",
         "elastic",
         "fmu",
@@ -71,7 +72,7 @@ def test_plugins_json_and_kind_filter(dcsim_cli):
     assert entries[0]["kind"] == "controller"
     assert entries[0]["distribution"] == "dcsim"
     assert (
-        entries[0]["entry_point"] == "computed-torque = dcsim_plugins.controllers.computed_torque"
+        entries[0]["entry_point"] == "capture-detumble = dcsim_plugins.controllers.capture_detumble"
     )
 
 
@@ -199,8 +200,8 @@ def test_run_writes_resolved_scenario_with_seed_and_overrides(dcsim_cli, tmp_pat
     [
         (
             "controller.plugin=pdd",
-            "no controller plugin named 'pdd' (available: computed-torque, elastic, fmu, pd, "
-            "underactuated); did you mean 'pd'?",
+            "no controller plugin named 'pdd' (available: capture-detumble, computed-torque, elastic, fmu, "
+            "pd, underactuated); did you mean 'pd'?",
         ),
         (
             "controller.params.bandwidth=-1",

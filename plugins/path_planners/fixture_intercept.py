@@ -58,13 +58,10 @@ from dcsim.api import (
     hookimpl,
     minimum_jerk_profile,
     quantity,
-    quaternion_conjugate,
     quaternion_from_matrix,
-    quaternion_multiply,
     rotation_matrix,
     rotation_vector,
     shortest_duration,
-    slerp,
 )
 
 
@@ -213,10 +210,13 @@ class FixtureInterceptPlanner(PathPlanner):
                 body, grasp, shoulder, model.reach, judged, problem.grasp is not None
             )
             if refusal is None:
-                trajectory = self._trajectory(times, grasp_time, body, grasp, frame)
-                refusal = self._check(problem, trajectory)
-                if refusal is None:
-                    return trajectory
+                trajectory = self._trajectory(problem, times, grasp_time, body, grasp)
+                if isinstance(trajectory, Trajectory):
+                    refusal = self._check(problem, trajectory)
+                    if refusal is None:
+                        return trajectory
+                else:
+                    refusal = trajectory
             kind, detail = refusal
             refusals[kind] = (refusals.get(kind, (0, ""))[0] + 1, detail)
             if problem.grasp is None:  # a fixture that does not move: later is no better
@@ -257,56 +257,39 @@ class FixtureInterceptPlanner(PathPlanner):
 
     def _trajectory(
         self,
+        problem: PathProblem,
         times: np.ndarray,
         grasp_time: float,
         body: BodyPrediction,
         grasp: GraspGoal,
-        frame: ForwardKinematics,
-    ) -> Trajectory:
-        """The three phases' poses at ``times`` as a trajectory of DH frame n."""
+    ) -> Trajectory | tuple[str, str]:
+        """The three phases as a trajectory of DH frame n, or why the arm has no joint
+        solution at the pre-grasp pose."""
+        assert isinstance(problem.model, ManipulatorModel)  # plan() refuses other models
+        model, start = problem.model, problem.start.configuration
         p = self.params
-        approach = np.asarray(grasp.approach_axis)
         lined_up = grasp_time - p.insertion_time
-        inserted, insert_rate, _ = minimum_jerk_profile(
-            (times - lined_up) / p.insertion_time, p.insertion_time
+        moving = _GraspPoses.along(body, grasp, times, lined_up, p, model.forward_kinematics(start))
+        first = int(np.searchsorted(times, lined_up))
+        joints = _pose_solution(model, start, moving.positions[first], moving.rotations[first])
+        if joints is None:
+            return "no joint solution at the pre-grasp pose", f"t = {lined_up:.1f} s"
+        transfer = _JointTransfer(
+            model, start, joints, moving.twist(first), (float(times[0]), lined_up)
         )
-        offset, offset_rate = (
-            p.approach_distance * (1.0 - inserted),
-            -p.approach_distance * insert_rate,
-        )
-        grasp_point = np.asarray(grasp.fixture) + grasp.tool_offset * approach
-        out = body.axes(approach)
-        # the grasp pose moved out along the approach axis by the offset
-        held = body.points(grasp_point) + offset[:, None] * out
-        held_velocity = (
-            body.point_velocities(grasp_point)
-            + offset_rate[:, None] * out
-            + offset[:, None] * np.cross(body.angular_velocities, out)
-        )
-        z_axis = body.axes(np.asarray(grasp.bar_axis))
-        # a bar is held either way round: the way nearer the end effector's z at the start
-        at_grasp = min(int(np.searchsorted(times, grasp_time)), len(times) - 1)
-        if z_axis[at_grasp] @ frame.end_effector_rotation[:, 2] < 0.0:
-            z_axis = -z_axis
-        rotations = np.stack([-out, np.cross(z_axis, -out), z_axis], axis=-1)
-        start_attitude = quaternion_from_matrix(frame.end_effector_rotation)
-        transfer = lined_up - times[0]
-        weight, weight_rate, _ = minimum_jerk_profile((times - times[0]) / transfer, transfer)
-        start = frame.end_effector
-        positions = start + weight[:, None] * (held - start)
-        velocities = weight_rate[:, None] * (held - start) + weight[:, None] * held_velocity
-        attitudes = np.array(
-            [
-                slerp(start_attitude, _near(quaternion_from_matrix(r), start_attitude), w)
-                for r, w in zip(rotations, weight, strict=True)
-            ]
-        )
+        positions, velocities = moving.positions.copy(), moving.velocities.copy()
+        rotations, angular = moving.rotations.copy(), moving.angular.copy()
+        for i, t in enumerate(times[:first]):
+            positions[i], rotations[i], velocities[i], angular[i] = transfer.at(t)
+        attitudes = np.array([quaternion_from_matrix(r) for r in rotations])
+        for i in range(1, len(attitudes)):  # one sign along the way, for slerp between samples
+            attitudes[i] = _near(attitudes[i], attitudes[i - 1])
         return Trajectory(
             times=times,
             positions=positions,
             velocities=velocities,
             attitudes=attitudes,
-            angular_velocities=_angular_velocities(attitudes, times),
+            angular_velocities=angular,
             length=float(np.linalg.norm(np.diff(positions, axis=0), axis=1).sum()),
             duration=float(times[-1] - times[0]),
             statistics={"grasp_time": grasp_time},
@@ -333,6 +316,120 @@ class FixtureInterceptPlanner(PathPlanner):
         if figures.max_error > problem.goal.tolerance:
             return "the joints fall behind the path", f"{figures.max_error:.3g} m"
         return None
+
+
+@dataclass(frozen=True)
+class _GraspPoses:
+    """The pose of DH frame n that holds the bar, moved out along the approach axis by
+    the insertion's offset, at sample times: insertion and follow, and the pre-grasp
+    pose before (world frame).
+
+    Attributes
+    ----------
+    positions, velocities : ndarray (N, 3)
+        Origin of frame n, m and m/s.
+    rotations : ndarray (N, 3, 3)
+        Frame n to world.
+    angular : ndarray (N, 3)
+        Angular velocity, rad/s (the body's).
+    """
+
+    positions: np.ndarray
+    velocities: np.ndarray
+    rotations: np.ndarray
+    angular: np.ndarray
+
+    @classmethod
+    def along(
+        cls,
+        body: BodyPrediction,
+        grasp: GraspGoal,
+        times: np.ndarray,
+        lined_up: float,
+        params: FixtureInterceptParams,
+        frame: ForwardKinematics,
+    ) -> _GraspPoses:
+        """The poses at ``times`` for an insertion from ``lined_up`` (s)."""
+        approach = np.asarray(grasp.approach_axis)
+        inserted, insert_rate, _ = minimum_jerk_profile(
+            (times - lined_up) / params.insertion_time, params.insertion_time
+        )
+        offset = params.approach_distance * (1.0 - inserted)
+        grasp_point = np.asarray(grasp.fixture) + grasp.tool_offset * approach
+        out = body.axes(approach)
+        spin = body.angular_velocities
+        velocities = (
+            body.point_velocities(grasp_point)
+            - params.approach_distance * insert_rate[:, None] * out
+            + offset[:, None] * np.cross(spin, out)
+        )
+        z_axis = body.axes(np.asarray(grasp.bar_axis))
+        # a bar is held either way round: the way nearer the end effector's z at the start
+        if z_axis[-1] @ frame.end_effector_rotation[:, 2] < 0.0:
+            z_axis = -z_axis
+        rotations = np.stack([-out, np.cross(z_axis, -out), z_axis], axis=-1)
+        positions = body.points(grasp_point) + offset[:, None] * out
+        return cls(positions, velocities, rotations, spin)
+
+    def twist(self, row: int) -> np.ndarray:
+        """``[v; ω]`` (6,) of the pose at sample ``row``."""
+        return np.concatenate([self.velocities[row], self.angular[row]])
+
+
+class _JointTransfer:
+    """The transfer in joint space: from the start, at rest, to the pre-grasp joints,
+    arriving with the joint rates that move the end effector as the pre-grasp pose
+    moves (a quintic per joint: zero acceleration at both ends), so the arm meets no
+    singularity a straight Cartesian move might cross."""
+
+    def __init__(
+        self,
+        model: ManipulatorModel,
+        start: np.ndarray,
+        joints: np.ndarray,
+        twist: np.ndarray,
+        times: tuple[float, float],
+    ) -> None:
+        self.model, self.base = model, np.asarray(start[:7])
+        self.origin = np.asarray(start[7:], dtype=float)
+        self.goal = joints
+        full = np.concatenate([self.base, joints])
+        self.end_rates = np.linalg.solve(model.jacobian(full)[:, 6:], twist)
+        self.start_time, self.duration = times[0], times[1] - times[0]
+
+    def at(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Frame n's position, rotation, velocity and angular velocity at ``t`` (s)."""
+        duration = self.duration
+        tau = (t - self.start_time) / duration
+        shape = tau**3 * (10 - 15 * tau + 6 * tau**2)
+        shape_rate = 30 * tau**2 * (1 - tau) ** 2
+        end = tau**3 * (-4 + 7 * tau - 3 * tau**2)
+        end_rate = tau**2 * (-12 + 28 * tau - 15 * tau**2)
+        step = self.goal - self.origin
+        angles = self.origin + shape * step + duration * end * self.end_rates
+        rates = (shape_rate * step) / duration + end_rate * self.end_rates
+        kin = self.model.kinematics(np.concatenate([self.base, angles]))
+        twist = kin.jacobian[:, 6:] @ rates
+        return kin.end_effector, kin.rotations[-1], twist[:3], twist[3:]
+
+
+def _pose_solution(
+    model: ManipulatorModel, start: np.ndarray, position: np.ndarray, rotation: np.ndarray
+) -> np.ndarray | None:
+    """Joint angles near the start's that put frame n at ``position`` (m) turned by
+    ``rotation``, the base held (damped Newton on the pose error); None when they do not
+    converge to 1e-9 m and 1e-9 rad."""
+    q = np.array(start, dtype=float)
+    damping = 0.05
+    for _ in range(200):
+        kin = model.kinematics(q)
+        turn = rotation_vector(quaternion_from_matrix(rotation @ kin.rotations[-1].T))
+        error = np.concatenate([position - kin.end_effector, turn])
+        if np.abs(error).max() < 1e-9:
+            return q[7:]
+        jac = kin.jacobian[:, 6:]
+        q[7:] += jac.T @ np.linalg.solve(jac @ jac.T + damping**2 * np.eye(6), error)
+    return None
 
 
 def _out_of_reach(
@@ -395,16 +492,6 @@ def _summary(refusals: dict[str, tuple[int, str]]) -> str:
 def _near(q: np.ndarray, reference: np.ndarray) -> np.ndarray:
     """``q`` or ``-q``, whichever is nearer ``reference`` (the shorter slerp)."""
     return q if float(q @ reference) >= 0.0 else -q
-
-
-def _angular_velocities(attitudes: np.ndarray, times: np.ndarray) -> np.ndarray:
-    """World angular velocities (N, 3) of sampled attitudes, by central differences."""
-    rates = np.empty((len(times), 3))
-    for i in range(len(times)):
-        before, after = max(i - 1, 0), min(i + 1, len(times) - 1)
-        turn = quaternion_multiply(attitudes[after], quaternion_conjugate(attitudes[before]))
-        rates[i] = rotation_vector(turn) / (times[after] - times[before])
-    return rates
 
 
 @hookimpl

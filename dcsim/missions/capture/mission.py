@@ -160,6 +160,7 @@ class CaptureMission(Mission):
         "peak_contact_force_N",
         "force_limit_exceeded",
         "max_base_turn_deg",
+        "base_turn_exceeded",
         "final_target_rate_deg_s",
     )
     settings: CaptureMissionSection
@@ -466,6 +467,8 @@ class CaptureMission(Mission):
             "peak_contact_force_N": figures["peak_force"],
             "force_limit_exceeded": figures["peak_force"] > self.gripper.force_limit,
             "max_base_turn_deg": float(np.degrees(figures["max_turn"])),
+            "base_turn_exceeded": figures["max_turn"]
+            > np.radians(self.settings.max_base_excursion_deg),
             "final_target_rate_deg_s": float(np.degrees(figures["target_rate"])),
         }
 
