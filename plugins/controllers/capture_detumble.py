@@ -49,7 +49,7 @@ class CaptureDetumbleParams(ComputedTorqueParams):
         description="Stiffness of the base's attitude while a body is held.",
     )
     rate_damping: float = quantity(
-        5000.0,
+        20000.0,
         unit="N*m*s/rad",
         gt=0,
         description="Damping of the base's angular rate while a body is held.",

@@ -12,21 +12,23 @@ round, and the way nearer the end effector's z axis at the start is taken), the 
 point ``tool_offset`` ahead of the frame on the bar's centre. The end effector's
 trajectory has three phases:
 
-1. **transfer** — from the start pose (at rest) onto the *pre-grasp* pose, the grasp
-   pose moved ``approach_distance`` out along the approach axis; both poses are blended
-   by a minimum-jerk weight ``s(τ)``, so that at the transfer's end the end effector
-   moves exactly as the pre-grasp pose does (matched velocity);
+1. **transfer** — from the start (at rest) onto the *pre-grasp* pose, the grasp pose
+   moved ``approach_distance`` out along the approach axis, flown in joint space: the
+   joints of the pre-grasp pose are found by damped Newton iteration from the start's,
+   and each joint follows a quintic from rest to them, arriving with the rates that move
+   the end effector exactly as the pre-grasp pose moves (matched velocity). A straight
+   Cartesian blend would carry this arm (its joints 5 and 6 are parallel: it has no
+   wrist roll) through singularities that a joint-space move does not meet;
 2. **insertion** — in along the approach axis onto the grasp pose, the offset falling
    from ``approach_distance`` to 0 by the minimum-jerk law while the pose turns and
    moves with the body;
 3. **follow** — on the grasp pose, moving with the fixture, for ``follow_time`` (the
    gripper closes and its grip is judged meanwhile).
 
-Grasp times are tried every ``candidate_step`` from the earliest the transfer's length
-allows up to ``horizon``, those that need the end effector to roll least about its own x
-axis first (a roll is what an arm without a wrist roll joint does worst). A candidate
-whose fixture, over insertion and follow, stays within the arm's reach from the shoulder
-and faces it is flown by the framework's closed-loop inverse kinematics
+Grasp times are tried every ``candidate_step``, from the earliest the transfer's length
+allows up to ``horizon``. A candidate whose fixture, over insertion and follow, stays
+within the arm's reach from the shoulder and faces it, and whose pre-grasp pose has a
+joint solution, is flown by the framework's closed-loop inverse kinematics
 (:class:`~dcsim.api.PosePath`, the base held); it is accepted when the joints stay
 ``limit_margin_deg`` from their limits, ``det(J Jᵀ)`` of the 6 × n arm Jacobian stays
 above ``min_det_jjt`` (away from singularities; an arm that starts nearer one must not
@@ -92,13 +94,6 @@ class FixtureInterceptParams(PathPlannerParams):
     )
     horizon: float = quantity(
         120.0, unit="s", gt=0, description="Latest grasp time tried, after the start."
-    )
-    roll_resolution: float = quantity(
-        0.1,
-        unit="rad",
-        gt=0,
-        description="Bins of the end effector's roll to the bar by which grasp times are "
-        "ordered (least roll first, then earliest).",
     )
     limit_margin_deg: float = quantity(
         5.0, unit="deg", ge=0, description="Least distance kept from every joint limit."
@@ -231,9 +226,7 @@ class FixtureInterceptPlanner(PathPlanner):
     ) -> np.ndarray:
         """Candidate grasp times, s: every ``candidate_step`` from the earliest the
         transfer's straight length allows within the speed and acceleration limits, up to
-        ``horizon``; those that need the end effector to roll least about its x axis
-        first (the roll is what an arm without a wrist roll joint does worst), the
-        earlier first among equals."""
+        ``horizon``."""
         p = self.params
         start = problem.start.time
         fixture = predict_body(grasp, np.array([start])).points(np.asarray(grasp.fixture))
@@ -241,13 +234,7 @@ class FixtureInterceptPlanner(PathPlanner):
         transfer = shortest_duration(
             distance, problem.max_speed, problem.max_acceleration, p.min_transfer_time
         )
-        times = np.arange(start + transfer + p.insertion_time, start + p.horizon, p.candidate_step)
-        if len(times) == 0:
-            return times
-        bars = predict_body(grasp, times).axes(np.asarray(grasp.bar_axis))
-        # the bar is held either way round: the roll is at most 90 degrees
-        roll = np.arccos(np.clip(np.abs(bars @ frame.end_effector_rotation[:, 2]), 0.0, 1.0))
-        return times[np.lexsort((times, np.round(roll / p.roll_resolution)))]
+        return np.arange(start + transfer + p.insertion_time, start + p.horizon, p.candidate_step)
 
     def _times(self, start: float, grasp_time: float) -> np.ndarray:
         """Sample times from ``start`` to the end of the follow phase, s."""

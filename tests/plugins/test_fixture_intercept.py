@@ -162,7 +162,7 @@ def test_the_path_starts_where_the_end_effector_is_at_rest(model):
 def test_a_bar_out_of_reach_gives_no_path_with_the_reason(model):
     track = tumbling_track((3.0, 0.3, 0.0))
     posed = problem(model, track, standoff=8.0)
-    params = FixtureInterceptPlanner.Params(horizon=40.0)
+    params = FixtureInterceptPlanner.Params(horizon=80.0)
     answer = FixtureInterceptPlanner(params, np.random.default_rng(0)).plan(posed)
     assert isinstance(answer, NoPath)
     assert "out of the arm's reach" in answer.reason
