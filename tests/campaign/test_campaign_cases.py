@@ -47,7 +47,7 @@ def test_shipped_campaigns_give_valid_cases(path, registry):
 
 
 def test_plot_axes_name_the_values_in_words_with_their_units(tmp_path):
-    campaign = load_campaign(SHIPPED[0])  # the default mission, in LVLH
+    campaign = load_campaign(REPO / "scenarios" / "campaigns" / "default_dispersed.yaml")
     assert axis_label(campaign, "robot.initial.position[0]") == "robot initial position, radial [m]"
     assert axis_label(campaign, "robot.initial.velocity[2]") == (
         "robot initial velocity, orbit-normal [m/s]"
