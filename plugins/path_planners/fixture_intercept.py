@@ -3,7 +3,8 @@ grapple fixture, moving with it.
 
 The problem's :class:`~dcsim.api.GraspGoal` carries the body's track (pose, velocities,
 inertia) and the fixture; a problem without one (a reach) is met as a fixture that does
-not move, at the goal region's centre, with the end effector's attitude at the start.
+not move, at the goal region's centre, with the end effector's attitude at the start,
+reached by the transfer alone (no insertion, no follow).
 The body's motion is predicted by its torque-free tumble
 (:class:`~dcsim.api.TorqueFreeRotation`) and a straight line for its centre of mass. The
 grasp pose of DH frame n at any time is then rigidly attached to the body: x_n along
@@ -190,7 +191,11 @@ class FixtureInterceptPlanner(PathPlanner):
         grasp = problem.grasp or _still_goal(problem, frame)
         shoulder = frame.origins[0]
         p = self.params
-        candidates = self._grasp_times(problem, frame, grasp)
+        if problem.grasp is None:  # a still goal: the transfer ends on it, at rest
+            p = p.model_copy(
+                update={"approach_distance": 0.0, "insertion_time": 1e-9, "follow_time": 0.0}
+            )
+        candidates = self._grasp_times(problem, frame, grasp, p)
         if len(candidates) == 0:
             return NoPath(
                 f"the fixture is too far to reach by the horizon of {p.horizon:g} s at the "
@@ -198,14 +203,14 @@ class FixtureInterceptPlanner(PathPlanner):
             )
         refusals: dict[str, tuple[int, str]] = {}
         for grasp_time in candidates:
-            times = self._times(start.time, grasp_time)
+            times = self._times(start.time, grasp_time, p)
             body = predict_body(grasp, times)
             judged = times >= grasp_time - p.insertion_time
             refusal = _out_of_reach(
                 body, grasp, shoulder, model.reach, judged, problem.grasp is not None
             )
             if refusal is None:
-                trajectory = self._trajectory(problem, times, grasp_time, body, grasp)
+                trajectory = self._trajectory(problem, times, grasp_time, body, grasp, p)
                 if isinstance(trajectory, Trajectory):
                     refusal = self._check(problem, trajectory)
                     if refusal is None:
@@ -214,20 +219,23 @@ class FixtureInterceptPlanner(PathPlanner):
                     refusal = trajectory
             kind, detail = refusal
             refusals[kind] = (refusals.get(kind, (0, ""))[0] + 1, detail)
-            if problem.grasp is None:  # a fixture that does not move: later is no better
-                break
+            if problem.grasp is None and kind != _TOO_FAST:
+                break  # a still goal: a later start of the same move is no better
             if wallclock.monotonic() > due:
                 refusals["the planning budget ran out"] = (1, f"{problem.time_budget:g} s")
                 break
         return NoPath(_summary(refusals))
 
     def _grasp_times(
-        self, problem: PathProblem, frame: ForwardKinematics, grasp: GraspGoal
+        self,
+        problem: PathProblem,
+        frame: ForwardKinematics,
+        grasp: GraspGoal,
+        p: FixtureInterceptParams,
     ) -> np.ndarray:
         """Candidate grasp times, s: every ``candidate_step`` from the earliest the
         transfer's straight length allows within the speed and acceleration limits, up to
         ``horizon``."""
-        p = self.params
         start = problem.start.time
         fixture = predict_body(grasp, np.array([start])).points(np.asarray(grasp.fixture))
         distance = float(np.linalg.norm(fixture[0] - frame.end_effector))
@@ -236,10 +244,11 @@ class FixtureInterceptPlanner(PathPlanner):
         )
         return np.arange(start + transfer + p.insertion_time, start + p.horizon, p.candidate_step)
 
-    def _times(self, start: float, grasp_time: float) -> np.ndarray:
+    @staticmethod
+    def _times(start: float, grasp_time: float, p: FixtureInterceptParams) -> np.ndarray:
         """Sample times from ``start`` to the end of the follow phase, s."""
-        end = grasp_time + self.params.follow_time
-        count = int(np.ceil((end - start) / self.params.sample_step)) + 1
+        end = grasp_time + p.follow_time
+        count = int(np.ceil((end - start) / p.sample_step)) + 1
         return np.linspace(start, end, count)
 
     def _trajectory(
@@ -249,12 +258,12 @@ class FixtureInterceptPlanner(PathPlanner):
         grasp_time: float,
         body: BodyPrediction,
         grasp: GraspGoal,
+        p: FixtureInterceptParams,
     ) -> Trajectory | tuple[str, str]:
         """The three phases as a trajectory of DH frame n, or why the arm has no joint
         solution at the pre-grasp pose."""
         assert isinstance(problem.model, ManipulatorModel)  # plan() refuses other models
         model, start = problem.model, problem.start.configuration
-        p = self.params
         lined_up = grasp_time - p.insertion_time
         moving = _GraspPoses.along(body, grasp, times, lined_up, p, model.forward_kinematics(start))
         first = int(np.searchsorted(times, lined_up))
@@ -268,6 +277,9 @@ class FixtureInterceptPlanner(PathPlanner):
         rotations, angular = moving.rotations.copy(), moving.angular.copy()
         for i, t in enumerate(times[:first]):
             positions[i], rotations[i], velocities[i], angular[i] = transfer.at(t)
+        too_fast = _beyond_limits(problem, times[: first + 1], velocities[: first + 1])
+        if too_fast is not None:
+            return _TOO_FAST, too_fast
         attitudes = np.array([quaternion_from_matrix(r) for r in rotations])
         for i in range(1, len(attitudes)):  # one sign along the way, for slerp between samples
             attitudes[i] = _near(attitudes[i], attitudes[i - 1])
@@ -398,6 +410,22 @@ class _JointTransfer:
         kin = self.model.kinematics(np.concatenate([self.base, angles]))
         twist = kin.jacobian[:, 6:] @ rates
         return kin.end_effector, kin.rotations[-1], twist[:3], twist[3:]
+
+
+_TOO_FAST = "the transfer is too fast for the limits"
+
+
+def _beyond_limits(problem: PathProblem, times: np.ndarray, velocities: np.ndarray) -> str | None:
+    """Which of the problem's speed and acceleration limits the samples pass (between
+    consecutive samples for the acceleration); None within both."""
+    speed = float(np.linalg.norm(velocities, axis=1).max())
+    if speed > problem.max_speed * (1 + 1e-9):
+        return f"{speed:.3g} m/s of {problem.max_speed:g}"
+    if len(times) > 1:
+        changes = np.linalg.norm(np.diff(velocities, axis=0), axis=1) / np.diff(times)
+        if changes.max() > problem.max_acceleration * (1 + 1e-9):
+            return f"{changes.max():.3g} m/s² of {problem.max_acceleration:g}"
+    return None
 
 
 def _pose_solution(
