@@ -110,8 +110,10 @@ class CaptureRig:
     def _latch_force(self) -> np.ndarray:
         """The force the latch puts on the body now, world frame, N."""
         assert self._latch is not None
+        # PyBullet gives the force on the parent (the palm), N, not an impulse: measured,
+        # it times the step is the body's momentum change less the contact impulse
         forces = pb.getConstraintState(self._latch, physicsClientId=self._client)
-        return -np.asarray(forces[:3]) / self._dt if _IMPULSE_STATE else -np.asarray(forces[:3])
+        return -np.asarray(forces[:3])
 
     def latch(self) -> None:
         """Hold the body rigidly to the palm as they are now, and brake the arm's joints
@@ -147,18 +149,12 @@ class CaptureRig:
         """The tumbling body's true state now."""
         return self.target.state()
 
-    def fixture_from_pads(self) -> tuple[np.ndarray, np.ndarray]:
+    def fixture_from_pads(self, target: BodyState | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Position (m) and velocity (m/s) of the bar's centre relative to the point
-        between the pads, world frame: zero when the bar sits still in the grip."""
-        link = pb.getLinkState(
-            self._robot, self.gripper.palm, computeLinkVelocity=1, physicsClientId=self._client
-        )
-        rotation = np.reshape(pb.getMatrixFromQuaternion(link[1]), (3, 3))
-        spec = self.gripper.spec
-        lever = (spec.reach - 0.5 * spec.palm_size[0]) * rotation[:, 0]
-        centre = np.asarray(link[0]) + lever
-        velocity = np.asarray(link[6]) + np.cross(link[7], lever)
-        state = self.target.state()
+        between the pads, world frame: zero when the bar sits still in the grip.
+        ``target`` is the body's state now, if already read."""
+        centre, velocity = self.gripper.centre()
+        state = self.target.state() if target is None else target
         return state.fixture - centre, state.fixture_velocity - velocity
 
     def target_track(self, time: float) -> ObjectTrack:
@@ -178,7 +174,3 @@ class CaptureRig:
             angular_velocity=state.angular_velocity,
             inertia=self.target.inertia,
         )
-
-
-_IMPULSE_STATE = False
-"""Whether PyBullet's constraint state is an impulse (per step) rather than a force."""

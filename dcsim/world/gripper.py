@@ -19,6 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from dcsim.messages import Shape, ShapeKind
+from dcsim.robots.urdf import box_link
 from dcsim.scenario.model import GripperSpec
 from dcsim.world.pybullet_client import pb
 
@@ -30,15 +32,8 @@ TUMBLING_GROUP = 4
 
 def _box_link(name: str, mass: float, size: tuple[float, float, float]) -> str:
     """A URDF link: a uniform box of ``size`` (m) and ``mass`` (kg) centred on its frame."""
-    sx, sy, sz = size
-    ixx, iyy, izz = (mass / 12.0 * (b * b + c * c) for b, c in ((sy, sz), (sx, sz), (sx, sy)))
-    box = f'<geometry><box size="{sx!r} {sy!r} {sz!r}"/></geometry>'
-    return (
-        f'<link name="{name}"><inertial><origin xyz="0 0 0" rpy="0 0 0"/>'
-        f'<mass value="{mass!r}"/><inertia ixx="{ixx!r}" ixy="0" ixz="0" iyy="{iyy!r}" '
-        f'iyz="0" izz="{izz!r}"/></inertial><visual>{box}</visual>'
-        f"<collision>{box}</collision></link>"
-    )
+    moments = Shape(ShapeKind.BOX, half_extents=0.5 * np.array(size)).moments_of_inertia(mass)
+    return box_link(name, mass, size, moments)
 
 
 def gripper_urdf(spec: GripperSpec) -> str:
@@ -170,6 +165,16 @@ class Gripper:
                 maxVelocity=speed,
                 physicsClientId=self._client,
             )
+
+    def centre(self) -> tuple[np.ndarray, np.ndarray]:
+        """Position (m) and velocity (m/s) of the point between the pads' centres (where a
+        held bar's centre sits), world frame."""
+        link = pb.getLinkState(
+            self._body, self.palm, computeLinkVelocity=1, physicsClientId=self._client
+        )
+        rotation = np.reshape(pb.getMatrixFromQuaternion(link[1]), (3, 3))
+        lever = (self.spec.reach - 0.5 * self.spec.palm_size[0]) * rotation[:, 0]
+        return np.asarray(link[0]) + lever, np.asarray(link[6]) + np.cross(link[7], lever)
 
     def pad_positions(self) -> np.ndarray:
         """How far each pad has closed from open, m (2,)."""

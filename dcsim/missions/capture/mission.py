@@ -49,6 +49,7 @@ from dcsim.geometry import (
     quaternion_multiply,
     rotate,
     slerp,
+    unit,
 )
 from dcsim.messages import (
     GoalRegion,
@@ -216,7 +217,7 @@ class CaptureMission(Mission):
         return self.hold_reference
 
     def _approach(self, time: float, estimate: StateEstimate) -> Reference:
-        reference = self.approach.reference(time, self.start)
+        reference = self.approach.reference(time)
         if time >= self.approach.end_time:
             self.times["observe"] = time
             self.standoff_attitude = estimate.attitude
@@ -226,7 +227,7 @@ class CaptureMission(Mission):
     def _observe(
         self, time: float, estimate: StateEstimate, observations: Observations
     ) -> Reference:
-        reference = self.approach.reference(time, self.start)
+        reference = self.approach.reference(time)
         observed = self.times["observe"]
         assert observed is not None
         if time - observed >= self.settings.observation_time:
@@ -273,8 +274,8 @@ class CaptureMission(Mission):
             grasp=GraspGoal(
                 target=track,
                 fixture=np.array(fixture.position),
-                approach_axis=_unit(fixture.approach_axis),
-                bar_axis=_unit(fixture.bar_axis),
+                approach_axis=unit(fixture.approach_axis),
+                bar_axis=unit(fixture.bar_axis),
                 tool_offset=self.gripper.reach,
             ),
         )
@@ -388,11 +389,11 @@ class CaptureMission(Mission):
     # ------------------------------------------------------------------ records
     def telemetry(self, outputs: Mapping[str, Any]) -> dict[str, Any]:
         """The columns of :attr:`columns` from the true state."""
-        offset, velocity = self.rig.fixture_from_pads()
+        target = self.rig.target_state()
+        offset, velocity = self.rig.fixture_from_pads(target)
         record = self.rig.period
         normal = record.last.normal if record.last is not None else np.zeros(2)
         base = self.world.robot_state()
-        target = self.rig.target_state()
         target_rate = float(np.linalg.norm(target.angular_velocity))
         turn = attitude_error(base.attitude, self.standoff_attitude)
         figures = self.figures
@@ -509,6 +510,7 @@ class _Approach:
         up = rotate(self.attitude, [0.0, 0.0, 1.0])
         self.goal = target.position + settings.standoff * axis - settings.standoff_height * up
         self.start_attitude = start.attitude
+        self.joints = start.joint_positions
         length = float(np.linalg.norm(self.goal - self.origin))
         self.start_time = start.time
         self.duration = max(
@@ -517,7 +519,7 @@ class _Approach:
         )
         self.end_time = self.start_time + self.duration
 
-    def reference(self, time: float, start: RobotState) -> Reference:
+    def reference(self, time: float) -> Reference:
         """The base on its move at ``time`` (s), the joints as at the start."""
         tau = (time - self.start_time) / self.duration
         shape, rate, curve = minimum_jerk_profile(tau, self.duration)
@@ -528,10 +530,5 @@ class _Approach:
             velocity=rate * offset,
             acceleration=curve * offset,
             attitude=slerp(self.start_attitude, self.attitude, shape),
-            joint_positions=start.joint_positions,
+            joint_positions=self.joints,
         )
-
-
-def _unit(vector: Sequence[float]) -> np.ndarray:
-    array = np.asarray(vector, dtype=float)
-    return array / np.linalg.norm(array)
