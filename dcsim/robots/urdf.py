@@ -79,11 +79,18 @@ def _segment_geometry(link: DHLink) -> str:
     return f"<visual>{origin}{shape}</visual><collision>{origin}{shape}</collision>"
 
 
+def box_link(name: str, mass: float, size: ArrayLike, moments: ArrayLike) -> str:
+    """A URDF link: a box of edge lengths ``size`` (m) centred on the link's frame, with
+    ``mass`` (kg) and principal ``moments`` (kg·m²) along the frame's axes."""
+    box = f'<geometry><box size="{_numbers(size)}"/></geometry>'
+    inertial = _inertial(mass, (0, 0, 0), np.eye(3), moments)
+    shapes = f"<visual>{box}</visual><collision>{box}</collision>"
+    return f'<link name="{name}">{inertial}{shapes}</link>'
+
+
 def _base(robot: DHRobot) -> str:
     base = robot.base
-    box = f'<geometry><box size="{_numbers(base.size)}"/></geometry>'
-    inertial = _inertial(base.mass, (0, 0, 0), np.eye(3), base.inertia)
-    return f'<link name="base">{inertial}<visual>{box}</visual><collision>{box}</collision></link>'
+    return box_link("base", base.mass, base.size, base.inertia)
 
 
 def _arm_link(index: int, link: DHLink) -> str:
