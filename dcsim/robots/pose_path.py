@@ -123,13 +123,13 @@ class PosePath:
         """Wanted position (m), attitude (3×3) and twist ``[v; ω]`` of frame n at ``t``."""
         inside = min(max(t, self.start_time), self.end_time)
         trajectory = self._trajectory
-        state = trajectory.state_at(inside)
-        moving = self.start_time < t < self.end_time
         twist = np.zeros(6)
-        if moving:
+        if self.start_time < t < self.end_time:
             twist[:3] = self._curve(t, 1)
-            twist[3:] = state.angular_velocity
-        return self._curve(inside), rotation_matrix(state.attitude), twist
+            if trajectory.angular_velocities is not None:
+                rates = trajectory.angular_velocities
+                twist[3:] = [np.interp(t, trajectory.times, rates[:, k]) for k in range(3)]
+        return self._curve(inside), rotation_matrix(trajectory.attitude_at(inside)), twist
 
     def _rates(self, t: float, theta: Array) -> tuple[Array, float, float]:
         """``θ̇`` (rad/s), ``det(J Jᵀ)`` and the position error (m) at ``t``."""

@@ -152,6 +152,15 @@ class BodyPrediction:
         """World directions (N, 3) of a body-fixed direction."""
         return self.rotations @ body_axis
 
+    def head(self, count: int) -> BodyPrediction:
+        """The prediction at its first ``count`` samples."""
+        return BodyPrediction(
+            self.centres[:count],
+            self.velocity,
+            self.rotations[:count],
+            self.angular_velocities[:count],
+        )
+
 
 def predict_body(grasp: GraspGoal, times: np.ndarray) -> BodyPrediction:
     """The body's torque-free motion at ``times`` (s, increasing, not before its track)."""
@@ -195,7 +204,12 @@ class FixtureInterceptPlanner(PathPlanner):
             p = p.model_copy(
                 update={"approach_distance": 0.0, "insertion_time": 1e-9, "follow_time": 0.0}
             )
-        candidates = self._grasp_times(problem, frame, grasp, p)
+        # the body's motion over every candidate's samples, predicted once
+        samples = start.time + p.sample_step * np.arange(
+            _sample_count(p.horizon + p.follow_time, p)
+        )
+        predicted = predict_body(grasp, samples)
+        candidates = self._grasp_times(problem, frame, grasp, predicted, p)
         if len(candidates) == 0:
             return NoPath(
                 f"the fixture is too far to reach by the horizon of {p.horizon:g} s at the "
@@ -203,8 +217,8 @@ class FixtureInterceptPlanner(PathPlanner):
             )
         refusals: dict[str, tuple[int, str]] = {}
         for grasp_time in candidates:
-            times = self._times(start.time, grasp_time, p)
-            body = predict_body(grasp, times)
+            count = _sample_count(grasp_time + p.follow_time - start.time, p)
+            times, body = samples[:count], predicted.head(count)
             judged = times >= grasp_time - p.insertion_time
             refusal = _out_of_reach(
                 body, grasp, shoulder, model.reach, judged, problem.grasp is not None
@@ -231,25 +245,19 @@ class FixtureInterceptPlanner(PathPlanner):
         problem: PathProblem,
         frame: ForwardKinematics,
         grasp: GraspGoal,
+        predicted: BodyPrediction,
         p: FixtureInterceptParams,
     ) -> np.ndarray:
         """Candidate grasp times, s: every ``candidate_step`` from the earliest the
         transfer's straight length allows within the speed and acceleration limits, up to
-        ``horizon``."""
+        ``horizon`` (``predicted``: the body's motion from the start on)."""
         start = problem.start.time
-        fixture = predict_body(grasp, np.array([start])).points(np.asarray(grasp.fixture))
+        fixture = predicted.head(1).points(np.asarray(grasp.fixture))
         distance = float(np.linalg.norm(fixture[0] - frame.end_effector))
         transfer = shortest_duration(
             distance, problem.max_speed, problem.max_acceleration, p.min_transfer_time
         )
         return np.arange(start + transfer + p.insertion_time, start + p.horizon, p.candidate_step)
-
-    @staticmethod
-    def _times(start: float, grasp_time: float, p: FixtureInterceptParams) -> np.ndarray:
-        """Sample times from ``start`` to the end of the follow phase, s."""
-        end = grasp_time + p.follow_time
-        count = int(np.ceil((end - start) / p.sample_step)) + 1
-        return np.linspace(start, end, count)
 
     def _trajectory(
         self,
@@ -468,6 +476,11 @@ def _out_of_reach(
     if facing_matters and np.any(facing < 0.5):
         return "the fixture faces away", f"{np.degrees(np.arccos(facing.min())):.0f} deg"
     return None
+
+
+def _sample_count(span: float, p: FixtureInterceptParams) -> int:
+    """Samples every ``sample_step`` from the start that cover ``span`` (s)."""
+    return int(np.ceil(span / p.sample_step - 1e-9)) + 1
 
 
 def _still_goal(problem: PathProblem, frame: ForwardKinematics) -> GraspGoal:
