@@ -1032,20 +1032,16 @@ class SpaceObjectSpec(Section):
 
 def _inertia_tensor(value: Any) -> Any:
     """Three principal moments, or a symmetric 3x3 tensor, checked as a rigid body's."""
-    if isinstance(value, list | tuple) and len(value) == 3:
-        rows = [row if isinstance(row, list | tuple) else None for row in value]
-        if all(row is not None for row in rows):
-            matrix = np.array(value, dtype=float)
-            if matrix.shape != (3, 3) or not np.all(np.isfinite(matrix)):
-                raise ValueError("give three principal moments or a 3x3 tensor of numbers")
-            if not np.allclose(matrix, matrix.T, rtol=1e-9, atol=0.0):
-                raise ValueError("the inertia tensor must be symmetric")
-            moments = np.linalg.eigvalsh(matrix)
-            if moments[0] <= 0.0:
-                raise ValueError("the inertia tensor must be positive definite")
-            _rigid((float(moments[0]), float(moments[1]), float(moments[2])))
-            return value
-    return _rigid(value)
+    if not all(isinstance(row, list | tuple) for row in value):
+        return _rigid(value)
+    matrix = np.array(value, dtype=float)
+    if not np.allclose(matrix, matrix.T, rtol=1e-9, atol=0.0):
+        raise ValueError("the inertia tensor must be symmetric")
+    moments = np.linalg.eigvalsh(matrix)
+    if moments[0] <= 0.0:
+        raise ValueError("the inertia tensor must be positive definite")
+    _rigid((float(moments[0]), float(moments[1]), float(moments[2])))
+    return value
 
 
 InertiaSpec = Annotated[PositiveVec3 | tuple[Vec3, Vec3, Vec3], AfterValidator(_inertia_tensor)]
