@@ -27,6 +27,7 @@ from dcsim.scenario.model import TumblingBodySpec
 from dcsim.torque_free import TorqueFreeRotation
 from dcsim.world.gripper import GRIPPER_GROUP, TUMBLING_GROUP
 from dcsim.world.pybullet_client import MAX_SPEED, pb
+from dcsim.world.vector3 import compose
 
 
 @dataclass(frozen=True)
@@ -57,9 +58,6 @@ class BodyState:
     fixture_velocity: np.ndarray
     approach_axis: np.ndarray
     bar_axis: np.ndarray
-
-
-_ORIGIN = (0.0, 0.0, 0.0)
 
 
 class TumblingBody:
@@ -94,7 +92,8 @@ class TumblingBody:
         if np.linalg.det(axes) < 0:
             axes[:, 2] = -axes[:, 2]
         self._principal = axes  # principal frame to body frame
-        self._principal_turn = quaternion_from_matrix(axes).tolist()
+        x, y, z, w = quaternion_from_matrix(axes).tolist()
+        self._principal_turn = (x, y, z, w)
         attitude = spec.unit_attitude()
         rotation = rotation_matrix(attitude)
         omega = rotation @ np.radians(np.array(spec.angular_velocity_deg_s))
@@ -158,9 +157,7 @@ class TumblingBody:
     def _place(self) -> None:
         """Put the PyBullet body on the torque-free state now."""
         client = self._client
-        _, attitude = pb.multiplyTransforms(
-            _ORIGIN, self.rotation.attitude, _ORIGIN, self._principal_turn
-        )
+        attitude = compose(self.rotation.attitude, self._principal_turn)
         pb.resetBasePositionAndOrientation(
             self.body, self._position.tolist(), attitude, physicsClientId=client
         )

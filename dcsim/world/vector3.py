@@ -59,3 +59,20 @@ def rotated(rotation_vector: Vec, v: Vec) -> Vec:
         v[1] * c + across[1] * s + k[1] * along,
         v[2] * c + across[2] * s + k[2] * along,
     )
+
+
+Quaternion = tuple[float, float, float, float]
+"""A quaternion ``[x, y, z, w]`` in plain floats."""
+
+
+def compose(p: Quaternion, q: Quaternion) -> Quaternion:
+    """The rotation ``q`` then ``p`` (the Hamilton product ``p ⊗ q``), in double precision
+    (PyBullet's ``multiplyTransforms`` rounds to about 1e-7)."""
+    px, py, pz, pw = p
+    qx, qy, qz, qw = q
+    return (
+        pw * qx + px * qw + py * qz - pz * qy,
+        pw * qy - px * qz + py * qw + pz * qx,
+        pw * qz + px * qy - py * qx + pz * qw,
+        pw * qw - px * qx - py * qy - pz * qz,
+    )
