@@ -238,6 +238,16 @@ class Detection(Message):
         The object's catalogue mass, kg.
     shape : Shape or None
         The object's shape when the sensor sees shapes; None otherwise.
+    attitude : ndarray (4,) or None
+        Measured body-to-world rotation ``[x, y, z, w]`` of an object whose rotation the
+        sensor measures (a tumbling body, by a sensor with an attitude noise); None
+        otherwise.
+    attitude_covariance : ndarray (3, 3) or None
+        Covariance of ``attitude``'s error, a small rotation about the world axes, rad²;
+        None without an attitude.
+    inertia : ndarray (3, 3) or None
+        The object's catalogue inertia tensor about its centre of mass, body axes,
+        kg·m², for an object whose rotation the world models; None otherwise.
     """
 
     time: float
@@ -248,6 +258,9 @@ class Detection(Message):
     radius: float = 0.0
     mass: float = 0.0
     shape: Shape | None = None
+    attitude: Vector | None = array_field(shape=(4,), default=None, optional=True)
+    attitude_covariance: Vector | None = array_field(shape=(3, 3), default=None, optional=True)
+    inertia: Vector | None = array_field(shape=(3, 3), default=None, optional=True)
 
 
 @message
@@ -264,12 +277,16 @@ class KnownObject(Message):
         kg.
     shape : Shape
         Its true collision shape.
+    inertia : ndarray (3, 3) or None
+        Its inertia tensor about its centre of mass, body axes, kg·m², for an object
+        whose rotation the world models (a tumbling body); None otherwise.
     """
 
     id: int
     kind: ObjectKind
     mass: float
     shape: Shape
+    inertia: Vector | None = array_field(shape=(3, 3), default=None, optional=True)
 
 
 @message
@@ -328,6 +345,10 @@ class SensedTruth(Message):
     free : ndarray of bool (N,)
         Whether each object is free (not held by the robot, not delivered): a sensor
         sees only free objects.
+    object_attitudes : ndarray (N, 4)
+        Every object's body-to-world rotation ``[x, y, z, w]`` when the world models
+        some object's rotation (a tumbling body), NaN rows for the objects whose
+        rotation it does not model; empty (0, 4) when it models none.
     """
 
     time: float
@@ -338,6 +359,7 @@ class SensedTruth(Message):
     object_positions: Vector = array_field(shape=(-1, 3), default=np.zeros((0, 3)))
     object_velocities: Vector = array_field(shape=(-1, 3), default=np.zeros((0, 3)))
     free: np.ndarray = field(default_factory=lambda: _NONE_FREE)
+    object_attitudes: Vector = array_field(shape=(-1, 4), default=np.zeros((0, 4)))
 
 
 @message

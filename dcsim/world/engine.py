@@ -218,7 +218,6 @@ class World:
         self._mean_motion = scenario.mean_motion if lvlh and orbit.model == "cw" else None
         dynamics = relative_dynamics(orbit) if lvlh and orbit.model != "cw" else None
         self.field = ObjectField(build_objects(scenario, dynamics))
-        self.sensing = Sensing(scenario, self.field, build_sensor_models(scenario, rng, registry))
         self._client = connect_direct()
         # A world dropped without close() (an FMU reset does that) still disconnects.
         self._disconnect = weakref.finalize(self, pb.disconnect, physicsClientId=self._client)
@@ -236,6 +235,12 @@ class World:
         self._joint_torques = np.zeros(0)
         self._bodies = ObjectBodies(self._client, self.field)
         self.capture = _build_capture_rig(scenario, self._client, self._robot)
+        self.sensing = Sensing(
+            scenario,
+            self.field,
+            build_sensor_models(scenario, rng, registry),
+            None if self.capture is None else self.capture.target,
+        )
         self._payload = Payload(self._client, self.robot_id, robot.radius, self.field, self._bodies)
         self._contacts: set[tuple[int, int]] = set()
         self._candidates = np.zeros(0, dtype=int)
@@ -820,7 +825,7 @@ class World:
             return observed
         angles, rates = self._robot.joint_state()  # noise-free encoders
         tracks = observed.tracks
-        if self.capture is not None:
+        if self.capture is not None and self.sensing.ideal_objects:
             tracks = (*tracks, self.capture.target_track(self.time))
         return dataclasses.replace(
             observed, joint_positions=angles, joint_velocities=rates, tracks=tracks

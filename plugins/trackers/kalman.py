@@ -31,6 +31,11 @@ Gate
 Track loss
     A track without an accepted detection for more than ``lose_after`` (s) is dropped; a
     later detection of the object starts it again.
+Rotation
+    An object whose detections carry a measured attitude (a tumbling body seen by a
+    sensor that estimates poses) has its attitude and angular velocity estimated too,
+    by a :class:`~dcsim_plugins.trackers.rotation.RotationFilter` that predicts with the
+    detection's catalogue inertia; its track carries them and that inertia.
 
 Detections are taken as made at the ``time`` of the update that brings them. Every
 track is predicted to that time whether or not it is detected, and all tracks are
@@ -45,6 +50,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from dcsim_plugins.trackers.rotation import RotationFilter, symmetric
 from scipy.linalg import expm
 from scipy.stats import chi2
 
@@ -91,6 +97,20 @@ class KalmanParams(PluginParams):
         unit="s",
         gt=0,
         description="Time without an accepted detection after which a track is dropped.",
+    )
+    angular_acceleration_noise: float = quantity(
+        3e-5,
+        unit="rad/s^1.5",
+        gt=0,
+        description="Square root of the white angular acceleration noise's spectral "
+        "density per axis (rad/s²/√Hz) of a tracked rotation: what the torque-free model "
+        "leaves out.",
+    )
+    initial_rate_sigma: float = quantity(
+        10.0,
+        unit="deg/s",
+        gt=0,
+        description="Angular velocity standard deviation of a new tracked rotation, per axis.",
     )
     shape_margin: float = quantity(
         0.1,
@@ -155,6 +175,7 @@ class KalmanTracker(Tracker):
         self._details: list[_Details] = []
         self._spheres: dict[tuple[ObjectKind, float, float], _Details] = {}
         self._step: tuple[float, np.ndarray, np.ndarray] | None = None
+        self._rotations: dict[int, RotationFilter] = {}
 
     def update(
         self, time: float, detections: Sequence[Detection], robot: StateEstimate
@@ -174,9 +195,11 @@ class KalmanTracker(Tracker):
         self.time = time
         if dt <= 0 or not len(self._ids):
             return
+        for rotation in self._rotations.values():
+            rotation.predict(dt)
         phi, noise = self._transition(dt)
         self._states = _frozen(self._states @ phi.T)
-        self._covariances = _frozen(_symmetric(phi @ self._covariances @ phi.T + noise))
+        self._covariances = _frozen(symmetric(phi @ self._covariances @ phi.T + noise))
         self._robot_parts = phi @ self._robot_parts @ phi.T
 
     def _transition(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
@@ -196,7 +219,7 @@ class KalmanTracker(Tracker):
         blocks[6:, 6:] = a.T
         exponential = expm(blocks * dt)
         phi = exponential[6:, 6:].T
-        noise = _symmetric(phi @ exponential[:6, 6:])
+        noise = symmetric(phi @ exponential[:6, 6:])
         self._step = (dt, phi, noise)
         return phi, noise
 
@@ -217,6 +240,25 @@ class KalmanTracker(Tracker):
         self._start(
             ids[fresh], measured[fresh], noise[fresh], [chosen[i] for i in np.flatnonzero(fresh)]
         )
+        self._turn(chosen)
+
+    def _turn(self, detections: list[Detection]) -> None:
+        """Fold the measured attitudes of ``detections`` into their objects' rotation
+        filters, starting those not yet tracked."""
+        for detection in detections:
+            if detection.attitude is None or detection.attitude_covariance is None:
+                continue
+            rotation = self._rotations.get(detection.id)
+            if rotation is None:
+                self._rotations[detection.id] = RotationFilter(
+                    detection.attitude,
+                    detection.attitude_covariance,
+                    detection.inertia,
+                    math.radians(self.params.initial_rate_sigma),
+                    self.params.angular_acceleration_noise,
+                )
+            else:
+                rotation.correct(detection.attitude, detection.attitude_covariance)
 
     def _correct(
         self,
@@ -244,7 +286,7 @@ class KalmanTracker(Tracker):
         new_states = self._states.copy()
         new_states[slots] = states + np.einsum("nij,nj->ni", gain, innovation)
         new_covariances = self._covariances.copy()
-        new_covariances[slots] = _symmetric(  # Joseph form: stays positive definite
+        new_covariances[slots] = symmetric(  # Joseph form: stays positive definite
             reduction @ covariances @ reduction.transpose(0, 2, 1)
             + gain @ noise @ gain.transpose(0, 2, 1)
         )
@@ -286,6 +328,8 @@ class KalmanTracker(Tracker):
         self._covariances = _frozen(self._covariances[live])
         self._robot_parts = self._robot_parts[live]
         self._details = [d for d, keep in zip(self._details, live.tolist(), strict=True) if keep]
+        kept = set(self._ids.tolist())
+        self._rotations = {i: r for i, r in self._rotations.items() if i in kept}
 
     # ------------------------------------------------------------------ answers
     def _described(self, detection: Detection) -> _Details:
@@ -328,19 +372,15 @@ class KalmanTracker(Tracker):
                 motion=self._motion(state),
                 shape=details.shape,
                 covariance=covariances[i],
-                attitude=None,
-                angular_velocity=None,
-                inertia=None,
+                attitude=None if rotation is None else rotation.attitude,
+                angular_velocity=None if rotation is None else rotation.angular_velocity,
+                inertia=None if rotation is None else rotation.inertia,
             )
             for i, (track_id, details, state) in enumerate(
                 zip(self._ids.tolist(), self._details, states.tolist(), strict=True)
             )
+            for rotation in (self._rotations.get(track_id),)
         )
-
-
-def _symmetric(matrices: np.ndarray) -> np.ndarray:
-    """``matrices`` (..., k, k) made exactly symmetric (their mean with their transposes)."""
-    return 0.5 * (matrices + np.swapaxes(matrices, -1, -2))
 
 
 def _base_covariance(robot: StateEstimate) -> np.ndarray:

@@ -427,6 +427,49 @@ def test_detections_carry_the_catalogue_and_read_only_arrays():
         assert np.all(np.linalg.eigvalsh(d.covariance) > 0)
 
 
+def test_a_tumbling_body_s_measured_attitude_errs_by_the_attitude_noise_about_each_axis():
+    """The rotation from the true to the measured attitude has, about each world axis,
+    a zero-mean error of the attitude noise; the detection reports that covariance and
+    the catalogue inertia. An object whose rotation the world does not model (NaN row)
+    gets no attitude, nor does any object when the sensor has no attitude noise."""
+    inertia = np.diag([900.0, 1100.0, 1400.0])
+    objects = (
+        catalogue(1)[0],
+        KnownObject(
+            id=7, kind=ObjectKind.TARGET, mass=1400.0, shape=Shape(radius=3.3), inertia=inertia
+        ),
+    )
+    positions = np.array([[20.0, 0.0, 0.0], [0.0, 4.0, 0.0]])
+    attitudes = np.array([[np.nan] * 4, TURNED])
+
+    def measured(model: ObjectSensor, t: float) -> tuple:
+        state = truth(
+            t,
+            object_positions=positions,
+            object_velocities=np.zeros_like(positions),
+            free=np.ones(2, dtype=bool),
+            object_attitudes=attitudes,
+        )
+        return model.measure(state)
+
+    model = object_model(objects, detection_probability=1.0, attitude_noise=1.0)
+    errors = []
+    for t in ticks(1000.0):
+        plain, tumbling = measured(model, t)
+        assert plain.attitude is None and plain.inertia is None
+        errors.append(
+            rotation_vector(quaternion_multiply(tumbling.attitude, quaternion_conjugate(TURNED)))
+        )
+    assert np.array_equal(tumbling.attitude_covariance, math.radians(1.0) ** 2 * np.eye(3))
+    assert np.array_equal(tumbling.inertia, inertia)
+    errors_ = np.array(errors)
+    n, sigma = len(errors_), math.radians(1.0)
+    assert np.all(np.abs(errors_.std(axis=0) / sigma - 1) < 4 / math.sqrt(2 * n))
+    assert np.all(np.abs(errors_.mean(axis=0)) < 4 * sigma / math.sqrt(n))
+    blind = object_model(objects, detection_probability=1.0)
+    assert [d.attitude for d in measured(blind, 0.0)] == [None, None]
+
+
 def test_the_object_sensor_reads_at_ten_hertz_by_default():
     model = ObjectSensor({"detection_probability": 1.0}, np.random.default_rng(0))
     model.reset(SensorSetup(control_period=0.05, object_range=100.0, objects=catalogue(1)))

@@ -24,10 +24,18 @@ first-order one at the measured point,
 
 so the cross-range spread is ``σ_b r`` along θ and ``σ_b r sin θ`` along φ (an
 azimuth's error moves a point near the body z axis little).
+
+With an ``attitude_noise`` σ_a the sensor also estimates the pose of each detected
+object whose rotation the world models (a tumbling body; a camera's model-based pose
+estimate): the measured attitude is the true one turned by a small rotation whose
+rotation vector about the world axes has independent normal components of standard
+deviation σ_a, ``q_m = exp(σ_a N / 2) ⊗ q``, reported with the covariance σ_a² I
+(rad²). Such a detection also carries the object's catalogue inertia.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -41,6 +49,8 @@ from dcsim.api import (
     SensorSetup,
     hookimpl,
     quantity,
+    quaternion_from_rotation_vector,
+    quaternion_multiply,
 )
 from dcsim.geometry import row_lengths
 from dcsim.world.sensors.sampling import SampleClock, rate_field
@@ -73,6 +83,14 @@ class ObjectSensorParams(PluginParams):
     sees_shapes: bool = quantity(
         False, description="Whether a detection carries the object's true shape."
     )
+    attitude_noise: float | None = quantity(
+        None,
+        unit="deg",
+        gt=0,
+        description="1σ of the error of a measured attitude about each world axis, for "
+        "the objects whose rotation the world models (a tumbling body); null: the sensor "
+        "measures no attitudes.",
+    )
 
     @field_validator("boresight")
     @classmethod
@@ -101,6 +119,9 @@ class ObjectSensor(SensorModel):
             (o.id, o.kind, o.shape.bounding_radius, o.mass, o.shape if params.sees_shapes else None)
             for o in setup.objects
         ]
+        self._inertias = [o.inertia for o in setup.objects]
+        noise = params.attitude_noise
+        self._attitude_sigma = None if noise is None else math.radians(noise)
         self._boresight = np.array(params.boresight, dtype=float) / math.hypot(*params.boresight)
         half = math.radians(params.field_of_view) / 2.0
         self._cos_half = None if params.field_of_view >= 360.0 else math.cos(half)
@@ -125,7 +146,7 @@ class ObjectSensor(SensorModel):
             return _NONE
         positions, covariances = self._measured(body[seen], world_to_body)
         catalogue, time = self._catalogue, truth.time
-        return tuple(
+        detections = tuple(
             Detection.trusted(
                 time=time,
                 id=id_,
@@ -135,11 +156,42 @@ class ObjectSensor(SensorModel):
                 radius=radius,
                 mass=mass,
                 shape=shape,
+                attitude=None,
+                attitude_covariance=None,
+                inertia=None,
             )
             for (id_, kind, radius, mass, shape), position, covariance in zip(
                 (catalogue[i] for i in seen.tolist()), positions, covariances, strict=True
             )
         )
+        if self._attitude_sigma is None or len(truth.object_attitudes) == 0:
+            return detections
+        return self._with_attitudes(detections, seen, truth.object_attitudes)
+
+    def _with_attitudes(
+        self, detections: tuple[Detection, ...], seen: np.ndarray, attitudes: np.ndarray
+    ) -> tuple[Detection, ...]:
+        """``detections`` of the objects at indices ``seen``, those whose true attitude
+        (``attitudes`` (N, 4), NaN rows for none) is known given a measured attitude, its
+        covariance and the catalogue inertia."""
+        sigma = self._attitude_sigma
+        assert sigma is not None
+        covariance = np.eye(3) * sigma**2
+        covariance.setflags(write=False)
+        answered = list(detections)
+        for slot, index in enumerate(seen.tolist()):
+            if np.isnan(attitudes[index, 0]):
+                continue
+            error = quaternion_from_rotation_vector(sigma * self.rng.standard_normal(3))
+            measured = quaternion_multiply(error, attitudes[index])
+            measured.setflags(write=False)
+            answered[slot] = dataclasses.replace(
+                detections[slot],
+                attitude=measured,
+                attitude_covariance=covariance,
+                inertia=self._inertias[index],
+            )
+        return tuple(answered)
 
     def _detected(self, body: np.ndarray, distances: np.ndarray, free: np.ndarray) -> np.ndarray:
         """Indices of the objects detected now: free, in reach, in view and not missed.

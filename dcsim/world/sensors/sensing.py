@@ -7,6 +7,10 @@ readings into :class:`~dcsim.messages.Observations`: beacon ranges; the attitude
 angular velocity the star tracker and the gyros give (their latest readings, held
 between readings); the object sensor's detections, or, under ideal object sensing, the
 exact tracks of the objects in sensor range (each with its true shape and motion).
+
+A world with a tumbling body (a capture's target) shows it to the object sensor as one
+more object after the field's, with its attitude and catalogue inertia; under ideal
+object sensing the world adds its exact track itself.
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ from dcsim.messages import (
     BeaconRange,
     Detection,
     KnownObject,
+    ObjectKind,
     ObjectTrack,
     Observations,
     RateReading,
@@ -35,6 +40,7 @@ from dcsim.run.seeding import component_rng
 from dcsim.scenario.model import Scenario, point_to_cartesian
 from dcsim.scenario.sensors import sensor_choices, sensor_model_class
 from dcsim.world.objects import ObjectField
+from dcsim.world.tumbling_body import TumblingBody
 
 
 def build_sensor_models(
@@ -89,6 +95,8 @@ class Sensing:
     models : mapping of str to SensorModel
         The sensor models by sensor (:data:`~dcsim.registry.interfaces.SENSOR_SLOTS`);
         a sensor without one reports the truth (beacons: none).
+    tumbling : TumblingBody or None, optional
+        The world's tumbling body, seen by the object sensor after the field's objects.
 
     Attributes
     ----------
@@ -103,7 +111,11 @@ class Sensing:
     """
 
     def __init__(
-        self, scenario: Scenario, field: ObjectField, models: Mapping[str, SensorModel]
+        self,
+        scenario: Scenario,
+        field: ObjectField,
+        models: Mapping[str, SensorModel],
+        tumbling: TumblingBody | None = None,
     ) -> None:
         beacons = scenario.beacons
         self.beacons = (
@@ -112,6 +124,7 @@ class Sensing:
         self.beacons.setflags(write=False)  # shared by every range message, not copied
         self._sensor_range = scenario.robot.sensor_range
         self._field = field
+        self._tumbling = tumbling
         self.models = {slot: models[slot] for slot in SENSOR_SLOTS if slot in models}
         self._roles = {f"sensors.{slot}": model for slot, model in self.models.items()}
         self.ideal_objects = "objects" not in self.models
@@ -129,7 +142,7 @@ class Sensing:
             beacon_max_range=np.inf if beacons.max_range is None else float(beacons.max_range),
             beacon_report_nearest=beacons.report_nearest,
             object_range=float(self._sensor_range),
-            objects=tuple(KnownObject(o.id, o.kind, o.mass, o.shape) for o in field.objects),
+            objects=_known_objects(field, tumbling),
         )
         for role in self._roles:
             call_plugin(self._roles, role, "reset", setup)
@@ -144,12 +157,17 @@ class Sensing:
     ) -> SensedTruth:
         """The truth the sensor models read at ``time`` (s): the robot base's state (world
         frame, SI) and, when an object sensor has a model, every object's state."""
+        attitudes = _NO_ATTITUDES
         if self.ideal_objects:
             positions = velocities = _NO_OBJECTS
             free = _NONE_FREE
         else:
             positions, velocities = self._field.free_states(time)
             free = self._field.free_mask()
+            if self._tumbling is not None:
+                positions, velocities, free, attitudes = _with_tumbling(
+                    self._tumbling, positions, velocities, free
+                )
         return SensedTruth.trusted(
             time=time,
             position=position,
@@ -159,6 +177,7 @@ class Sensing:
             object_positions=positions,
             object_velocities=velocities,
             free=free,
+            object_attitudes=attitudes,
         )
 
     def beacon_ranges(self, truth: SensedTruth) -> tuple[BeaconRange, ...]:
@@ -276,9 +295,41 @@ class Sensing:
         return star, rate
 
 
+def _known_objects(field: ObjectField, tumbling: TumblingBody | None) -> tuple[KnownObject, ...]:
+    """The objects the sensor models are told of: the field's, then the tumbling body."""
+    known = tuple(KnownObject(o.id, o.kind, o.mass, o.shape) for o in field.objects)
+    if tumbling is None:
+        return known
+    spec = tumbling.spec
+    body = KnownObject(spec.id, ObjectKind.TARGET, spec.mass, spec.shape.build(), tumbling.inertia)
+    return (*known, body)
+
+
+def _with_tumbling(
+    tumbling: TumblingBody, positions: np.ndarray, velocities: np.ndarray, free: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The field's object states with the tumbling body's appended: positions and
+    velocities (N + 1, 3), free flags (N + 1,), attitudes (N + 1, 4) with NaN rows for the
+    field's objects, whose rotation the world does not model; all read-only."""
+    state = tumbling.state()
+    attitudes = np.full((len(positions) + 1, 4), np.nan)
+    attitudes[-1] = state.attitude
+    arrays = (
+        np.vstack([positions, state.position]),
+        np.vstack([velocities, state.velocity]),
+        np.append(free, True),
+        attitudes,
+    )
+    for array in arrays:
+        array.setflags(write=False)
+    return arrays
+
+
 _NO_OBJECTS = np.zeros((0, 3))
 _NO_OBJECTS.setflags(write=False)
 _NONE_FREE = np.zeros(0, dtype=bool)
 _NONE_FREE.setflags(write=False)
+_NO_ATTITUDES = np.zeros((0, 4))
+_NO_ATTITUDES.setflags(write=False)
 _NO_JOINTS = np.zeros(0)
 _NO_JOINTS.setflags(write=False)
