@@ -35,7 +35,6 @@ CAPTURE = REPO / "scenarios" / "debris_capture.yaml"
 CAPTURE_TURNED_AT = 104.0
 """Time (s) into the shipped capture whose target attitude a short capture starts from:
 its earliest grasp then meets the bar turned about as the shipped run grasps it."""
-"""Time (s) the shipped capture asks its path planner (its ``path`` event)."""
 
 
 def short_capture(observation: float, duration: float) -> dict[str, object]:
@@ -45,7 +44,9 @@ def short_capture(observation: float, duration: float) -> dict[str, object]:
     mass on its angular momentum axis (fixed while it tumbles free) and
     ``standoff_height`` below it, its mount facing the target (the shipped base starts
     unturned). The target starts turned as it is :data:`CAPTURE_TURNED_AT` less
-    ``observation`` into the shipped run.
+    ``observation`` into the shipped run. The object sensor reports the truth: a watch
+    of well under the shipped 5 s is too short for the tracker to learn the tumble (the
+    shipped run's tracker watches it through the whole approach).
 
     Parameters
     ----------
@@ -80,6 +81,7 @@ def short_capture(observation: float, duration: float) -> dict[str, object]:
         "mission.target.attitude": list(tumble.attitude),
         "mission.observation_time": observation,
         "world.duration": duration,
+        "sensors.objects": None,
     }
 
 

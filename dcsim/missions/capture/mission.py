@@ -238,7 +238,10 @@ class CaptureMission(Mission):
         """Ask the path planner for the end effector's intercept of the fixture."""
         track = self._target_track(observations)
         if track is None:
-            self._abort("the target is not tracked")
+            self._abort(
+                "the target's rotation is not tracked: its track has no attitude (under an "
+                "object sensor model, give it an attitude_noise so that it measures poses)"
+            )
             return
         start = estimate.as_state()
         problem = self._problem(start, track)
