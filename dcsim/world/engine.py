@@ -236,10 +236,13 @@ class World:
         self._bodies = ObjectBodies(self._client, self.field)
         self.capture = _build_capture_rig(scenario, self._client, self._robot)
         self.sensing = Sensing(
-            scenario,
             self.field,
             build_sensor_models(scenario, rng, registry),
-            None if self.capture is None else self.capture.target,
+            beacons=scenario.beacons,
+            sensor_range=robot.sensor_range,
+            control_period=scenario.world.control_period,
+            initial=robot.initial,
+            tumbling=None if self.capture is None else self.capture.target,
         )
         self._payload = Payload(self._client, self.robot_id, robot.radius, self.field, self._bodies)
         self._contacts: set[tuple[int, int]] = set()

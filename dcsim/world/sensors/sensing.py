@@ -37,7 +37,7 @@ from dcsim.registry.calls import call_plugin
 from dcsim.registry.discovery import PluginRegistry
 from dcsim.registry.interfaces import SENSOR_SLOTS, SensorModel
 from dcsim.run.seeding import component_rng
-from dcsim.scenario.model import Scenario, point_to_cartesian
+from dcsim.scenario.model import BeaconsSection, InitialStateSpec, Scenario, point_to_cartesian
 from dcsim.scenario.sensors import sensor_choices, sensor_model_class
 from dcsim.world.objects import ObjectField
 from dcsim.world.tumbling_body import TumblingBody
@@ -88,13 +88,20 @@ class Sensing:
 
     Parameters
     ----------
-    scenario : Scenario
-        The scenario (beacons, object sensor range, initial attitude, control period).
     field : ObjectField
         The world's objects.
     models : mapping of str to SensorModel
         The sensor models by sensor (:data:`~dcsim.registry.interfaces.SENSOR_SLOTS`);
         a sensor without one reports the truth (beacons: none).
+    beacons : BeaconsSection
+        The localisation beacons (``beacons:``).
+    sensor_range : float
+        Reach of the object sensor (``robot.sensor_range``), m.
+    control_period : float
+        Time between two readings of the models, s.
+    initial : InitialStateSpec
+        The robot's initial state (``robot.initial``): the attitude and rate the star
+        tracker and the gyros hold before their first readings.
     tumbling : TumblingBody or None, optional
         The world's tumbling body, seen by the object sensor after the field's objects.
 
@@ -112,31 +119,33 @@ class Sensing:
 
     def __init__(
         self,
-        scenario: Scenario,
         field: ObjectField,
         models: Mapping[str, SensorModel],
+        *,
+        beacons: BeaconsSection,
+        sensor_range: float,
+        control_period: float,
+        initial: InitialStateSpec,
         tumbling: TumblingBody | None = None,
     ) -> None:
-        beacons = scenario.beacons
         self.beacons = (
             np.array([point_to_cartesian(p) for p in beacons.positions]).reshape(-1, 3).copy()
         )  # its own data, not a view of the list's array
         self.beacons.setflags(write=False)  # shared by every range message, not copied
-        self._sensor_range = scenario.robot.sensor_range
+        self._sensor_range = sensor_range
         self._field = field
         self._tumbling = tumbling
         self.models = {slot: models[slot] for slot in SENSOR_SLOTS if slot in models}
         self._roles = {f"sensors.{slot}": model for slot, model in self.models.items()}
         self.ideal_objects = "objects" not in self.models
         self.ideal_attitude = "star_tracker" not in self.models and "gyros" not in self.models
-        initial = scenario.robot.initial
         self._attitude = np.array(initial.attitude, dtype=float)
         self._attitude.setflags(write=False)
         self._body_rate = rotate(
             quaternion_conjugate(self._attitude), np.array(initial.angular_velocity, dtype=float)
         )
         setup = SensorSetup(
-            control_period=scenario.world.control_period,
+            control_period=control_period,
             beacons=self.beacons,
             beacon_noise=float(beacons.noise_sigma),
             beacon_max_range=np.inf if beacons.max_range is None else float(beacons.max_range),
