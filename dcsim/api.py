@@ -22,7 +22,8 @@ Parameters
     path planners' models, which refuses the retired ``clearance``).
 Missions (docs/plugins.md, "Writing a mission")
     :class:`Mission` (the task side of a run), :class:`MissionSettings` (its scenario
-    section), :func:`register_mission` (a mission class made at run time; a
+    section), :class:`MissionWorld` (what a mission may use of the world, for its type
+    hints), :func:`register_mission` (a mission class made at run time; a
     distribution declares its missions in the ``dcsim.missions`` entry point group).
 Messages
     The robot: :class:`RobotState`, :class:`StateEstimate`, :class:`Prior`,
@@ -185,6 +186,7 @@ from dcsim.minimum_jerk import (
     shortest_duration,
 )
 from dcsim.missions import Mission, register_mission
+from dcsim.missions.base import MissionWorld
 from dcsim.motion import (
     ClohessyWiltshireMotion,
     LinearMotion,
@@ -352,6 +354,7 @@ __all__ = [
     "minimum_jerk_move",
     "minimum_jerk_profile",
     "Mission",
+    "MissionWorld",
     "MissionSettings",
     "MotionInput",
     "MotionModel",

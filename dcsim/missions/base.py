@@ -36,6 +36,7 @@ from dcsim.registry.interfaces import Plugin
 from dcsim.scenario.model import MissionSettings, Scenario
 
 if TYPE_CHECKING:
+    from dcsim.world.capture_rig import CaptureRig
     from dcsim.world.objects import ObjectField
 
 Emit = Callable[..., None]
@@ -55,9 +56,13 @@ class MissionWorld(Protocol):
     field : ObjectField
         The targets and obstacles: their kinds, shapes, status (free, carried,
         removed) and counts.
+    capture : CaptureRig or None
+        The gripper and the tumbling body with their contact and latch, in a world whose
+        manipulator has a gripper and whose mission has a tumbling body; None otherwise.
     """
 
     field: ObjectField
+    capture: CaptureRig | None
 
     def robot_spec(self) -> RobotSpec:
         """The robot's mass (cargo included), inertia, limits and model now."""

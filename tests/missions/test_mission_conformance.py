@@ -32,6 +32,7 @@ SCENARIOS = {
     "transfer": shipped("ffsr_obstacles", 10.0),
     "reach": shipped("space_manipulator_reach", 1.0),
     "hold": {"world": {"frame": "geocentric", "duration": 5}, "mission": {"type": "hold"}},
+    "capture": shipped("debris_capture", 1.0),
 }
 
 

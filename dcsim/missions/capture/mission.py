@@ -70,7 +70,6 @@ from dcsim.robots.kinematics import rotation_matrix
 from dcsim.robots.manipulator import ManipulatorModel
 from dcsim.robots.pose_path import PosePath
 from dcsim.scenario.model import ManipulatorSection, Scenario
-from dcsim.world.capture_rig import CaptureRig
 from dcsim.world.tumbling_body import BodyState
 
 TARGET_POSE_COLUMNS = (
@@ -170,8 +169,8 @@ class CaptureMission(Mission):
         self, scenario: Scenario, world: MissionWorld, plugins: Mapping[str, Plugin], emit: Emit
     ) -> None:
         super().__init__(scenario, world, plugins, emit)
-        rig = getattr(world, "capture", None)
-        if not isinstance(rig, CaptureRig):
+        rig = world.capture
+        if rig is None:
             raise TypeError("a capture needs a world with a gripper and a tumbling body")
         self.rig = rig
         robot = scenario.robot
