@@ -224,13 +224,16 @@ def fly(
     return np.array(times), np.array(positions), wall
 
 
-def reference_positions(
-    case: DriftCase, orbit: OrbitSpec, velocity: np.ndarray, times: np.ndarray
-) -> np.ndarray:
-    """The robot's positions (m, LVLH) at ``times`` (s) by the inertial reference under
-    the case's exact physics, from its start and ``velocity`` (m/s)."""
+def drift_duration(orbit: OrbitSpec, orbits: float, control_period: float) -> float:
+    """The flight time (s) of ``orbits`` chief periods rounded to whole control periods
+    of ``control_period`` s, at least one."""
+    return max(round(orbits * orbit_period(orbit) / control_period), 1) * control_period
+
+
+def chief_elements(orbit: OrbitSpec) -> reference.OrbitElements:
+    """The chief's elements at t = 0 in the reference's terms (SI units, rad)."""
     chief = orbit.chief_orbit()
-    elements = reference.OrbitElements(
+    return reference.OrbitElements(
         chief.semi_major_axis,
         chief.eccentricity,
         chief.inclination,
@@ -238,8 +241,15 @@ def reference_positions(
         chief.argument_of_perigee,
         chief.true_anomaly,
     )
+
+
+def reference_positions(
+    case: DriftCase, orbit: OrbitSpec, velocity: np.ndarray, times: np.ndarray
+) -> np.ndarray:
+    """The robot's positions (m, LVLH) at ``times`` (s) by the inertial reference under
+    the case's exact physics, from its start and ``velocity`` (m/s)."""
     trajectory = reference.propagate_relative(
-        elements,
+        chief_elements(orbit),
         case.start[None],
         velocity[None],
         times,
@@ -265,7 +275,7 @@ def drift_error(
         return DriftResult(case, 0.0, None, None, skipped=reason)
     orbit = scenario.world.orbit
     period = scenario.world.control_period
-    duration = max(round(orbits * orbit_period(orbit) / period), 1) * period
+    duration = drift_duration(orbit, orbits, period)
     velocity = drift_free_velocity(orbit, case.start)
     scenario = drift_scenario(case, duration, physics_step, control_period, velocity.tolist())
     times, positions, wall = fly(scenario, max(round(SAMPLE_INTERVAL / period), 1))
@@ -414,8 +424,8 @@ def thrust_cost(
     case = DriftCase("j2", 0.0, 1000.0, "x")
     orbit = drift_scenario(case, 1.0).world.orbit
     velocity = drift_free_velocity(orbit, case.start).tolist()
-    periods = max(round(orbits * orbit_period(orbit) / control_period), 1)
-    duration = periods * control_period
+    duration = drift_duration(orbit, orbits, control_period)
+    periods = round(duration / control_period)
     sample_every = max(round(SAMPLE_INTERVAL / control_period), 1)
     thrusting = min(round(THRUST_DURATION / control_period), periods)
     gaps = []
