@@ -36,7 +36,7 @@ from matplotlib.colors import ListedColormap  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
 from dcsim.report.plots import TRUE_COLOUR, numbered_columns  # noqa: E402
-from dcsim.scenario.model import ActuatorsSpec, RobotSection, Scenario  # noqa: E402
+from dcsim.scenario.model import ActuatorsSpec, Scenario  # noqa: E402
 
 PANEL_HEIGHT = 2.2
 """Height a hardware panel adds to a timeline, with the gap above it, in."""
@@ -212,7 +212,7 @@ def _direction(direction: Sequence[float]) -> str:
 
 
 def _actuators(scenario: Scenario | None) -> ActuatorsSpec | None:
-    """The free flyer's actuators of ``scenario`` (None without a scenario or a free flyer)."""
-    if scenario is None or not isinstance(scenario.robot, RobotSection):
+    """The base's actuators of ``scenario``'s robot (None without a scenario)."""
+    if scenario is None:
         return None
     return scenario.robot.actuators

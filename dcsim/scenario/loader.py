@@ -443,8 +443,6 @@ def _propellant_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
 def _actuator_limit_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
     """With thrusters or reaction wheels, a ``robot.max_force`` or ``robot.max_torque``
     given must be within what they give along every body axis."""
-    if get("robot", "type") != "free-flyer":
-        return []
     actuators = get("robot", "actuators")
     if not isinstance(actuators, ActuatorsSpec):
         return []

@@ -570,7 +570,7 @@ def _thrusters_push_every_way(thrusters: list[ThrusterSpec]) -> list[ThrusterSpe
 
 
 class ActuatorsSpec(Section):
-    """The free flyer's actuators: thrusters, reaction wheels, both or neither (ideal).
+    """A robot base's actuators: thrusters, reaction wheels, both or neither (ideal).
 
     Without ``thrusters`` the commanded force is applied as it is (world frame, clipped
     to ``robot.max_force``); without ``reaction_wheels`` the commanded torque likewise,
@@ -641,7 +641,35 @@ class ActuatorsSpec(Section):
         return float(thruster_capacities(self.thrusters)[0].min())
 
 
-class RobotSection(RobotBaseSection):
+class ActuatedRobotSection(RobotBaseSection):
+    """A robot base with thrusters and reaction wheels (``actuators``), or ideal force
+    and torque: what the free flyer and the manipulator's base share."""
+
+    actuators: ActuatorsSpec = Field(
+        default_factory=ActuatorsSpec,
+        description="Thrusters and reaction wheels on the base; absent, ideal force and "
+        "torque. With them, `max_force` and `max_torque` are theirs when left out (the "
+        "largest given along every body axis); given, they must not exceed them.",
+    )
+
+    @model_validator(mode="wrap")
+    @classmethod
+    def _actuator_limits(cls, data: Any, handler: ModelWrapValidatorHandler[Any]) -> Any:
+        """Fill in ``max_force`` and ``max_torque`` from the actuators when not given."""
+        robot = handler(data)
+        limits = {
+            "max_force": robot.actuators.force_limit(),
+            "max_torque": robot.actuators.torque_limit(),
+        }
+        update = {
+            key: limit
+            for key, limit in limits.items()
+            if limit is not None and key not in robot.model_fields_set
+        }
+        return robot.model_copy(update=update) if update else robot
+
+
+class RobotSection(ActuatedRobotSection):
     """The robot: a free flyer (the debris collector) with mass, limits, sensors, grabber."""
 
     type: Literal["free-flyer"] = Field(
@@ -665,40 +693,16 @@ class RobotSection(RobotBaseSection):
         "would). A full 3x3 tensor is refused: turn the body axes to the principal axes. "
         "null: a uniform sphere's of `radius`, 2/5 m r^2.",
     )
-    actuators: ActuatorsSpec = Field(
-        default_factory=ActuatorsSpec,
-        description="Thrusters and reaction wheels; absent, ideal force and torque. With "
-        "them, `max_force` and `max_torque` are theirs when left out (the largest given "
-        "along every body axis); given, they must not exceed them.",
-    )
     initial: InitialStateSpec = Field(
         default_factory=InitialStateSpec, description="State at t = 0."
     )
-
-    @model_validator(mode="wrap")
-    @classmethod
-    def _actuator_limits(cls, data: Any, handler: ModelWrapValidatorHandler[Any]) -> Any:
-        """Fill in ``max_force`` and ``max_torque`` from the actuators when not given."""
-        robot = handler(data)
-        limits = {
-            "max_force": robot.actuators.force_limit(),
-            "max_torque": robot.actuators.torque_limit(),
-        }
-        update = {
-            key: limit
-            for key, limit in limits.items()
-            if limit is not None and key not in robot.model_fields_set
-        }
-        return robot.model_copy(update=update) if update else robot
 
 
 def robot_hardware(
     robot: RobotSection | ManipulatorSection,
 ) -> tuple[list[ThrusterSpec], list[WheelSpec]]:
-    """The thrusters and the reaction wheels of a scenario's robot, in the scenario's
-    order (none for ideal force and torque, and for a manipulator)."""
-    if not isinstance(robot, RobotSection):
-        return [], []
+    """The thrusters and the reaction wheels of a scenario's robot's base, in the
+    scenario's order (none for ideal force and torque)."""
     return list(robot.actuators.thrusters or ()), list(robot.actuators.reaction_wheels or ())
 
 
@@ -819,7 +823,7 @@ class GripperSpec(Section):
         return self
 
 
-class ManipulatorSection(RobotBaseSection):
+class ManipulatorSection(ActuatedRobotSection):
     """The robot: a space manipulator, a satellite base carrying an arm of revolute joints.
 
     The base flies as a free flyer does (thrust from propellant, torque from reaction

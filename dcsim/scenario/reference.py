@@ -118,7 +118,8 @@ def _sections() -> dict[type[BaseModel], list[str]]:
                 if cls not in paths:
                     paths[cls] = []
                     queue.append((child, cls))
-                paths[cls].append(child)
+                if child not in paths[cls]:  # two robot types' sections share a path
+                    paths[cls].append(child)
     return paths
 
 

@@ -1,4 +1,4 @@
-"""A free flyer's thrusters and reaction wheels over one control period.
+"""A robot base's thrusters and reaction wheels over one control period.
 
 The world asks this module, at each control period's start, what the hardware does
 with the controller's command:
@@ -89,7 +89,7 @@ class ThrustProfile:
 
 
 class Actuators:
-    """A free flyer's thrusters and reaction wheels, either of them absent.
+    """A robot base's thrusters and reaction wheels, either of them absent.
 
     Parameters
     ----------

@@ -12,14 +12,15 @@ composes its pieces:
 - :mod:`~dcsim.world.sensors`: beacon ranges, object tracks, attitude and rate;
 - :mod:`~dcsim.world.payload`: objects held by the robot (a mission attaches them);
 - :mod:`~dcsim.world.objects`: the targets and obstacles and their motion;
-- :mod:`~dcsim.world.actuators`: the free flyer's thrusters and reaction wheels;
+- :mod:`~dcsim.world.actuators`: the base's thrusters and reaction wheels;
 - :mod:`~dcsim.world.capture_rig`: a manipulator's gripper and a tumbling body it may
   grasp (:mod:`~dcsim.world.gripper`, :mod:`~dcsim.world.tumbling_body`), with contact.
 
 - **Robot**: its base is driven by thrust and torque: ideal (thrust clipped to
   ``max_force`` and to the propellant left, torque to ``max_torque``, using none), or
-  what the free flyer's thrusters and reaction wheels deliver
-  (:mod:`~dcsim.world.actuators`); a manipulator's joints by joint torques. The base's
+  what the base's thrusters and reaction wheels deliver
+  (:mod:`~dcsim.world.actuators`; a free flyer's and a manipulator's base alike); a
+  manipulator's joints by joint torques. The base's
   mass is updated once per control period.
 - **Objects**: targets and obstacles, spheres, boxes or cylinders of fixed orientation,
   follow their motion models exactly while free.
@@ -148,8 +149,8 @@ class CollisionEvent:
 def _build_actuators(
     robot: RobotSection | ManipulatorSection, control_period: float, physics_step: float
 ) -> Actuators | None:
-    """The free flyer's thrusters and reaction wheels, or None when both are ideal."""
-    if not isinstance(robot, RobotSection) or robot.actuators.ideal:
+    """The base's thrusters and reaction wheels, or None when both are ideal."""
+    if robot.actuators.ideal:
         return None
     return Actuators(robot.actuators, robot.specific_impulse, control_period, physics_step)
 
@@ -186,10 +187,10 @@ class World:
     robot_id : int
         The robot's PyBullet body id (its base is link -1).
     actuators : Actuators or None
-        The free flyer's thrusters and reaction wheels (``robot.actuators``); None when
+        The base's thrusters and reaction wheels (``robot.actuators``); None when
         force and torque are ideal.
     wheels : ReactionWheels or None
-        The free flyer's reaction wheels; None for ideal (or thrusters') torque.
+        The base's reaction wheels; None for ideal (or thrusters') torque.
     capture : CaptureRig or None
         The manipulator's gripper and the mission's tumbling body; None unless the robot
         has a gripper and the mission a tumbling body.

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import yaml
 
+from dcsim.errors import ScenarioError
 from dcsim.robots.manipulator import ManipulatorModel
 from dcsim.scenario import read_scenario
 from dcsim.world import World, WorldInputs
@@ -17,14 +18,18 @@ FIXTURE = REPO / "tests" / "world" / "data" / "thesis_manipulator.yaml"
 
 
 def scenario(tmp_path, **changes):
-    """The fixture scenario with ``changes`` (``section.key`` → value) applied."""
+    """The fixture scenario with ``changes`` (``section.key`` → value; None takes the
+    key out) applied."""
     data = yaml.safe_load(FIXTURE.read_text())
     for dotted, value in changes.items():
         node = data
         *parents, last = dotted.split(".")
         for key in parents:
             node = node[int(key)] if isinstance(node, list) else node[key]
-        node[last] = value
+        if value is None:
+            node.pop(last)
+        else:
+            node[last] = value
     path = tmp_path / "arm.yaml"
     path.write_text(yaml.safe_dump(data))
     return read_scenario(path)
@@ -158,3 +163,65 @@ def test_momentum_drift_falls_with_the_physics_step_to_first_order(tmp_path):
     order = np.log(coarse / fine) / np.log(4.0)
     print(f"momentum drift: {coarse:.3g} at 2e-3 s, {fine:.3g} at 5e-4 s, order {order:.2f}")
     assert 0.7 < order < 1.5
+
+
+# ---------------------------------------------------------------- reaction wheels
+PYRAMID_WHEELS = [
+    {"axis": axis, "inertia": 0.5, "max_torque": 5.0, "max_momentum": 50.0}
+    for axis in ([1, 1, 1], [-1, 1, 1], [-1, -1, 1], [1, -1, 1])
+]
+"""Four wheels in a pyramid about base +z."""
+
+
+def test_a_manipulator_s_base_takes_the_free_flyer_s_wheels_and_their_limits(tmp_path):
+    """``robot.actuators`` on a manipulator: its torque limit is the wheels' (as a free
+    flyer's with the same wheels), and a larger ``max_torque`` given is refused."""
+    wheels = {"robot.actuators": {"reaction_wheels": PYRAMID_WHEELS}, "robot.max_torque": None}
+    arm = scenario(tmp_path, **wheels)
+    flyer = read_scenario(
+        {"world": {"frame": "geocentric"}, "robot": {"actuators": arm.robot.actuators.model_dump()}}
+    )
+    assert arm.robot.max_torque == flyer.robot.max_torque < 10.0
+    with pytest.raises(ScenarioError, match="robot.max_torque.*exceeds the reaction wheels'"):
+        scenario(
+            tmp_path,
+            **{"robot.actuators": {"reaction_wheels": PYRAMID_WHEELS}, "robot.max_torque": 100.0},
+        )
+
+
+def wheel_run(tmp_path, wheels: bool) -> tuple[float, float, float]:
+    """Fly the arm for 1 s on joint torques with the base's rate damped (by the wheels,
+    or not at all); the largest change of total angular momentum (base and arm from
+    their states, plus the wheels' own, N·m·s), the largest wheel momentum (N·m·s) and
+    the largest base rate (rad/s)."""
+    hardware = {"robot.actuators": {"reaction_wheels": PYRAMID_WHEELS}, "robot.max_torque": None}
+    changes = hardware if wheels else {}
+    w = world(tmp_path, **changes)
+    start = momentum(w)[3:]
+    torques = np.array([2.0, -2.0, 2.0, -2.0, 2.0, -2.0])
+    drift = peak_h = peak_rate = 0.0
+    for _ in range(100):
+        state = w.robot_state()
+        total = momentum(w)[3:]
+        if wheels:
+            rotation = np.reshape(pb.getMatrixFromQuaternion(state.attitude.tolist()), (3, 3))
+            h = rotation @ w.wheels.axes @ w.wheels.momentum
+            total, peak_h = total + h, max(peak_h, float(np.linalg.norm(h)))
+        drift = max(drift, float(np.linalg.norm(total - start)))
+        peak_rate = max(peak_rate, float(np.linalg.norm(state.angular_velocity)))
+        damping = -200.0 * state.angular_velocity if wheels else np.zeros(3)
+        w.step(WorldInputs(joint_torques=torques, torque=damping))
+    return drift, peak_h, peak_rate
+
+
+def test_wheels_on_a_manipulator_s_base_keep_the_total_angular_momentum(tmp_path):
+    """The wheels take up several N·m·s holding the base against the arm, and base, arm
+    and wheels together keep their angular momentum as well as base and arm alone do
+    without wheels (PyBullet's first-order drift, 0.044 N·m·s here, either way): a
+    wheel reaction of the wrong sign or size would add about twice the wheels'
+    momentum."""
+    bare, _, bare_rate = wheel_run(tmp_path, wheels=False)
+    held, peak_h, held_rate = wheel_run(tmp_path, wheels=True)
+    assert peak_h > 3.0
+    assert held_rate < 0.8 * bare_rate
+    assert held <= 1.1 * bare

@@ -14,7 +14,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from dcsim.run.recording import duty_columns
-from dcsim.scenario.model import ManipulatorSection, RobotSection, Scenario
+from dcsim.scenario.model import ManipulatorSection, Scenario
 
 _ATTITUDE_COLUMNS = ("qx", "qy", "qz", "qw")
 
@@ -153,7 +153,7 @@ class Thrusters:
         """The thrusters of ``scenario``'s robot with their ``duty_i`` columns in
         ``telemetry`` at the frames' ``rows``; None without thrusters or duty columns."""
         robot = scenario.robot
-        thrusters = robot.actuators.thrusters if isinstance(robot, RobotSection) else None
+        thrusters = robot.actuators.thrusters
         if thrusters is None:
             return None
         names = duty_columns(len(thrusters))
