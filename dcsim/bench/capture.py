@@ -5,11 +5,12 @@ The cases of a campaign of the ``capture`` mission (by default
 axis and the collector's start dispersed) run on the campaign engine
 (:mod:`dcsim.campaign`), and each case is judged against the capture's targets: a
 success is a case that captured the target and detumbled the stack to the mission's
-``detumbled_rate_deg_s``, with no contact force above the gripper's ``force_limit``
-and the base turned at most ``max_base_excursion_deg`` from its attitude at the
-standoff. Every other case is a failure, with each of its causes: the mission's reason
-for stopping (no path, a grip that did not hold, a run that failed), a detumble not
-reached, a force or a turn above its limit.
+``detumbled_rate_deg_s``, with no contact force above the gripper's ``force_limit``,
+the base turned at most ``max_base_excursion_deg`` from its attitude at the standoff,
+and no link of the arm other than the gripper's, nor the base, striking the target.
+Every other case is a failure, with each of its causes: the mission's reason for
+stopping (no path, a grip that did not hold, a run that failed), a detumble not
+reached, a force or a turn above its limit, the arm striking the target.
 """
 
 from __future__ import annotations
@@ -85,8 +86,8 @@ class Limits:
         """What a success is, in words."""
         return (
             f"captured and detumbled to <= {self.rate_deg_s:g} deg/s, no contact force "
-            f"above the gripper's {self.force_N:g} N and the base turned <= "
-            f"{self.turn_deg:g} deg"
+            f"above the gripper's {self.force_N:g} N, the base turned <= "
+            f"{self.turn_deg:g} deg and no arm link or the base striking the target"
         )
 
 
@@ -219,6 +220,8 @@ def _faults(row: dict[str, Any], figures: dict[str, float], limits: Limits) -> I
         yield f"contact force above the gripper's {limits.force_N:g} N"
     if figures["max_base_turn_deg"] > limits.turn_deg:
         yield f"base turned more than {limits.turn_deg:g} deg"
+    if _true(row.get("arm_links_struck")):
+        yield f"the arm struck the target ({_number(row['arm_links_struck']):.0f} links)"
 
 
 def cause(fault: str) -> str:

@@ -21,7 +21,7 @@ import numpy as np
 
 from dcsim.messages import ObjectKind, ObjectTrack
 from dcsim.scenario.model import GripperSpec, TumblingBodySpec
-from dcsim.world.gripper import Gripper, GripReading
+from dcsim.world.gripper import ARM_GROUP, TUMBLING_GROUP, Gripper, GripReading
 from dcsim.world.manipulator import ManipulatorBody
 from dcsim.world.pybullet_client import pb
 from dcsim.world.tumbling_body import BodyState, TumblingBody
@@ -40,11 +40,15 @@ class ContactRecord:
         Contact impulse given to the body over the period, world frame, N·s.
     last : GripReading or None
         The reading after the period's last physics step (None before any reading).
+    struck : set of int
+        The arm's links other than palm and pads (-1 the base) that pushed on the body
+        at any physics step of the period.
     """
 
     peak_force: float = 0.0
     impulse: np.ndarray = field(default_factory=lambda: np.zeros(3))
     last: GripReading | None = None
+    struck: set[int] = field(default_factory=set)
 
 
 class CaptureRig:
@@ -87,6 +91,12 @@ class CaptureRig:
         self._arm = arm
         self.gripper = Gripper(client, arm.body, gripper)
         self.target = TumblingBody(client, target, physics_step)
+        held = {self.gripper.palm, *self.gripper.pads}
+        for link in range(-1, pb.getNumJoints(arm.body, physicsClientId=client)):
+            if link not in held:
+                pb.setCollisionFilterGroupMask(
+                    arm.body, link, ARM_GROUP, TUMBLING_GROUP, physicsClientId=client
+                )
         self.latched = False
         self._latch: int | None = None
         self.period = ContactRecord()
@@ -106,6 +116,8 @@ class CaptureRig:
         record.peak_force = max(record.peak_force, float(np.linalg.norm(force)))
         record.impulse = record.impulse + self._dt * reading.force
         record.last = reading
+        if reading.struck:
+            record.struck |= reading.struck
 
     def _latch_force(self) -> np.ndarray:
         """The force the latch puts on the body now, world frame, N."""
@@ -144,6 +156,13 @@ class CaptureRig:
         )
         pb.changeConstraint(self._latch, maxForce=1e9, physicsClientId=client)
         self.latched = True
+
+    def link_name(self, link: int) -> str:
+        """The name of the arm's link ``link`` (``base`` for -1)."""
+        if link < 0:
+            return "base"
+        info = pb.getJointInfo(self._robot, link, physicsClientId=self._client)
+        return str(info[12].decode())
 
     def target_state(self) -> BodyState:
         """The tumbling body's true state now."""

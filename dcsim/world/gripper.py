@@ -6,7 +6,9 @@ that slide along y_n towards each other. Each pad's drive is a PyBullet position
 with the gripper's grip force as its force limit and a speed that closes the opening in
 the closing time; what holds a bar is PyBullet's contact with friction between pads and
 bar, nothing else. Palm and pads collide only with a tumbling body (collision group
-:data:`GRIPPER_GROUP`); the arm's links collide with nothing, as for every robot.
+:data:`GRIPPER_GROUP`); in a capture the arm's other links and its base do too
+(:data:`ARM_GROUP`, set by the capture rig), so that an arm swinging into the body
+strikes it, and a reading names them.
 
 The arm's model (:class:`~dcsim.robots.manipulator.ManipulatorModel`, what controllers
 are told) is the DH arm without the gripper; the gripper's few kilograms are a load the
@@ -27,7 +29,9 @@ from dcsim.world.pybullet_client import pb
 GRIPPER_GROUP = 2
 """Collision group of the palm and the pads."""
 TUMBLING_GROUP = 4
-"""Collision group of a tumbling body (it collides with the gripper only)."""
+"""Collision group of a tumbling body (it collides with the arm and its gripper only)."""
+ARM_GROUP = 8
+"""Collision group of a capturing arm's base and links other than palm and pads."""
 
 
 def _box_link(name: str, mass: float, size: tuple[float, float, float]) -> str:
@@ -85,13 +89,16 @@ class GripReading:
         Total contact force (normal and friction) the pads put on the body, world
         frame, N.
     points : int
-        Number of contact points between the gripper (palm and pads) and the body that
-        push (a positive normal force).
+        Number of contact points between the arm (gripper, links, base) and the body
+        that push (a positive normal force).
+    struck : frozenset of int
+        The arm's links other than palm and pads (-1 the base) pushing on the body.
     """
 
     normal: np.ndarray
     force: np.ndarray
     points: int
+    struck: frozenset[int] = frozenset()
 
 
 class Gripper:
@@ -182,11 +189,13 @@ class Gripper:
         return np.array([s[0] for s in states])
 
     def contact(self, other: int) -> GripReading:
-        """The gripper's contact with body ``other`` now (after the last physics step)."""
+        """The arm's contact with body ``other`` now (after the last physics step): the
+        pads' and the palm's, and any other link's that strikes it."""
         points = pb.getContactPoints(self._body, other, physicsClientId=self._client)
         normal = np.zeros(2)
         force = np.zeros(3)
         pushing = 0
+        struck: set[int] = set()
         for point in points:
             if point[9] <= 0.0:  # within the contact margin, not touching
                 continue
@@ -202,4 +211,6 @@ class Gripper:
             )
             if point[3] in self.pads:
                 normal[self.pads.index(point[3])] += point[9]
-        return GripReading(normal=normal, force=force, points=pushing)
+            elif point[3] != self.palm:
+                struck.add(point[3])
+        return GripReading(normal=normal, force=force, points=pushing, struck=frozenset(struck))

@@ -25,7 +25,7 @@ from dcsim.geometry import quaternion_between, quaternion_from_matrix, unit
 from dcsim.robots.kinematics import rotation_matrix
 from dcsim.scenario.model import TumblingBodySpec
 from dcsim.torque_free import TorqueFreeRotation
-from dcsim.world.gripper import GRIPPER_GROUP, TUMBLING_GROUP
+from dcsim.world.gripper import ARM_GROUP, GRIPPER_GROUP, TUMBLING_GROUP
 from dcsim.world.pybullet_client import MAX_SPEED, pb
 from dcsim.world.vector3 import compose
 
@@ -149,7 +149,7 @@ class TumblingBody:
             physicsClientId=client,
         )
         pb.setCollisionFilterGroupMask(
-            body, -1, TUMBLING_GROUP, GRIPPER_GROUP, physicsClientId=client
+            body, -1, TUMBLING_GROUP, GRIPPER_GROUP | ARM_GROUP, physicsClientId=client
         )
         return body
 

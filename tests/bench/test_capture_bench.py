@@ -45,7 +45,7 @@ ROWS = [
         "status": "stopped",
         "reason": "no path: near a singularity (9x, last det(J Jᵀ) 1.68e-09)",
     },
-    {**CAPTURED, "peak_contact_force_N": 1600.0, "max_base_turn_deg": 6.0},
+    {**CAPTURED, "peak_contact_force_N": 1600.0, "max_base_turn_deg": 6.0, "arm_links_struck": 2},
     {
         **CAPTURED,
         "status": "stopped",
@@ -82,6 +82,7 @@ def test_every_limit_is_judged_and_every_failure_says_why(shipped):
     assert judged[2].faults == (
         "contact force above the gripper's 1500 N",
         "base turned more than 5 deg",
+        "the arm struck the target (2 links)",
     )
     assert judged[3].faults == (
         "not detumbled to 0.1 deg/s (target at 0.40 deg/s): the run reached its duration",

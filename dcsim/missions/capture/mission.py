@@ -28,6 +28,10 @@ Modes::
   detumbled when the base's and the target's angular rates both stay below
   ``detumbled_rate_deg_s`` for one second.
 
+Any link of the arm other than the gripper's, or its base, that strikes the target is
+named in an ``arm_contact`` event (once per link); the summary counts them
+(``arm_links_struck``).
+
 Telemetry (world frame, SI, true state): the bar's centre relative to the point between
 the pads and its relative velocity, the pads' normal forces, the peak contact (or
 latch) force and the contact impulse of each control period, the target's and the
@@ -162,6 +166,7 @@ class CaptureMission(Mission):
         "max_base_turn_deg",
         "base_turn_exceeded",
         "final_target_rate_deg_s",
+        "arm_links_struck",
     )
     settings: CaptureMissionSection
 
@@ -192,6 +197,7 @@ class CaptureMission(Mission):
             ("contact", "latch", "detumbled", "observe"), None
         )
         self.planning_time = 0.0
+        self.struck: set[int] = set()
         self.reason = ""
         self.figures = {"peak_force": 0.0, "max_turn": 0.0, "target_rate": 0.0}
 
@@ -353,6 +359,10 @@ class CaptureMission(Mission):
         if self.times["contact"] is None and not self.rig.target.free:
             self.times["contact"] = time
             self.emit("contact")
+        struck = self.rig.period.struck - self.struck
+        if struck:
+            self.struck |= struck
+            self.emit("arm_contact", links=sorted(self.rig.link_name(k) for k in struck))
 
     def _hold(self, state: RobotState) -> Reference:
         """Hold the base's pose and the joints where they are, at rest."""
@@ -473,6 +483,7 @@ class CaptureMission(Mission):
             "base_turn_exceeded": figures["max_turn"]
             > np.radians(self.settings.max_base_excursion_deg),
             "final_target_rate_deg_s": float(np.degrees(figures["target_rate"])),
+            "arm_links_struck": len(self.struck),
         }
 
 
