@@ -372,8 +372,10 @@ class KalmanTracker(Tracker):
                 motion=self._motion(state),
                 shape=details.shape,
                 covariance=covariances[i],
-                attitude=None if rotation is None else rotation.attitude,
-                angular_velocity=None if rotation is None else rotation.angular_velocity,
+                attitude=None if rotation is None else _frozen(rotation.attitude.copy()),
+                angular_velocity=(
+                    None if rotation is None else _frozen(rotation.angular_velocity.copy())
+                ),
                 inertia=None if rotation is None else rotation.inertia,
             )
             for i, (track_id, details, state) in enumerate(

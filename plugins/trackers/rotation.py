@@ -11,10 +11,12 @@ State and error
 Prediction
     The mean follows the torque-free motion of a body of the detection's catalogue
     inertia (:class:`~dcsim.api.TorqueFreeRotation`), or a constant ``ω`` when the
-    inertia is unknown. The error follows ``δθ' = δθ + dt δω``, ``δω' = δω`` plus white
-    angular acceleration noise of spectral density ``s²`` per axis, for what this leaves
-    out (the gyroscopic coupling of the error, the inertia's error):
-    ``Q = s² [[dt³/3, dt²/2], [dt²/2, dt]] ⊗ I``.
+    inertia is unknown. The error follows ``d(δθ)/dt = ω̂ × δθ + δω``, ``d(δω)/dt = 0``
+    (a world-frame error turns with the body), whose transition over ``dt`` is taken to
+    second order in ``ω̂ dt`` (``Φθθ = I + dt W + dt² W² / 2``, ``Φθω = dt I + dt² W / 2``,
+    ``W = [ω̂ ×]``), plus white angular acceleration noise of spectral density ``s²`` per
+    axis for what this leaves out (the rate error's own gyroscopic dynamics, the
+    inertia's error): ``Q = s² [[dt³/3, dt²/2], [dt²/2, dt]] ⊗ I``.
 Update
     The residual is the rotation vector of ``q_m ⊗ q̂⁻¹``, measured as ``δθ`` with the
     detection's covariance; the correction turns ``q̂`` by its first three components
@@ -101,8 +103,7 @@ class RotationFilter:
             self._rotation.advance(dt)
             self.attitude = np.array(self._rotation.attitude)
             self.angular_velocity = np.array(self._rotation.angular_velocity)
-        transition = np.eye(6)
-        transition[:3, 3:] = dt * np.eye(3)
+        transition = _transition(self.angular_velocity, dt)
         s = self._spectral_density
         noise = np.kron(s * np.array([[dt**3 / 3.0, dt**2 / 2.0], [dt**2 / 2.0, dt]]), np.eye(3))
         self.covariance = symmetric(transition @ self.covariance @ transition.T + noise)
@@ -122,6 +123,17 @@ class RotationFilter:
         self.covariance = symmetric(
             reduction @ self.covariance @ reduction.T + gain @ covariance @ gain.T
         )
+
+
+def _transition(rate: np.ndarray, dt: float) -> np.ndarray:
+    """The error state's transition (6, 6) over ``dt`` (s) at the estimated rate ``rate``
+    (world frame, rad/s), to second order in ``|rate| dt``."""
+    x, y, z = rate.tolist()
+    turn = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    transition = np.eye(6)
+    transition[:3, :3] += dt * turn + 0.5 * dt**2 * (turn @ turn)
+    transition[:3, 3:] = dt * np.eye(3) + 0.5 * dt**2 * turn
+    return transition
 
 
 def symmetric(matrices: np.ndarray) -> np.ndarray:

@@ -471,7 +471,8 @@ def test_a_tumbling_body_s_attitude_and_rate_are_tracked_within_their_covariance
         if made[0].time >= 10.0:
             nees.append(error @ np.linalg.solve(rotation.covariance, error))
     assert np.array_equal(track.inertia, TUMBLING_INERTIA)
-    assert np.array_equal(track.attitude, rotation.attitude)
+    assert np.array_equal(track.attitude, rotation.attitude)  # a read-only copy of it
+    assert track.attitude is not rotation.attitude and not track.attitude.flags.writeable
     assert 6.0 * 0.5 < np.mean(nees) < 6.0 * 1.5
     assert np.degrees(np.linalg.norm(error[3:])) < 0.03
 
