@@ -493,12 +493,14 @@ def _attitude_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
 
 
 def _object_rules(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
-    """Ids unique across the mission's targets and the obstacles; their motions and
-    shapes."""
+    """Ids unique across the mission's targets, its tumbling body and the obstacles;
+    their motions and shapes."""
     found: list[tuple[KeyPath, str]] = []
     owners: dict[int, str] = {}
-    targets_key = _mission_section(get.model).targets_key
-    targets = [] if targets_key is None else [("mission", targets_key)]
+    mission = _mission_section(get.model)
+    if mission.body_key is not None and get.given("mission", mission.body_key):
+        found += _checked(_unique_id_rule, get, ("mission", mission.body_key), owners)
+    targets = [] if mission.targets_key is None else [("mission", mission.targets_key)]
     for section in (*targets, ("obstacles",)):
         for index in get.items(*section):
             item = (*section, index)

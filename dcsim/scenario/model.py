@@ -1219,6 +1219,9 @@ class MissionSettings(Section):
     targets_key: ClassVar[str | None] = None
     """The section's key holding the targets the mission puts into the world (a list of
     objects, checked as the obstacles are); None when the mission has none."""
+    body_key: ClassVar[str | None] = None
+    """The section's key holding the one tumbling body the mission puts into the world
+    (its id shares the objects' id space); None when the mission has none."""
     moved_keys: ClassVar[dict[tuple[str, ...], tuple[str, ...]]] = {}
     """Keys the mission's scenarios once had elsewhere, by old key path: a file that
     still has one is refused with an error naming the new place."""

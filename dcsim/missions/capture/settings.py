@@ -16,6 +16,7 @@ class CaptureMissionSection(MissionSettings):
     """A capture: a manipulator grasps a tumbling body's grapple fixture and detumbles it."""
 
     rules: ClassVar[tuple[Rule, ...]] = RULES
+    body_key: ClassVar[str | None] = "target"
     role_defaults: ClassVar[dict[str, PluginChoice | None]] = {
         "localiser": None,
         "path_planner": PluginChoice(plugin="fixture-intercept"),
