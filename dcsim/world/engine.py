@@ -243,7 +243,7 @@ class World:
             sensor_range=robot.sensor_range,
             control_period=scenario.world.control_period,
             initial=robot.initial,
-            tumbling=None if self.capture is None else self.capture.target,
+            capture=self.capture,
         )
         self._payload = Payload(self._client, self.robot_id, robot.radius, self.field, self._bodies)
         self._contacts: set[tuple[int, int]] = set()

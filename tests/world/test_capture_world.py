@@ -25,11 +25,20 @@ FAR = [30.0, 0.0, 0.0]  # m: a target position the arm cannot reach
 OBLIQUE_DEG_S = [3.0, 0.0, 4.0]  # deg/s, body axes: 5 deg/s between a transverse axis and the axis
 
 
-def capture_world(physics_step: float = 5e-4, control_period: float = 0.01, **target: Any) -> World:
-    """A world of the shipped capture with the target's keys replaced by ``target``."""
+def capture_world(
+    physics_step: float = 5e-4,
+    control_period: float = 0.01,
+    sensors: dict[str, Any] | None = None,
+    **target: Any,
+) -> World:
+    """A world of the shipped capture with the target's keys replaced by ``target`` and
+    its ``sensors`` section by ``sensors`` (ideal sensing when None)."""
     data = copy.deepcopy(SHIPPED)
     data["world"].update(physics_step=physics_step, control_period=control_period)
     data["mission"]["target"].update(target)
+    data.pop("sensors", None)
+    if sensors is not None:
+        data["sensors"] = sensors
     scenario = scenario_model(CaptureMissionSection).model_validate(data)
     return World(scenario, np.random.default_rng(0))
 
@@ -357,3 +366,34 @@ def test_a_body_drifting_into_the_base_strikes_it_and_the_reading_names_the_base
         assert struck == {-1}
         assert rig.link_name(-1) == "base"
         assert rig.period.peak_force > 0.0
+
+
+# ---------------------------------------------------------------- the body as sensed
+POSE_SENSOR = {
+    "objects": {
+        "model": "object-sensor",
+        "params": {"attitude_noise": 1.0, "detection_probability": 1.0, "rate": None},
+    }
+}
+"""An object sensor that estimates poses, reading every tick."""
+
+
+def test_a_pose_sensor_sees_the_free_body_and_not_the_latched_one():
+    """Under an object sensor model the world hands over no true track of the body: the
+    sensor detects it, with a measured attitude and the catalogue inertia, while it is
+    free, and no more once the latch holds it."""
+    position, attitude = grasp_pose()
+    with capture_world(
+        sensors=POSE_SENSOR, position=position.tolist(), attitude=attitude.tolist()
+    ) as w:
+        seen = w.observations()
+        assert seen.tracks == ()
+        (detection,) = seen.detections
+        assert detection.id == w.capture.target.spec.id
+        assert np.array_equal(detection.inertia, w.capture.target.inertia)
+        turn = Rotation.from_quat(detection.attitude) * Rotation.from_quat(attitude).inv()
+        assert 0.0 < turn.magnitude() < np.radians(5.0)
+        close_until_held(w, settle=0.2)
+        w.capture.latch()
+        w.step(WorldInputs())
+        assert w.observations().detections == ()

@@ -39,8 +39,8 @@ from dcsim.registry.interfaces import SENSOR_SLOTS, SensorModel
 from dcsim.run.seeding import component_rng
 from dcsim.scenario.model import BeaconsSection, InitialStateSpec, Scenario, point_to_cartesian
 from dcsim.scenario.sensors import sensor_choices, sensor_model_class
+from dcsim.world.capture_rig import CaptureRig
 from dcsim.world.objects import ObjectField
-from dcsim.world.tumbling_body import TumblingBody
 
 
 def build_sensor_models(
@@ -102,8 +102,9 @@ class Sensing:
     initial : InitialStateSpec
         The robot's initial state (``robot.initial``): the attitude and rate the star
         tracker and the gyros hold before their first readings.
-    tumbling : TumblingBody or None, optional
-        The world's tumbling body, seen by the object sensor after the field's objects.
+    capture : CaptureRig or None, optional
+        The world's capture rig: its tumbling body is seen by the object sensor after
+        the field's objects, free until the latch holds it.
 
     Attributes
     ----------
@@ -126,7 +127,7 @@ class Sensing:
         sensor_range: float,
         control_period: float,
         initial: InitialStateSpec,
-        tumbling: TumblingBody | None = None,
+        capture: CaptureRig | None = None,
     ) -> None:
         self.beacons = (
             np.array([point_to_cartesian(p) for p in beacons.positions]).reshape(-1, 3).copy()
@@ -134,7 +135,7 @@ class Sensing:
         self.beacons.setflags(write=False)  # shared by every range message, not copied
         self._sensor_range = sensor_range
         self._field = field
-        self._tumbling = tumbling
+        self._capture = capture
         self.models = {slot: models[slot] for slot in SENSOR_SLOTS if slot in models}
         self._roles = {f"sensors.{slot}": model for slot, model in self.models.items()}
         self.ideal_objects = "objects" not in self.models
@@ -151,7 +152,7 @@ class Sensing:
             beacon_max_range=np.inf if beacons.max_range is None else float(beacons.max_range),
             beacon_report_nearest=beacons.report_nearest,
             object_range=float(self._sensor_range),
-            objects=_known_objects(field, tumbling),
+            objects=_known_objects(field, capture),
         )
         for role in self._roles:
             call_plugin(self._roles, role, "reset", setup)
@@ -173,9 +174,9 @@ class Sensing:
         else:
             positions, velocities = self._field.free_states(time)
             free = self._field.free_mask()
-            if self._tumbling is not None:
+            if self._capture is not None:
                 positions, velocities, free, attitudes = _with_tumbling(
-                    self._tumbling, positions, velocities, free
+                    self._capture, positions, velocities, free
                 )
         return SensedTruth.trusted(
             time=time,
@@ -304,29 +305,32 @@ class Sensing:
         return star, rate
 
 
-def _known_objects(field: ObjectField, tumbling: TumblingBody | None) -> tuple[KnownObject, ...]:
-    """The objects the sensor models are told of: the field's, then the tumbling body."""
+def _known_objects(field: ObjectField, capture: CaptureRig | None) -> tuple[KnownObject, ...]:
+    """The objects the sensor models are told of: the field's, then the capture's
+    tumbling body."""
     known = tuple(KnownObject(o.id, o.kind, o.mass, o.shape) for o in field.objects)
-    if tumbling is None:
+    if capture is None:
         return known
+    tumbling = capture.target
     spec = tumbling.spec
     body = KnownObject(spec.id, ObjectKind.TARGET, spec.mass, spec.shape.build(), tumbling.inertia)
     return (*known, body)
 
 
 def _with_tumbling(
-    tumbling: TumblingBody, positions: np.ndarray, velocities: np.ndarray, free: np.ndarray
+    capture: CaptureRig, positions: np.ndarray, velocities: np.ndarray, free: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The field's object states with the tumbling body's appended: positions and
-    velocities (N + 1, 3), free flags (N + 1,), attitudes (N + 1, 4) with NaN rows for the
-    field's objects, whose rotation the world does not model; all read-only."""
-    state = tumbling.state()
+    velocities (N + 1, 3), free flags (N + 1,: the body is free until latched), attitudes
+    (N + 1, 4) with NaN rows for the field's objects, whose rotation the world does not
+    model; all read-only."""
+    state = capture.target.state()
     attitudes = np.full((len(positions) + 1, 4), np.nan)
     attitudes[-1] = state.attitude
     arrays = (
         np.vstack([positions, state.position]),
         np.vstack([velocities, state.velocity]),
-        np.append(free, True),
+        np.append(free, not capture.latched),
         attitudes,
     )
     for array in arrays:
