@@ -201,6 +201,7 @@ _FIELDS = (
     *(name for name, _, _ in FIGURES),
     "contact_time_s",
     "final_target_rate_deg_s",
+    "arm_links_struck",
 )
 
 
@@ -361,9 +362,19 @@ def limits_of(campaign: Campaign) -> Limits:
     Raises
     ------
     DcsimError
-        If the campaign's scenario is not a capture.
+        If the campaign's scenario is not a capture, or its metrics leave out a summary
+        field the judgement reads.
     """
-    return Limits.of(validate(campaign.base))
+    limits = Limits.of(validate(campaign.base))
+    missing = [
+        name for name in ("captured", "detumbled", *_FIELDS) if name not in campaign.spec.metrics
+    ]
+    if missing:
+        raise DcsimError(
+            f"dcsim bench capture judges each case by {', '.join(missing)}: add them to the "
+            "campaign's `metrics`"
+        )
+    return limits
 
 
 def _values(judged: Sequence[CaptureCase], name: str, over: str) -> list[float]:

@@ -6,6 +6,7 @@ import math
 
 import pandas
 import pytest
+import yaml
 from click.testing import CliRunner
 
 from dcsim.bench.capture import cause, judge, limits_of, markdown
@@ -134,3 +135,17 @@ def test_what_cannot_be_benched_is_refused_before_anything_runs(arguments, messa
     result = CliRunner().invoke(cli, ["bench", "capture", *arguments])
     assert result.exit_code == 2
     assert message in result.output
+
+
+def test_a_campaign_whose_metrics_leave_out_a_judged_field_is_refused(tmp_path):
+    """Without ``arm_links_struck`` among the metrics, a strike could not fail a case."""
+    data = yaml.safe_load(CAMPAIGN.read_text())
+    data["scenario"] = str(CAMPAIGN.parent / data["scenario"])
+    data["metrics"].remove("arm_links_struck")
+    campaign = tmp_path / "campaign.yaml"
+    campaign.write_text(yaml.safe_dump(data))
+    result = CliRunner().invoke(cli, ["bench", "capture", str(campaign)])
+    assert result.exit_code == 2
+    assert "judges each case by arm_links_struck: add them to the campaign's `metrics`" in (
+        result.output
+    )

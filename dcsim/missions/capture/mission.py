@@ -241,12 +241,9 @@ class CaptureMission(Mission):
 
     def _plan(self, time: float, estimate: StateEstimate, observations: Observations) -> None:
         """Ask the path planner for the end effector's intercept of the fixture."""
-        track = self._target_track(observations)
+        track, missing = self._target_track(observations)
         if track is None:
-            self._abort(
-                "the target's rotation is not tracked: its track has no attitude (under an "
-                "object sensor model, give it an attitude_noise so that it measures poses)"
-            )
+            self._abort(missing)
             return
         start = estimate.as_state()
         problem = self._problem(start, track)
@@ -391,12 +388,22 @@ class CaptureMission(Mission):
         assert isinstance(model, ManipulatorModel)
         return model
 
-    def _target_track(self, observations: Observations) -> ObjectTrack | None:
+    def _target_track(self, observations: Observations) -> tuple[ObjectTrack | None, str]:
+        """The target's track if it tracks the rotation too, else None and why not."""
         target_id = self.settings.target.id
         for track in observations.tracks:
-            if track.id == target_id and track.attitude is not None:
-                return track
-        return None
+            if track.id != target_id:
+                continue
+            if track.attitude is None or track.angular_velocity is None:
+                return None, (
+                    "the target's rotation is not tracked: its track has no attitude "
+                    "(under an object sensor model, give it an attitude_noise so that it "
+                    "measures poses)"
+                )
+            if track.inertia is None:
+                return None, "the target's track has no inertia to predict its tumble with"
+            return track, ""
+        return None, "the target is not tracked (out of the object sensor's reach or view)"
 
     # ------------------------------------------------------------------ records
     def telemetry(self, outputs: Mapping[str, Any]) -> dict[str, Any]:
@@ -483,7 +490,7 @@ class CaptureMission(Mission):
             "base_turn_exceeded": figures["max_turn"]
             > np.radians(self.settings.max_base_excursion_deg),
             "final_target_rate_deg_s": float(np.degrees(figures["target_rate"])),
-            "arm_links_struck": len(self.struck),
+            "arm_links_struck": len(self.struck | self.rig.period.struck),
         }
 
 
