@@ -48,7 +48,7 @@ def fmu_export_command(
     The closed-loop FMU runs the whole scenario (world, localiser, planners, controller,
     mission) with disturbance force and torque as inputs; --plant-only exports the world
     alone. A manipulator's FMUs also output its joint angles and rates and its end
-    effector, and its plant FMU takes the joint torques. A free flyer's thrusters and
+    effector, and its plant FMU takes the joint torques. The base's thrusters and
     reaction wheels add their duty cycles and momenta (and the attitude error to the
     closed loop), and the plant takes their on-times and torques one by one. The
     resolved scenario travels inside the FMU; importing it needs Python with dcsim

@@ -395,8 +395,8 @@ class ClosedLoopSlave(_ScenarioSlave):
 
 
 class PlantSlave(_ScenarioSlave):
-    """The world alone as an FMU: force and torque (and a manipulator's joint torques, a
-    free flyer's thruster on-times and wheel torques) in, true state and sensors out.
+    """The world alone as an FMU: force and torque (and a manipulator's joint torques, the
+    base's thruster on-times and wheel torques) in, true state and sensors out.
 
     The on-times replace the allocation of force (and of torque without wheels) while
     ``thrusters_direct`` is true, the wheel torques that of torque while

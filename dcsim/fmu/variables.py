@@ -12,7 +12,7 @@ end effector's position; its plant FMU takes the joint torques (``joint_torque[i
 Only a robot that carries targets (a free flyer) has the ``captured`` and ``delivered``
 counts.
 
-A free flyer with ``robot.actuators`` hardware has, in both FMUs, each reaction wheel's
+A robot whose base has ``robot.actuators`` hardware has, in both FMUs, each reaction wheel's
 momentum (``wheel_momentum[i]``) and each thruster's duty cycle (``thruster_duty[i]``),
 and with thrusters the propellant burnt for attitude; its closed-loop FMU also outputs
 the attitude error, its plant FMU takes per-thruster on-times and per-wheel torques,

@@ -2,7 +2,8 @@
 
 A world whose manipulator has a gripper and whose mission puts a tumbling body into it
 has a :class:`CaptureRig`. After every physics step the rig reads the contact between
-gripper and body (PyBullet's contact points: normal and friction forces), hands the body
+arm and body (PyBullet's contact points: normal and friction forces; the pads', the
+palm's, and any other link's or the base's that strikes the body), hands the body
 from its torque-free motion to PyBullet at the first touch
 (:class:`~dcsim.world.tumbling_body.TumblingBody`), and keeps each control period's
 peak contact force and contact impulse. A mission commands the pads and, once it judges
@@ -29,7 +30,8 @@ from dcsim.world.tumbling_body import BodyState, TumblingBody
 
 @dataclass
 class ContactRecord:
-    """The gripper's contact with the body over one control period.
+    """The arm's contact with the body over one control period (the gripper's, and any
+    other link's that strikes it).
 
     Attributes
     ----------

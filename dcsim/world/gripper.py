@@ -79,15 +79,16 @@ def gripper_urdf(spec: GripperSpec) -> str:
 
 @dataclass(frozen=True)
 class GripReading:
-    """What the pads feel of a body at one physics step.
+    """The arm's contact with a body at one physics step: the pads', the palm's and any
+    other link's that strikes it.
 
     Attributes
     ----------
     normal : ndarray (2,)
         Total normal contact force on the left and the right pad, N.
     force : ndarray (3,)
-        Total contact force (normal and friction) the pads put on the body, world
-        frame, N.
+        Total contact force (normal and friction) the arm puts on the body, world frame,
+        N (the pads' while nothing else touches it).
     points : int
         Number of contact points between the arm (gripper, links, base) and the body
         that push (a positive normal force).

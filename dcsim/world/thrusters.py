@@ -1,4 +1,4 @@
-"""Thrusters: a free flyer's force (and, without wheels, torque) actuators when
+"""Thrusters: a robot base's force (and, without wheels, torque) actuators when
 ``robot.actuators.thrusters`` is given.
 
 Each thruster ``i`` sits at ``p_i`` (body frame, from the base's centre of mass) and

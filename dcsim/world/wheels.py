@@ -1,4 +1,4 @@
-"""Reaction wheels: a free flyer's attitude actuators when ``robot.actuators`` lists
+"""Reaction wheels: a robot base's attitude actuators when ``robot.actuators`` lists
 ``reaction_wheels``.
 
 The wheels' spin is bookkept here; PyBullet sees only the base. Each control period

@@ -10,8 +10,8 @@ target-facing side and the target (60° is the thesis's sight limit), the base's
 displacement against half the end effector's (the thesis's criterion), the commanded
 base torque and joint torques, and the change of total linear and angular momentum; then
 the base's attitude error, when its reference holds an attitude (the panels every
-timeline ends with, :mod:`dcsim.report.hardware`; a manipulator has no thrusters or
-wheels).
+timeline ends with, :mod:`dcsim.report.hardware`, and the wheel momenta and thruster
+duty cycles of a base with that hardware).
 
 ``joints.png``: every joint angle and its reference (±90° are the thesis's mechanical
 limits) and the largest joint tracking error.

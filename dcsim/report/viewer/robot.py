@@ -127,7 +127,7 @@ def arm_polylines(
 
 @dataclass(frozen=True)
 class Thrusters:
-    """A free flyer's thrusters and how much each fired at the viewer's frames.
+    """The base's thrusters and how much each fired at the viewer's frames.
 
     Attributes
     ----------

@@ -11,7 +11,7 @@ strings, ready for JSON) that the page's script plays without knowing dcsim:
   the drop point's tolerance sphere; a group's members may be labelled, ``lift`` (m)
   above their centres;
 - ``polylines``: lines redrawn at every frame (the base's body axes, the arm's links);
-- ``thrusters``: a free flyer's thrusters (body-frame ``positions`` and unit force
+- ``thrusters``: the base's thrusters (body-frame ``positions`` and unit force
   ``directions``), each one's mean ``duty`` cycle over the rows a frame stands for
   (:class:`~dcsim.report.viewer.robot.Thrusters`) and the plume's ``length`` (m: at
   duty 0 and added at duty 1); the page draws a plume from each firing thruster
