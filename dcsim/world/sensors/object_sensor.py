@@ -35,8 +35,9 @@ deviation σ_a, ``q_m = exp(σ_a N / 2) ⊗ q``, reported with the covariance σ
 
 from __future__ import annotations
 
-import dataclasses
+import itertools
 import math
+from collections.abc import Iterable
 
 import numpy as np
 from pydantic import field_validator
@@ -56,6 +57,10 @@ from dcsim.geometry import row_lengths
 from dcsim.world.sensors.sampling import SampleClock, rate_field
 
 _NONE: tuple[Detection, ...] = ()
+_Pose = tuple[np.ndarray | None, np.ndarray | None, np.ndarray | None]
+"""A detection's measured attitude, its covariance and the catalogue inertia."""
+_NO_POSE: _Pose = (None, None, None)
+"""What a detection carries of an object whose attitude the sensor does not measure."""
 
 
 class ObjectSensorParams(PluginParams):
@@ -122,6 +127,8 @@ class ObjectSensor(SensorModel):
         self._inertias = [o.inertia for o in setup.objects]
         noise = params.attitude_noise
         self._attitude_sigma = None if noise is None else math.radians(noise)
+        self._attitude_covariance = np.eye(3) * (self._attitude_sigma or 0.0) ** 2
+        self._attitude_covariance.setflags(write=False)
         self._boresight = np.array(params.boresight, dtype=float) / math.hypot(*params.boresight)
         half = math.radians(params.field_of_view) / 2.0
         self._cos_half = None if params.field_of_view >= 360.0 else math.cos(half)
@@ -145,8 +152,9 @@ class ObjectSensor(SensorModel):
         if len(seen) == 0:
             return _NONE
         positions, covariances = self._measured(body[seen], world_to_body)
+        poses = self._poses(seen, truth.object_attitudes)
         catalogue, time = self._catalogue, truth.time
-        detections = tuple(
+        return tuple(
             Detection.trusted(
                 time=time,
                 id=id_,
@@ -156,42 +164,37 @@ class ObjectSensor(SensorModel):
                 radius=radius,
                 mass=mass,
                 shape=shape,
-                attitude=None,
-                attitude_covariance=None,
-                inertia=None,
+                attitude=attitude,
+                attitude_covariance=attitude_covariance,
+                inertia=inertia,
             )
-            for (id_, kind, radius, mass, shape), position, covariance in zip(
-                (catalogue[i] for i in seen.tolist()), positions, covariances, strict=True
+            for (id_, kind, radius, mass, shape), position, covariance, (
+                attitude,
+                attitude_covariance,
+                inertia,
+            ) in zip(
+                (catalogue[i] for i in seen.tolist()), positions, covariances, poses, strict=True
             )
         )
-        if self._attitude_sigma is None or len(truth.object_attitudes) == 0:
-            return detections
-        return self._with_attitudes(detections, seen, truth.object_attitudes)
 
-    def _with_attitudes(
-        self, detections: tuple[Detection, ...], seen: np.ndarray, attitudes: np.ndarray
-    ) -> tuple[Detection, ...]:
-        """``detections`` of the objects at indices ``seen``, those whose true attitude
-        (``attitudes`` (N, 4), NaN rows for none) is known given a measured attitude, its
-        covariance and the catalogue inertia."""
+    def _poses(self, seen: np.ndarray, attitudes: np.ndarray) -> Iterable[_Pose]:
+        """For each object at the indices ``seen``: its measured attitude, that
+        attitude's covariance and its catalogue inertia, or three Nones when the sensor
+        measures no attitudes or the world does not model the object's rotation (a NaN
+        row of the true ``attitudes`` (N, 4), or none at all)."""
         sigma = self._attitude_sigma
-        assert sigma is not None
-        covariance = np.eye(3) * sigma**2
-        covariance.setflags(write=False)
-        answered = list(detections)
-        for slot, index in enumerate(seen.tolist()):
+        if sigma is None or len(attitudes) == 0:
+            return itertools.repeat(_NO_POSE, len(seen))
+        poses: list[_Pose] = []
+        for index in seen.tolist():
             if np.isnan(attitudes[index, 0]):
+                poses.append(_NO_POSE)
                 continue
             error = quaternion_from_rotation_vector(sigma * self.rng.standard_normal(3))
             measured = quaternion_multiply(error, attitudes[index])
             measured.setflags(write=False)
-            answered[slot] = dataclasses.replace(
-                detections[slot],
-                attitude=measured,
-                attitude_covariance=covariance,
-                inertia=self._inertias[index],
-            )
-        return tuple(answered)
+            poses.append((measured, self._attitude_covariance, self._inertias[index]))
+        return poses
 
     def _detected(self, body: np.ndarray, distances: np.ndarray, free: np.ndarray) -> np.ndarray:
         """Indices of the objects detected now: free, in reach, in view and not missed.
