@@ -87,6 +87,7 @@ class RotationFilter:
         self.covariance[3:, 3:] = rate_sigma**2 * np.eye(3)
         self.inertia = inertia
         self._spectral_density = acceleration_noise**2
+        self._noise: tuple[float, np.ndarray] | None = None
         self._rotation = (
             None if inertia is None else TorqueFreeRotation(inertia, self.attitude, np.zeros(3))
         )
@@ -104,9 +105,17 @@ class RotationFilter:
             self.attitude = np.array(self._rotation.attitude)
             self.angular_velocity = np.array(self._rotation.angular_velocity)
         transition = _transition(self.angular_velocity, dt)
-        s = self._spectral_density
-        noise = np.kron(s * np.array([[dt**3 / 3.0, dt**2 / 2.0], [dt**2 / 2.0, dt]]), np.eye(3))
+        noise = self._process_noise(dt)
         self.covariance = symmetric(transition @ self.covariance @ transition.T + noise)
+
+    def _process_noise(self, dt: float) -> np.ndarray:
+        """The process noise (6, 6) over ``dt`` (s); the last one is kept and serves the
+        same ``dt`` again (every control period)."""
+        if self._noise is None or self._noise[0] != dt:
+            s = self._spectral_density
+            blocks = s * np.array([[dt**3 / 3.0, dt**2 / 2.0], [dt**2 / 2.0, dt]])
+            self._noise = (dt, np.kron(blocks, np.eye(3)))
+        return self._noise[1]
 
     def correct(self, attitude: np.ndarray, covariance: np.ndarray) -> None:
         """Fold in a measured ``attitude`` ``[x, y, z, w]`` of error covariance
