@@ -1239,8 +1239,8 @@ class MissionSettings(Section):
 
     def tumbling_body(self) -> TumblingBodySpec | None:
         """The free rigid body with contact the mission puts into the world (a capture
-        target); None for a mission without one."""
-        return None
+        target): its field named by :attr:`body_key` (None without one)."""
+        return None if self.body_key is None else getattr(self, self.body_key)
 
 
 class StopSection(Section):

@@ -198,6 +198,7 @@ class CaptureMission(Mission):
         )
         self.planning_time = 0.0
         self.struck: set[int] = set()
+        self.joint_columns = _joint_columns(scenario)
         self.reason = ""
         self.figures = {"peak_force": 0.0, "max_turn": 0.0, "target_rate": 0.0}
 
@@ -437,7 +438,7 @@ class CaptureMission(Mission):
         pose = (*target.position.tolist(), *target.attitude.tolist())
         row.update(zip(TARGET_POSE_COLUMNS, pose, strict=True))
         angles = base.joint_positions.tolist()
-        row.update(zip(_joint_columns(self.scenario), angles, strict=True))
+        row.update(zip(self.joint_columns, angles, strict=True))
         return row
 
     def plot(

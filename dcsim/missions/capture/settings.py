@@ -96,7 +96,3 @@ class CaptureMissionSection(MissionSettings):
     planning_budget: float = quantity(
         5.0, unit="s", gt=0, description="Wall time given to the path planner."
     )
-
-    def tumbling_body(self) -> TumblingBodySpec:
-        """The target: the world gives it a body of its own, with contact."""
-        return self.target
