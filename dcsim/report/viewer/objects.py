@@ -5,7 +5,7 @@ grabbed target is held as it was at the grab, fixed to the robot's base (the wor
 grab service attaches it so): it moves and turns with the base until it is delivered,
 when it leaves the world. Grabs and deliveries come from the run's event log. A
 capture's tumbling body is where its telemetry columns put it (``target_x`` … and
-``target_qx`` …), shown carried from its ``latched`` event on.
+``target_qx`` …), latched or not.
 """
 
 from __future__ import annotations
@@ -43,8 +43,9 @@ class ObjectTrack:
     positions : ndarray (F, 3)
         Centre at each frame, m, world frame.
     turns : ndarray (F, 4) or None
-        Rotation of the object since its grab at each frame (``[x, y, z, w]``; identity
-        while free); None for an object never grabbed.
+        Rotation of the object at each frame (``[x, y, z, w]``): since its grab for a
+        grabbed target (identity while free), its attitude for a tumbling body; None for
+        an object never grabbed.
     status : ndarray (F,) of int
         :class:`Status` at each frame.
     """
@@ -99,7 +100,6 @@ def object_tracks(
     robot: RobotPath,
     handling: Handling,
     telemetry: Mapping[str, np.ndarray],
-    events: Sequence[Mapping[str, Any]] = (),
 ) -> list[ObjectTrack]:
     """Every target and obstacle at ``times``, targets first (a capture's tumbling body
     first of all).
@@ -116,10 +116,8 @@ def object_tracks(
         Grab and delivery times.
     telemetry : mapping of str to ndarray
         The run's telemetry (a tumbling body's pose).
-    events : sequence of mapping
-        The run's events (a tumbling body's latch).
     """
-    tumbling = _tumbling_track(scenario, times, robot, telemetry, events)
+    tumbling = _tumbling_track(scenario, times, robot, telemetry)
     objects = build_objects(scenario)
     if not objects:
         return tumbling
@@ -136,21 +134,20 @@ def _tumbling_track(
     times: np.ndarray,
     robot: RobotPath,
     telemetry: Mapping[str, np.ndarray],
-    events: Sequence[Mapping[str, Any]],
 ) -> list[ObjectTrack]:
-    """A capture's tumbling body at ``times`` from its pose columns (none without)."""
+    """A capture's tumbling body at ``times`` from its pose columns (none without): its
+    attitude as its ``turns``, never delivered."""
     spec = scenario.mission.tumbling_body()
     if spec is None or "target_x" not in telemetry:
         return []
     rows = robot.row_at(times)
     position = np.column_stack([telemetry[f"target_{a}"] for a in "xyz"])[rows]
     attitude = np.column_stack([telemetry[f"target_q{a}"] for a in "xyzw"])[rows]
-    latched = min((float(e["t"]) for e in events if e["event"] == "latched"), default=np.inf)
-    status = np.where(times >= latched, Status.CARRIED, Status.FREE).astype(int)
+    status = np.full(len(times), Status.FREE, dtype=int)
     body = SpaceObject(
         spec.id, ObjectKind.TARGET, spec.shape.build(), spec.mass, StaticMotion(spec.position)
     )
-    return [ObjectTrack(body, position.astype(float), attitude.astype(float), status)]
+    return [ObjectTrack(body, position, attitude, status)]
 
 
 def _track(
