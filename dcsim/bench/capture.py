@@ -103,8 +103,6 @@ class CaptureCase:
         The target's initial angular velocity, body axes, deg/s.
     start_offset_m : tuple of float
         The collector's start from the base scenario's, world frame, m.
-    status, reason : str
-        The run's end (``completed``, ``stopped``, ``failed``, ``not run``) and why.
     figures : dict of str to float
         The summary's ``peak_contact_force_N``, ``max_base_turn_deg``,
         ``detumble_time_s``, ``latch_time_s``, ``contact_time_s`` and
@@ -116,8 +114,6 @@ class CaptureCase:
     index: int
     spin_deg_s: tuple[float, float, float]
     start_offset_m: tuple[float, float, float]
-    status: str
-    reason: str
     figures: dict[str, float]
     faults: tuple[str, ...]
 
@@ -150,30 +146,28 @@ TOUCHED = FIGURES[0][2]
 """The cases the force and the turn are taken over."""
 
 
-def judge(campaign: Campaign, cases: Sequence[Case], table: pandas.DataFrame) -> list[CaptureCase]:
+def judge(
+    campaign: Campaign, cases: Sequence[Case], table: pandas.DataFrame, limits: Limits
+) -> list[CaptureCase]:
     """Judge every case of a capture campaign's results table against its limits.
 
     Parameters
     ----------
     campaign : Campaign
-        The campaign (its base scenario gives the limits and the nominal start).
+        The campaign (its base scenario gives the nominal start).
     cases : sequence of Case
         The cases run, in index order.
     table : pandas.DataFrame
         The campaign's results (one row per case, with the capture's summary fields).
+    limits : Limits
+        What a success keeps within (:func:`limits_of` the campaign).
 
     Returns
     -------
     list of CaptureCase
         One per case, in index order.
-
-    Raises
-    ------
-    DcsimError
-        If the campaign's scenario is not a capture.
     """
     base = validate(campaign.base)
-    limits = Limits.of(base)  # refuses another mission before anything is read
     rows = {int(row["case"]): row for row in table.to_dict("records")}
     start = np.array(base.robot.initial.position)
     judged = []
@@ -188,8 +182,6 @@ def judge(campaign: Campaign, cases: Sequence[Case], table: pandas.DataFrame) ->
                 case.index,
                 _triple(target.angular_velocity_deg_s),
                 _triple(np.array(scenario.robot.initial.position) - start),
-                str(row["status"]),
-                str(row.get("reason") or ""),
                 figures,
                 tuple(_faults(row, figures, limits)),
             )
@@ -385,8 +377,6 @@ def _values(judged: Sequence[CaptureCase], name: str, over: str) -> list[float]:
 
 def _number(value: Any) -> float:
     """A summary value as a float; NaN for a missing one."""
-    if value is None:
-        return math.nan
     try:
         return float(value)
     except (TypeError, ValueError):

@@ -75,7 +75,7 @@ def test_like_faults_group_without_their_numbers():
 def test_every_limit_is_judged_and_every_failure_says_why(shipped):
     campaign, cases = shipped
     table = pandas.DataFrame([{"case": i, **row} for i, row in enumerate(ROWS)])
-    judged = judge(campaign, cases, table)
+    judged = judge(campaign, cases, table, limits_of(campaign))
     assert [case.success for case in judged] == [True, False, False, False, False]
     assert judged[1].faults == (
         "not captured: no path: near a singularity (9x, last det(J Jᵀ) 1.68e-09)",

@@ -367,7 +367,7 @@ def bench_capture_command(
             progress(f"campaign {loaded.spec.name}: {count} cases → {folder}")
             run = run_campaign(loaded, folder, options, count)
         selected = campaign_cases(loaded, PluginRegistry.discover(), count)
-        judged = bench.judge(loaded, selected, run.table)
+        judged = bench.judge(loaded, selected, run.table, limits)
         click.echo(bench.markdown(judged, limits))
         if plot_path is not None:
             bench.plot(judged, limits, plot_path)
