@@ -224,7 +224,7 @@ class FixtureInterceptPlanner(PathPlanner):
                 body, grasp, shoulder, model.reach, judged, problem.grasp is not None
             )
             if refusal is None:
-                trajectory = self._trajectory(problem, times, grasp_time, body, grasp, p)
+                trajectory = self._trajectory(problem, frame, times, grasp_time, body, grasp, p)
                 if isinstance(trajectory, Trajectory):
                     refusal = self._check(problem, trajectory)
                     if refusal is None:
@@ -262,6 +262,7 @@ class FixtureInterceptPlanner(PathPlanner):
     def _trajectory(
         self,
         problem: PathProblem,
+        frame: ForwardKinematics,
         times: np.ndarray,
         grasp_time: float,
         body: BodyPrediction,
@@ -269,18 +270,21 @@ class FixtureInterceptPlanner(PathPlanner):
         p: FixtureInterceptParams,
     ) -> Trajectory | tuple[str, str]:
         """The three phases as a trajectory of DH frame n, or why the arm has no joint
-        solution at the pre-grasp pose."""
+        solution at the pre-grasp pose (``frame``: the arm's at the start)."""
         assert isinstance(problem.model, ManipulatorModel)  # plan() refuses other models
         model, start = problem.model, problem.start.configuration
         lined_up = grasp_time - p.insertion_time
-        moving = _GraspPoses.along(body, grasp, times, lined_up, p, model.forward_kinematics(start))
+        moving = _GraspPoses.along(body, grasp, times, lined_up, p, frame)
         first = int(np.searchsorted(times, lined_up))
         joints = _pose_solution(model, start, moving.positions[first], moving.rotations[first])
         if joints is None:
             return "no joint solution at the pre-grasp pose", f"t = {lined_up:.1f} s"
-        transfer = _JointTransfer(
-            model, start, joints, moving.twist(first), (float(times[0]), lined_up)
-        )
+        try:
+            transfer = _JointTransfer(
+                model, start, joints, moving.twist(first), (float(times[0]), lined_up)
+            )
+        except np.linalg.LinAlgError:
+            return "a singular arm at the pre-grasp pose", f"t = {lined_up:.1f} s"
         positions, velocities = moving.positions.copy(), moving.velocities.copy()
         rotations, angular = moving.rotations.copy(), moving.angular.copy()
         for i, t in enumerate(times[:first]):
@@ -401,7 +405,11 @@ class _JointTransfer:
         self.origin = np.asarray(start[7:], dtype=float)
         self.goal = joints
         full = np.concatenate([self.base, joints])
-        self.end_rates = np.linalg.solve(model.jacobian(full)[:, 6:], twist)
+        arm = model.jacobian(full)[:, 6:]
+        square = arm.shape[0] == arm.shape[1]
+        self.end_rates = (
+            np.linalg.solve(arm, twist) if square else np.linalg.lstsq(arm, twist, rcond=None)[0]
+        )
         self.start_time, self.duration = times[0], times[1] - times[0]
 
     def at(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
