@@ -100,3 +100,19 @@ def test_a_capture_in_the_lvlh_frame_is_refused_by_the_cli(dcsim_cli):
     assert done.returncode == 2
     assert "world.frame: a capture's tumbling body moves in free space" in done.stderr
     assert "use `geocentric`" in done.stderr and "Traceback" not in done.stderr
+
+
+def test_a_body_striking_the_base_is_named_in_an_event_and_counted():
+    """The target drifting into the back of the base (the shipped start at [-7, 0, 0],
+    a 1 m cube; the cylinder's side 5 cm off it): the mission names the base once in an
+    ``arm_contact`` event and the summary counts one link struck."""
+    start = [-7.0 - 0.5 - 1.2 - 0.05, 0.0, 0.0]
+    overrides = {
+        "mission.target.position": start,
+        "mission.target.velocity": [0.1, 0.0, 0.0],
+        "world.duration": 1.0,
+        "sensors.objects": None,
+    }
+    result = run(CAPTURE, overrides, plots=False)
+    assert [e["links"] for e in named(result, "arm_contact")] == [["base"]]
+    assert result.summary["arm_links_struck"] == 1
