@@ -217,6 +217,20 @@ def test_shapes_know_their_bounding_radius_and_tracks_default_to_spheres():
     assert boxed.radius == pytest.approx(3.0)
 
 
+def test_a_track_s_shape_margin_is_the_part_of_its_radius_that_was_not_sensed():
+    track = ObjectTrack(1, ObjectKind.TARGET, 0.0, [0, 0, 0], [0, 0, 0], radius=0.4)
+    assert track.shape_margin == 0.0 and track.sensed_radius == 0.4
+    widened = ObjectTrack(
+        2, ObjectKind.TARGET, 0.0, [0, 0, 0], [0, 0, 0], radius=0.4, shape_margin=0.1
+    )
+    assert widened.radius == 0.4 and widened.sensed_radius == pytest.approx(0.3)
+    for margin in (-0.1, 0.4, 0.5, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="shape_margin must be 0 m or more"):
+            ObjectTrack(
+                3, ObjectKind.TARGET, 0.0, [0, 0, 0], [0, 0, 0], radius=0.4, shape_margin=margin
+            )
+
+
 def test_trajectory_attitude_follows_scipy_slerp():
     times = np.array([0.0, 2.0, 5.0])
     rotations = Rotation.from_euler(

@@ -99,7 +99,8 @@ class ObjectTrack(Message):
     mass : float
         Object mass, kg.
     radius : float
-        Radius of the object's bounding sphere, m (from ``shape`` when given as 0).
+        Radius of the object's bounding sphere, m (from ``shape`` when given as 0): the
+        sphere to keep clear of, ``shape_margin`` included.
     motion : MotionModel or None
         The motion :meth:`predict` follows: under ideal sensing the object's own motion;
         from a tracker, the frame's free dynamics from the track's state; None if unknown,
@@ -119,6 +120,16 @@ class ObjectTrack(Message):
     inertia : ndarray (3, 3) or None
         Its inertia tensor about the centre of mass, body axes, kg·m², when known (it
         predicts the torque-free tumble); None otherwise.
+    shape_margin : float
+        How far a tracker widened the sensed extent for a shape its sensor does not see,
+        m (0 when the shape is known): ``radius - shape_margin`` is the best estimate of
+        the object's bounding radius (:attr:`sensed_radius`), the figure to judge a
+        reach by, while ``radius`` is the one to keep clear of.
+
+    Raises
+    ------
+    ValueError
+        If ``shape_margin`` is negative, not finite or not less than ``radius``.
     """
 
     id: int
@@ -136,6 +147,7 @@ class ObjectTrack(Message):
     attitude: Vector | None = array_field(shape=(4,), default=None, optional=True)
     angular_velocity: Vector | None = array_field(shape=(3,), default=None, optional=True)
     inertia: Vector | None = array_field(shape=(3, 3), default=None, optional=True)
+    shape_margin: float = 0.0
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -143,6 +155,17 @@ class ObjectTrack(Message):
             object.__setattr__(self, "shape", Shape(ShapeKind.SPHERE, radius=self.radius))
         elif self.radius == 0.0:
             object.__setattr__(self, "radius", self.shape.bounding_radius)
+        if not (self.shape_margin == 0.0 or 0.0 < self.shape_margin < self.radius):
+            raise ValueError(
+                f"ObjectTrack.shape_margin must be 0 m or more and less than the radius "
+                f"{self.radius!r} m, got {self.shape_margin!r}"
+            )
+
+    @property
+    def sensed_radius(self) -> float:
+        """The best estimate of the object's bounding radius, m: ``radius`` without the
+        tracker's ``shape_margin``."""
+        return self.radius - self.shape_margin
 
     def predict(self, t: ArrayLike) -> tuple[Vector, Vector]:
         """Predicted ``(position, velocity)`` at time(s) ``t`` (s), shape ``(..., 3)``."""

@@ -124,12 +124,13 @@ class KalmanParams(PluginParams):
 @dataclass(frozen=True)
 class _Details:
     """What a track keeps from its latest accepted detection besides the state (its
-    shape's bounding radius, m, worked out once)."""
+    shape's bounding radius, m, worked out once, and the margin it holds, m)."""
 
     kind: ObjectKind
     mass: float
     shape: Shape
     radius: float
+    margin: float
 
 
 _H = np.hstack([np.eye(3), np.zeros((3, 3))])
@@ -337,13 +338,14 @@ class KalmanTracker(Tracker):
         of its radius plus the margin (shared while a detection repeats them)."""
         if detection.shape is not None:
             shape = detection.shape
-            return _Details(detection.kind, detection.mass, shape, shape.bounding_radius)
+            return _Details(detection.kind, detection.mass, shape, shape.bounding_radius, 0.0)
         key = (detection.kind, detection.mass, detection.radius)
         details = self._spheres.get(key)
         if details is None:
-            sphere = Shape(radius=detection.radius + self.params.shape_margin)
+            margin = self.params.shape_margin
+            sphere = Shape(radius=detection.radius + margin)
             details = self._spheres[key] = _Details(
-                detection.kind, detection.mass, sphere, sphere.radius
+                detection.kind, detection.mass, sphere, sphere.radius, margin
             )
         return details
 
@@ -377,6 +379,7 @@ class KalmanTracker(Tracker):
                     None if rotation is None else _frozen(rotation.angular_velocity.copy())
                 ),
                 inertia=None if rotation is None else rotation.inertia,
+                shape_margin=details.margin,
             )
             for i, (track_id, details, state) in enumerate(
                 zip(self._ids.tolist(), self._details, states.tolist(), strict=True)

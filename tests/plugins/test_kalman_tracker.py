@@ -284,6 +284,7 @@ def test_a_track_starts_at_the_first_detection_with_unknown_velocity():
     expected[3:, 3:] = (0.04 + 1e-4) * np.eye(3)  # and the robot's velocity spread
     np.testing.assert_allclose(track.covariance, expected)
     assert track.shape.kind is ShapeKind.SPHERE and track.radius == pytest.approx(0.65)
+    assert track.shape_margin == 0.25 and track.sensed_radius == pytest.approx(0.4)
     for array in (track.position, track.velocity, track.covariance):
         assert not array.flags.writeable
 
@@ -303,6 +304,7 @@ def test_a_detection_s_shape_is_kept_when_the_sensor_sees_one():
     )
     (track,) = plugin.update(0.0, [seen], robot)
     assert track.shape is box and track.radius == pytest.approx(box.bounding_radius)
+    assert track.shape_margin == 0.0 and track.sensed_radius == track.radius
 
 
 def test_the_gate_rejects_planted_outliers_and_counts_them():

@@ -36,15 +36,7 @@ REFUSED_BEFORE_THE_RUN = {
 """Plugins that cannot fly without a setting the scenario lacks, with the problem named:
 the ``fmu`` controller wraps the user's own FMU, and no FMU ships with dcsim."""
 
-_GRAB_LIVELOCK = (
-    "on the tracker's tracks (a bounding sphere 0.1 m wider than the target) the mission "
-    "holds its cargo-clear standoff 0.1 m further out than it thinks, enters GRAB at an "
-    "estimated gap of 1.5 m, the grab fails at a true gap of 1.6 m > grab_distance 1.5 m, "
-    "and it re-plans into the same grab every tick until world.duration (delivered 0/4)"
-)
 GOAL_NOT_MET = {
-    ("default_sensed", "path_planner", "ant-colony"): _GRAB_LIVELOCK,
-    ("default_sensed", "path_planner", "multi-burn"): _GRAB_LIVELOCK,
     ("space_manipulator_reach", "controller", "underactuated"): (
         "partial base control has no thrust: the base drifts 0.0216 m as the arm swings, "
         "so the end effector ends 0.0216 m from the target, beyond the 1 mm tolerance "

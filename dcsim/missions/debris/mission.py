@@ -376,7 +376,7 @@ class DebrisMission(Mission):
 
     def _standoff(self, track: ObjectTrack, time: float) -> tuple[np.ndarray, np.ndarray]:
         position, velocity = track.predict(time)
-        distance = self.robot.radius + track.radius + self._standoff_gap()
+        distance = self.robot.radius + track.sensed_radius + self._standoff_gap()
         return position + self.approach * distance, velocity
 
     def _move_to_next(self) -> Reference:
@@ -406,7 +406,11 @@ class DebrisMission(Mission):
                 self._go(Mode.DEVISE_PLAN, "pickup missed")
             return self._holding()
         target_position = track.predict(self.time)[0]
-        gap = length(self.estimate.position - target_position) - self.robot.radius - track.radius
+        gap = (
+            length(self.estimate.position - target_position)
+            - self.robot.radius
+            - track.sensed_radius
+        )
         if gap <= min(self._standoff_gap() + 0.5 * self.settings.reach, self.robot.grab_distance):
             self._go(Mode.GRAB, f"target {task.target_id} in reach")
         elif self.time > task.pickup_time + self.settings.pickup_slack:

@@ -226,6 +226,7 @@ class Sensing:
                 attitude=None,
                 angular_velocity=None,
                 inertia=None,
+                shape_margin=0.0,
             )
             for i in visible
             for obj in (self._field.objects[i],)
