@@ -25,10 +25,17 @@ JOINTS = 6
 TYPES = {float: "Real", int: "Integer", bool: "Boolean"}
 
 
+ACQUIRED = "mission.acquisition_time=1.0"
+"""The FMU's and the native run's watch of the target before the approach: 1 s, so that
+a short flight sees the tracker's acquisition end and the approach begin."""
+
+
 @pytest.fixture(scope="module")
 def capture_fmu(tmp_path_factory) -> Path:
-    """The shipped capture scenario as a closed-loop FMU."""
-    return export_fmu(CAPTURE, tmp_path_factory.mktemp("capture") / "capture.fmu")
+    """The shipped capture scenario as a closed-loop FMU, its target tracked for 1 s
+    before the approach (:data:`ACQUIRED`)."""
+    out = tmp_path_factory.mktemp("capture") / "capture.fmu"
+    return export_fmu(CAPTURE, out, overrides=[ACQUIRED])
 
 
 def simulate(fmu: Path, stop_time: float) -> np.ndarray:
@@ -92,13 +99,13 @@ def test_the_capture_fmu_is_valid_and_declares_the_arm_and_the_capture_modes(cap
     assert described == {v.name: (v.causality, TYPES[v.type]) for v in table}
     assert described[JOINT_ANGLE.format(JOINTS)] == ("output", "Real")
     assert "captured" not in described  # the arm carries no targets
-    assert "capture: 0 APPROACH, 1 OBSERVE, 2 INTERCEPT, 3 GRASP, 4 DETUMBLE" in mode
+    assert "capture: 0 ACQUIRE, 1 APPROACH, 2 OBSERVE, 3 INTERCEPT, 4 GRASP, 5 DETUMBLE" in mode
 
 
 def test_simulate_fmu_flies_the_capture_as_dcsim_run_does(capture_fmu):
-    stop = 3.0  # s of the approach
+    stop = 3.0  # s: 1 s of acquisition, then the approach
     result = simulate(capture_fmu, stop)
-    rows = native([f"world.duration={stop}"])
+    rows = native([f"world.duration={stop}", ACQUIRED])
     assert len(rows) == len(result) == 301
     assert_flown_alike(result, rows)
     assert result["velocity.x"][-1] > 0.0  # the base is on its way to the standoff

@@ -18,7 +18,7 @@ OBSERVATION = 0.5
 """Observation time (s) of the short run."""
 DURATION = 22.0
 """Duration (s) of the short run: it is detumbled at about 19 s."""
-MODES = ("APPROACH", "OBSERVE", "INTERCEPT", "GRASP", "DETUMBLE", "CAPTURED")
+MODES = ("ACQUIRE", "APPROACH", "OBSERVE", "INTERCEPT", "GRASP", "DETUMBLE", "CAPTURED")
 GRIP_DISTANCE = 0.005
 """Largest distance (m) of the bar from the pads' centre at latch time."""
 GRIP_SPEED = 0.005
@@ -116,3 +116,36 @@ def test_a_body_striking_the_base_is_named_in_an_event_and_counted():
     result = run(CAPTURE, overrides, plots=False)
     assert [e["links"] for e in named(result, "arm_contact")] == [["base"]]
     assert result.summary["arm_links_struck"] == 1
+
+
+def test_the_standoff_waits_for_the_tracker_and_an_exact_track_does_not():
+    """Under the shipped object sensor the robot holds at its start for the acquisition
+    time while the tracker learns the tumble; with the truth as the track it leaves at
+    once."""
+    acquisition = {"mission.acquisition_time": 2.0, "world.duration": 2.5}
+    tracked = run(CAPTURE, acquisition, plots=False)
+    exact = run(CAPTURE, {**acquisition, "sensors.objects": None}, plots=False)
+    for result, leaves in ((tracked, 2.0), (exact, 0.0)):
+        (approach,) = named(result, "mode")
+        assert (approach["previous"], approach["mode"]) == ("ACQUIRE", "APPROACH")
+        assert approach["t"] == pytest.approx(leaves, abs=1e-9)
+    held = tracked.telemetry[tracked.telemetry["time_s"] < 2.0 - 1e-9]
+    start = load_scenario(CAPTURE).robot.initial.position
+    drift = held[["x_m", "y_m", "z_m"]].to_numpy() - np.asarray(start)
+    assert np.abs(drift).max() < 1e-3  # m: held at the start while it watches
+
+
+def test_a_target_the_sensor_cannot_see_aborts_the_capture_before_the_approach():
+    """An object sensor of 1 m range never detects the body 7 m away: the capture aborts
+    at the end of the acquisition, naming why, and the base never leaves its start."""
+    overrides = {
+        "robot.sensor_range": 1.0,
+        "mission.acquisition_time": 1.0,
+        "world.duration": 3.0,
+    }
+    result = run(CAPTURE, overrides, plots=False)
+    ((abort,),) = [named(result, "abort")]
+    assert abort["t"] == pytest.approx(1.0, abs=1e-9)
+    assert abort["reason"].startswith("the target is not tracked")
+    assert [e["mode"] for e in named(result, "mode")] == ["ABORT"]
+    assert result.status == "stopped"

@@ -2,17 +2,22 @@
 
 Modes::
 
-    APPROACH ─base at the standoff─► OBSERVE ─watched, path planned─► INTERCEPT
-        ─end effector on the fixture─► GRASP ─grip held─► DETUMBLE ─stack still─► CAPTURED
-                                 │ no path                 │ grip not held
-                                 ▼                         ▼
-                               ABORT ◄─────────────────────┘
+    ACQUIRE ─target's tumble tracked─► APPROACH ─base at the standoff─► OBSERVE
+        ─watched, path planned─► INTERCEPT ─end effector on the fixture─► GRASP
+        ─grip held─► DETUMBLE ─stack still─► CAPTURED
+          │ not tracked            │ no path               │ grip not held
+          ▼                        ▼                       ▼
+        ABORT ◄──────────────────────────────────────────────┘
 
+- **ACQUIRE**: the robot holds at its start while the tracker follows the target, for
+  ``acquisition_time`` (no wait for an exact track, under ideal object sensing); then
+  the standoff point is chosen from the target's track. A target whose rotation is not
+  tracked by then aborts the capture.
 - **APPROACH**: the base flies from its start to the standoff point, ``standoff`` from
-  the target's centre of mass along its angular momentum (the fixture's side) and
-  ``standoff_height`` below it along the base's z axis, by a minimum-jerk move within
-  ``approach_speed`` and ``approach_acceleration``, turning its arm side to face the
-  target; the arm holds its start configuration.
+  the target's centre of mass along its angular momentum as the track gives it (the
+  fixture's side) and ``standoff_height`` below it along the base's z axis, by a
+  minimum-jerk move within ``approach_speed`` and ``approach_acceleration``, turning its
+  arm side to face the target; the arm holds its start configuration.
 - **OBSERVE**: the base holds there for ``observation_time`` while the target's track
   is watched; then the path planner is asked for the end effector's trajectory onto
   the fixture (a :class:`~dcsim.messages.PathProblem` with a
@@ -73,8 +78,7 @@ from dcsim.registry.interfaces import Plugin
 from dcsim.robots.kinematics import rotation_matrix
 from dcsim.robots.manipulator import ManipulatorModel
 from dcsim.robots.pose_path import PosePath
-from dcsim.scenario.model import ManipulatorSection, Scenario
-from dcsim.world.tumbling_body import BodyState
+from dcsim.scenario.model import FixtureSpec, ManipulatorSection, Scenario
 
 TARGET_POSE_COLUMNS = (
     "target_x",
@@ -113,7 +117,16 @@ class CaptureMission(Mission):
     summary = "grasp a tumbling body with a space manipulator and detumble it"
     Settings = CaptureMissionSection
     roles = ("path_planner", "controller")
-    modes = ("APPROACH", "OBSERVE", "INTERCEPT", "GRASP", "DETUMBLE", "CAPTURED", "ABORT")
+    modes = (
+        "ACQUIRE",
+        "APPROACH",
+        "OBSERVE",
+        "INTERCEPT",
+        "GRASP",
+        "DETUMBLE",
+        "CAPTURED",
+        "ABORT",
+    )
     robots = ("manipulator",)
     columns = (
         "fixture_dx",
@@ -181,11 +194,10 @@ class CaptureMission(Mission):
         robot = scenario.robot
         assert isinstance(robot, ManipulatorSection) and robot.gripper is not None
         self.gripper = robot.gripper
-        self.state = "APPROACH"
+        self.state = "ACQUIRE"
         self.start = world.robot_state()
-        self.approach = _Approach(
-            self.start, rig.target_state(), rig.target.inertia, np.array(robot.mount), self.settings
-        )
+        self.mount = np.array(robot.mount)
+        self.approach: _Approach | None = None
         self.held_since: float | None = None
         self.still_since: float | None = None
         self.hold_reference: Reference | None = None
@@ -211,6 +223,8 @@ class CaptureMission(Mission):
     def tick(self, time: float, estimate: StateEstimate, observations: Observations) -> Reference:
         """Advance the mode machine and give the reference of the coming period."""
         self._note_contact(time)
+        if self.state == "ACQUIRE":
+            return self._acquire(time, estimate, observations)
         if self.state == "APPROACH":
             return self._approach(time, estimate)
         if self.state == "OBSERVE":
@@ -222,7 +236,29 @@ class CaptureMission(Mission):
         assert self.hold_reference is not None  # set on the way to DETUMBLE or ABORT
         return self.hold_reference
 
+    def _acquire(
+        self, time: float, estimate: StateEstimate, observations: Observations
+    ) -> Reference:
+        """Hold at the start until the target's track has been watched long enough, then
+        choose the standoff from it and leave from where the robot is."""
+        track, missing = self._target_track(observations)
+        exact = track is not None and track.covariance is None
+        if exact or time - self.start.time >= self.settings.acquisition_time:
+            if track is None:
+                self._abort(missing)
+            else:
+                self.approach = _Approach(
+                    estimate.as_state(),
+                    track,
+                    self.settings.target.fixture,
+                    self.mount,
+                    self.settings,
+                )
+                self._go("APPROACH")
+        return self._hold(self.start)
+
     def _approach(self, time: float, estimate: StateEstimate) -> Reference:
+        assert self.approach is not None  # chosen on the way out of ACQUIRE
         reference = self.approach.reference(time)
         if time >= self.approach.end_time:
             self.times["observe"] = time
@@ -233,6 +269,7 @@ class CaptureMission(Mission):
     def _observe(
         self, time: float, estimate: StateEstimate, observations: Observations
     ) -> Reference:
+        assert self.approach is not None  # chosen on the way out of ACQUIRE
         reference = self.approach.reference(time)
         observed = self.times["observe"]
         assert observed is not None
@@ -508,28 +545,33 @@ class _Approach:
 
     The standoff point lies on the target's angular momentum axis through its centre of
     mass, on the fixture's side: points of a tumbling body near that axis move least.
-    A body that does not turn gives no axis; the fixture's approach axis stands in.
+    A body that does not turn gives no axis; the fixture's approach axis stands in. The
+    target is as its track gives it (position, attitude, angular velocity and inertia):
+    ``track.attitude``, ``track.angular_velocity`` and ``track.inertia`` are set.
     """
 
     def __init__(
         self,
         start: RobotState,
-        target: BodyState,
-        inertia: np.ndarray,
+        track: ObjectTrack,
+        fixture: FixtureSpec,
         mount: np.ndarray,
         settings: CaptureMissionSection,
     ) -> None:
-        rotation = rotation_matrix(target.attitude)
-        momentum = rotation @ inertia @ rotation.T @ target.angular_velocity
-        out = target.fixture - target.position
-        axis = momentum if np.linalg.norm(momentum) > 1e-9 else target.approach_axis
+        assert track.attitude is not None and track.angular_velocity is not None
+        assert track.inertia is not None  # _target_track answers only such tracks
+        rotation = rotation_matrix(track.attitude)
+        momentum = rotation @ track.inertia @ rotation.T @ track.angular_velocity
+        out = rotation @ np.array(fixture.position)
+        approach_axis = rotation @ np.array(fixture.approach_axis)
+        axis = momentum if np.linalg.norm(momentum) > 1e-9 else approach_axis
         axis = axis / np.linalg.norm(axis)
         axis = axis if axis @ out >= 0.0 else -axis
         self.origin = start.position
         facing = rotate(start.attitude, mount) if np.linalg.norm(mount) > 0 else -axis
         self.attitude = quaternion_multiply(quaternion_between(facing, -axis), start.attitude)
         up = rotate(self.attitude, [0.0, 0.0, 1.0])
-        self.goal = target.position + settings.standoff * axis - settings.standoff_height * up
+        self.goal = track.position + settings.standoff * axis - settings.standoff_height * up
         self.start_attitude = start.attitude
         self.joints = start.joint_positions
         length = float(np.linalg.norm(self.goal - self.origin))

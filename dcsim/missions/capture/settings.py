@@ -40,6 +40,14 @@ class CaptureMissionSection(MissionSettings):
         "standoff, along the base's z axis: an arm reaching straight ahead at its shoulder's "
         "height is near a singularity.",
     )
+    acquisition_time: float = quantity(
+        10.0,
+        unit="s",
+        ge=0,
+        description="Time the tracker follows the target from the start before the standoff "
+        "is chosen from its track (no wait when the track is exact, under ideal object "
+        "sensing).",
+    )
     approach_speed: float = quantity(
         0.1, unit="m/s", gt=0, description="Largest speed of the base's approach."
     )
