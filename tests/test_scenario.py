@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 from dcsim.api import ScenarioError, Shape, ShapeKind
 from dcsim.registry.discovery import PluginRegistry
@@ -460,3 +461,12 @@ def test_the_mission_section_is_read_as_its_mission_s_settings_class_or_refused(
     assert scenario.mission_as(DebrisMissionSection) is scenario.mission
     with pytest.raises(TypeError, match="not the TransferMissionSection"):
         scenario.mission_as(TransferMissionSection)
+
+
+@pytest.mark.parametrize("path", SCENARIOS, ids=lambda p: p.stem)
+def test_the_resolved_scenario_is_written_as_pyyaml_s_own_dumper_writes_it(path):
+    """libyaml's dumper, where there is one, gives PyYAML's text to the byte."""
+    scenario = read_scenario(path)
+    data = scenario.model_dump(mode="json")
+    expected = yaml.dump(data, Dumper=yaml.SafeDumper, sort_keys=False, allow_unicode=True)
+    assert dump_scenario(scenario) == expected

@@ -454,7 +454,9 @@ class Runner:
     def _start(self) -> None:
         world = self._opened_world
         self.mission = self.mission_class(self.scenario, world, self.plugins, self._event)
-        self.recorder.start(dump_scenario(self.scenario), self._summary_head("running", ""))
+        writes = self.recorder.out_dir is not None  # else scenario.yaml is not written
+        scenario_yaml = dump_scenario(self.scenario) if writes else ""
+        self.recorder.start(scenario_yaml, self._summary_head("running", ""))
         self._hook("dcsim_run_start", run=self.info)
         self._note_planner_models()
         # every tick's hook is called only when a plugin implements it

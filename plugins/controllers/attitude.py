@@ -47,6 +47,12 @@ def attitude_damping() -> Any:
 def design_gains(bandwidth: float, damping: float) -> tuple[float, float]:
     """Place the double integrator's poles at those of ``s² + 2ζω s + ω²``.
 
+    Ackermann's formula for ``ẍ = u`` (``A = [[0, 1], [0, 0]]``, ``B = [0, 1]ᵀ``) gives
+    the gains ``[kp, kd] = [a₀, a₁]``, the coefficients of the characteristic polynomial
+    ``s² + a₁ s + a₀`` of the placed poles. The poles are found and the polynomial is
+    rebuilt from them, as python-control's ``acker`` does, so that the gains are its to
+    the bit (``tests/plugins/test_pd.py``).
+
     Parameters
     ----------
     bandwidth : float
@@ -59,13 +65,9 @@ def design_gains(bandwidth: float, damping: float) -> tuple[float, float]:
     kp, kd : float
         Position gain (1/s²) and velocity gain (1/s), per unit mass.
     """
-    import control  # imported here: it is slow to import and only needed at reset
-
-    a = np.array([[0.0, 1.0], [0.0, 0.0]])
-    b = np.array([[0.0], [1.0]])
     poles = np.roots([1.0, 2.0 * damping * bandwidth, bandwidth**2])
-    gains = np.asarray(control.acker(a, b, poles)).ravel()
-    return float(gains[0]), float(gains[1])
+    characteristic = np.real(np.poly(poles))  # [1, a₁, a₀]
+    return float(characteristic[2]), float(characteristic[1])
 
 
 class AttitudeLoop:

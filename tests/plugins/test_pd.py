@@ -29,6 +29,17 @@ def test_pole_placement_gives_the_second_order_gains(bandwidth, damping):
     assert kd == pytest.approx(2 * damping * bandwidth)
 
 
+@pytest.mark.parametrize("bandwidth", [0.05, 0.2, 0.5, 1.0, 3.0, 17.3])
+@pytest.mark.parametrize("damping", [0.3, 0.7, 0.9, 1.0, 1.5, 5.0])
+def test_the_gains_are_python_control_s_ackermann_placement_to_the_bit(bandwidth, damping):
+    control = pytest.importorskip("control")
+    a = np.array([[0.0, 1.0], [0.0, 0.0]])
+    b = np.array([[0.0], [1.0]])
+    poles = np.roots([1.0, 2.0 * damping * bandwidth, bandwidth**2])
+    expected = np.asarray(control.acker(a, b, poles)).ravel()
+    assert design_gains(bandwidth, damping) == (expected[0], expected[1])
+
+
 def test_no_error_and_no_reference_velocity_commands_nothing():
     pd = controller()
     estimate = StateEstimate(time=0.0, position=[3, 4, 5], velocity=[0, 0, 0])
