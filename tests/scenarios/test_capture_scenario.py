@@ -149,3 +149,21 @@ def test_a_target_the_sensor_cannot_see_aborts_the_capture_before_the_approach()
     assert abort["reason"].startswith("the target is not tracked")
     assert [e["mode"] for e in named(result, "mode")] == ["ABORT"]
     assert result.status == "stopped"
+
+
+def test_the_sensed_detumble_is_the_world_s(capture):
+    """The mission judges the detumble by the rates the robot senses (the base's gyros,
+    the palm's rate through the arm's Jacobian); over the second before it says so,
+    the world's own rates of the base and the target are within the limit too, and
+    just before it the target's was not."""
+    limit = np.radians(load_scenario(CAPTURE).mission.detumbled_rate_deg_s)
+    (detumbled,) = named(capture, "detumbled")
+    telemetry = capture.telemetry
+    times = telemetry["time_s"].to_numpy()
+    last_second = (times > detumbled["t"] - 1.0 + 1e-9) & (times <= detumbled["t"] + 1e-9)
+    assert last_second.sum() >= 90  # control periods of 0.01 s
+    for column in ("target_rate_radps", "base_rate_radps"):
+        assert telemetry.loc[last_second, column].max() <= limit
+    # and the world's target crosses the limit when the sensed rates do, within 0.05 s
+    before = (times > detumbled["t"] - 1.05) & (times <= detumbled["t"] - 1.0 + 1e-9)
+    assert telemetry.loc[before, "target_rate_radps"].max() > limit

@@ -30,8 +30,10 @@ Modes::
   to the palm. If the planned trajectory ends first, the capture is aborted.
 - **DETUMBLE**: the base holds its attitude and position at the latch and the arm its
   configuration (the controller's stiffness gives way to the loads); the stack is
-  detumbled when the base's and the target's angular rates both stay below
-  ``detumbled_rate_deg_s`` for one second.
+  detumbled when the base's and the target's angular rates, as the robot senses them,
+  both stay below ``detumbled_rate_deg_s`` for one second: the base's from its
+  estimate, the target's as the palm's it is latched to (the base's rate and the
+  joints' through the arm's Jacobian).
 
 Any link of the arm other than the gripper's, or its base, that strikes the target is
 named in an ``arm_contact`` event (once per link); the summary counts them
@@ -232,7 +234,7 @@ class CaptureMission(Mission):
         if self.state in ("INTERCEPT", "GRASP"):
             return self._intercept(time, estimate)
         if self.state == "DETUMBLE":
-            self._check_still(time)
+            self._check_still(time, estimate)
         assert self.hold_reference is not None  # set on the way to DETUMBLE or ABORT
         return self.hold_reference
 
@@ -368,16 +370,14 @@ class CaptureMission(Mission):
             self.hold_reference = self._hold(estimate.as_state())
             self._go("DETUMBLE")
 
-    def _check_still(self, time: float) -> None:
-        """Say the stack is detumbled once both rates stay low for a second."""
+    def _check_still(self, time: float, estimate: StateEstimate) -> None:
+        """Say the stack is detumbled once both sensed rates stay low for a second."""
         limit = np.radians(self.settings.detumbled_rate_deg_s)
-        state = self.world.robot_state()
-        target = self.rig.target_state()
+        state = estimate.as_state()
+        twist = self._model().jacobian(state.configuration) @ state.generalised_velocity
+        palm_rate = twist[3:]  # the latched target's angular velocity, world frame
         still = (
-            max(
-                float(np.linalg.norm(state.angular_velocity)),
-                float(np.linalg.norm(target.angular_velocity)),
-            )
+            max(float(np.linalg.norm(state.angular_velocity)), float(np.linalg.norm(palm_rate)))
             <= limit
         )
         if not still:
