@@ -61,6 +61,13 @@ from dcsim.world.objects import ObjectStatus
 #: Gap kept between carried cargo and a target being approached, m.
 CARGO_CLEARANCE = 0.1
 
+#: How far out of an obstacle's keep-out a held point is moved, as a multiple of the
+#: keep-out's radius.
+KEEP_OUT_EXIT = 1.1
+
+_RADIAL = np.array([1.0, 0.0, 0.0])
+"""The way out of an obstacle whose centre a held point sits on (the frame's x axis)."""
+
 
 class Mode(enum.IntEnum):
     """Mission modes, with the integer each is reported as."""
@@ -245,9 +252,42 @@ class DebrisMission(Mission):
         )
 
     def _holding(self) -> Reference:
+        """Hold where the robot was when it began to wait, moved out of the keep-out of
+        any obstacle it lies in: obstacles drift, and a path planner refuses a start
+        inside one."""
         if self.hold is None:
             self.hold = np.array(self.estimate.position)
+        self.hold = self._clear_of_obstacles(self.hold)
         return Reference(time=self.time, position=self.hold)
+
+    def _keep_outs(self) -> list[tuple[np.ndarray, float]]:
+        """Centre (m) and radius (m) now of each seen obstacle's keep-out: its sphere,
+        the robot's radius and the safety distance, as the path planners judge a start."""
+        clearance = self.world.robot_spec().radius + self.settings.safety_distance
+        return [(t.predict(self.time)[0], t.radius + clearance) for t in self._obstacles()]
+
+    def _clear_of_obstacles(self, point: np.ndarray) -> np.ndarray:
+        """``point`` (m) as it is, or moved straight away from the centre of each
+        obstacle whose keep-out it lies in, to :data:`KEEP_OUT_EXIT` times that
+        keep-out's radius."""
+        for centre, keep_out in self._keep_outs():
+            offset = point - centre
+            distance = length(offset)
+            if distance < keep_out:
+                away = offset / distance if distance > 0.0 else _RADIAL
+                point = centre + KEEP_OUT_EXIT * keep_out * away
+        return point
+
+    def _may_plan(self) -> bool:
+        """Whether a path may be asked for now: not before the retry time and, after a
+        refusal, not while the robot is still inside an obstacle's keep-out (it is being
+        held out of it, and a planner would refuse that start again)."""
+        if self.time < self.retry_at:
+            return False
+        position = self.estimate.position
+        return self.refusals == 0 or all(
+            length(position - centre) >= keep_out for centre, keep_out in self._keep_outs()
+        )
 
     def _new_target(self) -> ObjectTrack | None:
         return next((t for t in self._free_targets() if t.id not in self.planned), None)
@@ -387,7 +427,7 @@ class DebrisMission(Mission):
         if newcomer is not None:
             self._go(Mode.DEVISE_PLAN, f"new target {newcomer.id} in sight")
             return self._holding()
-        if self.trajectory is None and self.plans_paths and self.time >= self.retry_at:
+        if self.trajectory is None and self.plans_paths and self._may_plan():
             if self.pickup_refused:  # the pickup as planned has no path: plan the tasks anew
                 self._go(Mode.DEVISE_PLAN, "no path to the pickup")
                 return self._holding()
@@ -451,15 +491,18 @@ class DebrisMission(Mission):
 
     def _move_to_drop(self) -> Reference:
         drop = self.drop_point
-        if self.trajectory is None and self.plans_paths and self.time >= self.retry_at:
+        if self.trajectory is None and self.plans_paths and self._may_plan():
             arrive = self.visit.time if self.visit and self.visit.time > self.time else None
             position, velocity = drop.state_at(self.time if arrive is None else arrive)
             self.trajectory = self._plan_path(
                 GoalRegion(position, 0.5 * drop.tolerance, velocity, arrive), self._drop_speed()
             )
             self.release_refused = False
+        if self.trajectory is None and self.plans_paths:  # refused: wait for the retry
+            followed = self._holding()
+        else:
+            followed = self._follow(lambda: drop.state_at(self.time))
         # The limit also holds once the trajectory is flown and the drop point is tracked.
-        followed = self._follow(lambda: drop.state_at(self.time))
         reference = Reference.trusted(**{**followed.__dict__, "max_speed": self._drop_speed()})
         distance = length(self.estimate.position - drop.state_at(self.time)[0])
         if distance <= self.settings.release_fraction * drop.tolerance:
