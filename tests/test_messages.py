@@ -224,7 +224,11 @@ def test_a_track_s_shape_margin_is_the_part_of_its_radius_that_was_not_sensed():
         2, ObjectKind.TARGET, 0.0, [0, 0, 0], [0, 0, 0], radius=0.4, shape_margin=0.1
     )
     assert widened.radius == 0.4 and widened.sensed_radius == pytest.approx(0.3)
-    for margin in (-0.1, 0.4, 0.5, float("nan"), float("inf")):
+    point = ObjectTrack(
+        3, ObjectKind.TARGET, 0.0, [0, 0, 0], [0, 0, 0], radius=0.4, shape_margin=0.4
+    )
+    assert point.sensed_radius == 0.0  # a detection without extent, widened by the margin
+    for margin in (-0.1, 0.5, float("nan"), float("inf")):
         with pytest.raises(ValueError, match="shape_margin must be 0 m or more"):
             ObjectTrack(
                 3, ObjectKind.TARGET, 0.0, [0, 0, 0], [0, 0, 0], radius=0.4, shape_margin=margin

@@ -129,7 +129,7 @@ class ObjectTrack(Message):
     Raises
     ------
     ValueError
-        If ``shape_margin`` is negative, not finite or not less than ``radius``.
+        If ``shape_margin`` is negative, not a number or more than ``radius``.
     """
 
     id: int
@@ -155,9 +155,9 @@ class ObjectTrack(Message):
             object.__setattr__(self, "shape", Shape(ShapeKind.SPHERE, radius=self.radius))
         elif self.radius == 0.0:
             object.__setattr__(self, "radius", self.shape.bounding_radius)
-        if not (self.shape_margin == 0.0 or 0.0 < self.shape_margin < self.radius):
+        if not 0.0 <= self.shape_margin <= self.radius:
             raise ValueError(
-                f"ObjectTrack.shape_margin must be 0 m or more and less than the radius "
+                f"ObjectTrack.shape_margin must be 0 m or more and at most the radius "
                 f"{self.radius!r} m, got {self.shape_margin!r}"
             )
 
