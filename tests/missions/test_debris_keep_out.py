@@ -65,3 +65,25 @@ def test_a_refused_way_to_the_drop_point_is_waited_out_not_flown_straight():
     waited = [r for r in runner.recorder.rows if r["time"] >= refusals[0]["t"]]
     moved = np.ptp([[r["x"], r["y"], r["z"]] for r in waited], axis=0)
     assert np.linalg.norm(moved) < 1.0  # m: held where it was
+
+
+def test_between_two_keep_outs_it_finds_the_way_out_and_asks_once_out():
+    """The collector starts between two static obstacles whose keep-outs overlap around
+    it: moved out of one along the line of centres, a held point lands in the other,
+    but not on that line exactly (the estimate is not); the collector leaves sideways
+    and asks again only once it is out of both."""
+    overrides = [
+        "path_planner={plugin: ant-colony}",
+        "robot.initial.position=[0.0, 0.0, 0.0]",
+        "obstacles[+]={id: 13, radius: 1.0, mass: 50.0, "
+        "motion: {type: static, position: [0.0, 1.8, 0.0]}}",
+        "obstacles[+]={id: 14, radius: 1.0, mass: 50.0, "
+        "motion: {type: static, position: [0.0, -1.8, 0.0]}}",
+        "world.duration=60",
+    ]
+    runner = Runner(setup_run(None, overrides, registry=PluginRegistry.discover()))
+    summary = runner.run()
+    events = [e for e in runner.recorder.events if e["event"] in ("no_path", "path")]
+    assert [e["event"] for e in events[:2]] == ["no_path", "path"]
+    assert events[0]["reason"].startswith("the start is inside obstacle 13")
+    assert summary["collisions"] == 0

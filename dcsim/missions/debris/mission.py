@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from dcsim.geometry import length, unit
+from dcsim.geometry import length, row_lengths, unit
 from dcsim.messages import (
     DropPoint,
     DropVisit,
@@ -64,9 +64,6 @@ CARGO_CLEARANCE = 0.1
 #: How far out of an obstacle's keep-out a held point is moved, as a multiple of the
 #: keep-out's radius.
 KEEP_OUT_EXIT = 1.1
-
-_RADIAL = np.array([1.0, 0.0, 0.0])
-"""The way out of an obstacle whose centre a held point sits on (the frame's x axis)."""
 
 
 class Mode(enum.IntEnum):
@@ -252,42 +249,62 @@ class DebrisMission(Mission):
         )
 
     def _holding(self) -> Reference:
-        """Hold where the robot was when it began to wait, moved out of the keep-out of
-        any obstacle it lies in: obstacles drift, and a path planner refuses a start
-        inside one."""
+        """Hold where the robot was when it began to wait; after a path planner's
+        refusal, moved out of any obstacle's keep-out it lies in (obstacles drift, and a
+        planner refuses a start inside one)."""
         if self.hold is None:
             self.hold = np.array(self.estimate.position)
-        self.hold = self._clear_of_obstacles(self.hold)
+        if self.refusals > 0:
+            self.hold = self._clear_of_obstacles(self.hold)
         return Reference(time=self.time, position=self.hold)
 
-    def _keep_outs(self) -> list[tuple[np.ndarray, float]]:
-        """Centre (m) and radius (m) now of each seen obstacle's keep-out: its sphere,
-        the robot's radius and the safety distance, as the path planners judge a start."""
+    def _keep_outs(self) -> tuple[np.ndarray, np.ndarray]:
+        """Centres (k, 3) (m) and radii (k,) (m) now of the seen obstacles' keep-outs:
+        each one's bounding sphere, the robot's radius and the safety distance (no
+        smaller than a planner's keep-out of the obstacle's own shape)."""
+        obstacles = self._obstacles()
         clearance = self.world.robot_spec().radius + self.settings.safety_distance
-        return [(t.predict(self.time)[0], t.radius + clearance) for t in self._obstacles()]
+        centres = np.array([t.predict(self.time)[0] for t in obstacles]).reshape(-1, 3)
+        return centres, np.array([t.radius + clearance for t in obstacles])
 
     def _clear_of_obstacles(self, point: np.ndarray) -> np.ndarray:
         """``point`` (m) as it is, or moved straight away from the centre of each
         obstacle whose keep-out it lies in, to :data:`KEEP_OUT_EXIT` times that
-        keep-out's radius."""
-        for centre, keep_out in self._keep_outs():
-            offset = point - centre
-            distance = length(offset)
-            if distance < keep_out:
-                away = offset / distance if distance > 0.0 else _RADIAL
-                point = centre + KEEP_OUT_EXIT * keep_out * away
+        keep-out's radius; passes are repeated while a move out of one keep-out lands in
+        another, at most once per obstacle (the point may stay inside where keep-outs
+        crowd it)."""
+        centres, radii = self._keep_outs()
+        for _ in range(len(radii)):
+            offsets = point - centres
+            distances = row_lengths(offsets)
+            inside = np.flatnonzero(distances < radii)
+            if not len(inside):
+                break
+            i = inside[0]  # away from its centre (along x from the centre itself)
+            point = centres[i] + KEEP_OUT_EXIT * radii[i] * unit(offsets[i])
         return point
 
     def _may_plan(self) -> bool:
         """Whether a path may be asked for now: not before the retry time and, after a
-        refusal, not while the robot is still inside an obstacle's keep-out (it is being
-        held out of it, and a planner would refuse that start again)."""
-        if self.time < self.retry_at:
-            return False
-        position = self.estimate.position
-        return self.refusals == 0 or all(
-            length(position - centre) >= keep_out for centre, keep_out in self._keep_outs()
-        )
+        refusal, not while the robot is still inside an obstacle's keep-out on its way
+        to a held point clear of them all (a planner would refuse that start again; it
+        counts as out half-way from the keep-out's edge to the held point's distance,
+        beyond the estimate's jitter). It
+        waits no longer than its refusals would have taken (``max_plan_attempts`` times
+        ``path_retry``), nor at all when keep-outs crowd the held point."""
+        if self.time < self.retry_at or self.refusals == 0:
+            return self.time >= self.retry_at
+        waited = self.time - self.retry_at
+        if (
+            self.hold is None
+            or waited >= self.settings.max_plan_attempts * self.settings.path_retry
+        ):
+            return True
+        centres, radii = self._keep_outs()
+        held_clear = bool(np.all(row_lengths(self.hold - centres) >= radii))
+        distances = row_lengths(self.estimate.position - centres)
+        robot_clear = bool(np.all(distances >= 0.5 * (1.0 + KEEP_OUT_EXIT) * radii))
+        return robot_clear or not held_clear
 
     def _new_target(self) -> ObjectTrack | None:
         return next((t for t in self._free_targets() if t.id not in self.planned), None)
