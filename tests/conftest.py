@@ -46,7 +46,7 @@ def short_capture(observation: float, duration: float) -> dict[str, object]:
     unturned). The target starts turned as it is :data:`CAPTURE_TURNED_AT` less
     ``observation`` into the shipped run. The object sensor reports the truth: a watch
     of well under the shipped 5 s is too short for the tracker to learn the tumble (the
-    shipped run's tracker watches it through the whole approach).
+    shipped run's tracker watches it through its acquisition and the whole approach).
 
     Parameters
     ----------

@@ -155,7 +155,7 @@ class ObjectTrack(Message):
             object.__setattr__(self, "shape", Shape(ShapeKind.SPHERE, radius=self.radius))
         elif self.radius == 0.0:
             object.__setattr__(self, "radius", self.shape.bounding_radius)
-        if not 0.0 <= self.shape_margin <= self.radius:
+        if self.shape_margin != 0.0 and not 0.0 < self.shape_margin <= self.radius:
             raise ValueError(
                 f"ObjectTrack.shape_margin must be 0 m or more and at most the radius "
                 f"{self.radius!r} m, got {self.shape_margin!r}"

@@ -173,7 +173,8 @@ def _covariance_problem(track: ObjectTrack) -> str | None:
     "on the standard tracking problem (five objects drifting in an orbit's LVLH frame, "
     "detected at 10 Hz for 30 s, one of them for 15 s only), each answer holds one track "
     "of every object detected at that tick, tracks of detected objects only, each with a "
-    "symmetric positive semi-definite 6×6 covariance and the tick's time",
+    "symmetric positive semi-definite 6×6 covariance, the tick's time and a shape margin "
+    "from 0 to its radius (its sensed radius, radius less margin, not negative)",
     kinds=("tracker",),
 )
 def check_detected_kept(plugin_class: type[Plugin]) -> None:
@@ -197,6 +198,11 @@ def check_detected_kept(plugin_class: type[Plugin]) -> None:
                 fail(
                     f"at t = {tick.time:g} s the track of object {track.id} is for "
                     f"t = {track.time:g} s"
+                )
+            if not 0.0 <= track.shape_margin <= track.radius:
+                fail(
+                    f"at t = {tick.time:g} s the track of object {track.id} has a shape "
+                    f"margin of {track.shape_margin!r} m for a radius of {track.radius!r} m"
                 )
 
 

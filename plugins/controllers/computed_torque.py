@@ -31,8 +31,8 @@ to the robot's limits (``max_force`` and ``max_torque`` on the vectors' magnitud
 ``joint_torque_limits`` per joint). While no limit binds, the law is exact on the model.
 
 Gains are diagonal, ``K_P = k_P 1`` and ``K_D = k_D 1``: the thesis's ``k_P = 1``,
-``k_D = 10`` by default (eqs 7.2–7.3), or, when ``bandwidth`` is set, placed with
-python-control at the poles of ``s² + 2ζω s + ω²`` (:func:`design_gains` of the ``pd``
+``k_D = 10`` by default (eqs 7.2–7.3), or, when ``bandwidth`` is set, placed at the poles
+of ``s² + 2ζω s + ω²`` by Ackermann's formula (:func:`design_gains` of the ``pd``
 controller: ``k_P = ω²``, ``k_D = 2ζω``).
 """
 

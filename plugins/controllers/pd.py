@@ -1,9 +1,9 @@
 """``pd`` controller: proportional-derivative tracking with force and speed limits.
 
 The gains come from pole placement on the double integrator ẍ = u (per axis, per unit
-mass) with python-control: the closed-loop poles are those of a second-order system of
-natural frequency ``bandwidth`` and damping ratio ``damping``, giving ``kp = ω²`` and
-``kd = 2ζω``. The law is written in its speed-limited form
+mass) by Ackermann's formula (:func:`design_gains`): the closed-loop poles are those of a
+second-order system of natural frequency ``bandwidth`` and damping ratio ``damping``,
+giving ``kp = ω²`` and ``kd = 2ζω`` (to the last bits). The law is written in its speed-limited form
 
     v_cmd = v_ref + (kp / kd) (p_ref − p),   |v_cmd| ≤ max_speed
     F = m (kd (v_cmd − v) + a_ref),          |F| ≤ max_force

@@ -13,7 +13,7 @@ from dcsim.run.loop import Runner
 from dcsim.run.setup import setup_run
 from dcsim.testing import checks_for
 
-TOLERANCE = 1e-9  # m, m/s: the FMU computes pd's gains in closed form, pd with acker
+TOLERANCE = 1e-9  # m, m/s: the FMU computes pd's gains as ω² and 2ζω, pd from the poles
 
 
 def fly(overrides):

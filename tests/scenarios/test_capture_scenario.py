@@ -1,7 +1,7 @@
 """The capture scenario (scenarios/debris_capture.yaml) cut short: the base starts at its
 standoff and the target is turned as it is when the shipped run asks its planner, so
 the whole capture (observe, intercept, grasp, latch, detumble) flies in about 20 s of
-simulated time instead of 88; then the capture's refusals and aborts."""
+simulated time instead of 105; then the capture's refusals and aborts."""
 
 from __future__ import annotations
 

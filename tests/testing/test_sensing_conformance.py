@@ -12,6 +12,7 @@ from dcsim_plugins.trackers.kalman import KalmanTracker
 from dcsim.api import (
     AttitudeReading,
     Detection,
+    ObjectTrack,
     PluginParams,
     RateReading,
     SensorModel,
@@ -154,6 +155,17 @@ class OverconfidentTracker(KalmanTracker):
         return tuple(dataclasses.replace(t, covariance=t.covariance / 100.0) for t in tracks)
 
 
+class OverwideTracker(KalmanTracker):
+    name = "overwide"
+    summary = "Claims a shape margin wider than its tracks' radius (test)"
+
+    def update(self, time, detections, robot):
+        tracks = super().update(time, detections, robot)
+        return tuple(
+            ObjectTrack.trusted(**{**t.__dict__, "shape_margin": t.radius + 0.5}) for t in tracks
+        )
+
+
 class LaggingTracker(KalmanTracker):
     name = "lagging"
     summary = "Answers the previous tick's tracks (test)"
@@ -186,6 +198,7 @@ def test_plain_plugins_keep_every_contract(plugin):
         (VagueTracker, {"keeps_the_detected_objects"}),
         (OverconfidentTracker, {"follows_within_its_covariance"}),
         (LaggingTracker, {"keeps_the_detected_objects"}),
+        (OverwideTracker, {"keeps_the_detected_objects"}),
     ],
     ids=lambda value: getattr(value, "name", None) or "-".join(sorted(value)),
 )

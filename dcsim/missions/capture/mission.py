@@ -2,12 +2,11 @@
 
 Modes::
 
-    ACQUIRE ─target's tumble tracked─► APPROACH ─base at the standoff─► OBSERVE
+    ACQUIRE ─watched acquisition_time─► APPROACH ─base at the standoff─► OBSERVE
         ─watched, path planned─► INTERCEPT ─end effector on the fixture─► GRASP
         ─grip held─► DETUMBLE ─stack still─► CAPTURED
-          │ not tracked            │ no path               │ grip not held
-          ▼                        ▼                       ▼
-        ABORT ◄──────────────────────────────────────────────┘
+
+    ACQUIRE (target not tracked), OBSERVE (no path), GRASP (grip not held) ─► ABORT
 
 - **ACQUIRE**: the robot holds at its start while the tracker follows the target, for
   ``acquisition_time`` (no wait for an exact track, under ideal object sensing); then

@@ -43,7 +43,7 @@ class CaptureMissionSection(MissionSettings):
     acquisition_time: float = quantity(
         10.0,
         unit="s",
-        ge=0,
+        gt=0,
         description="Time the tracker follows the target from the start before the standoff "
         "is chosen from its track (no wait when the track is exact, under ideal object "
         "sensing).",
