@@ -93,6 +93,7 @@ class CaptureRig:
         self._arm = arm
         self.gripper = Gripper(client, arm.body, gripper)
         self.target = TumblingBody(client, target, physics_step)
+        self._target_shape = target.shape.build()  # its exact tracks' shape
         held = {self.gripper.palm, *self.gripper.pads}
         for link in range(-1, pb.getNumJoints(arm.body, physicsClientId=client)):
             if link not in held:
@@ -190,7 +191,7 @@ class CaptureRig:
             position=state.position,
             velocity=state.velocity,
             mass=spec.mass,
-            shape=spec.shape.build(),
+            shape=self._target_shape,
             attitude=state.attitude,
             angular_velocity=state.angular_velocity,
             inertia=self.target.inertia,

@@ -828,12 +828,7 @@ class World:
         if not self._robot.n_joints:
             return observed
         angles, rates = self._robot.joint_state()  # noise-free encoders
-        tracks = observed.tracks
-        if self.capture is not None and self.sensing.ideal_objects:
-            tracks = (*tracks, self.capture.target_track(self.time))
-        return dataclasses.replace(
-            observed, joint_positions=angles, joint_velocities=rates, tracks=tracks
-        )
+        return dataclasses.replace(observed, joint_positions=angles, joint_velocities=rates)
 
     def motion_input(self) -> MotionInput:
         """Mean thrust acceleration applied over the last control period."""

@@ -65,6 +65,10 @@ CARGO_CLEARANCE = 0.1
 #: keep-out's radius.
 KEEP_OUT_EXIT = 1.1
 
+#: Where a collector leaving a keep-out counts as out of it, as a multiple of the
+#: keep-out's radius: half-way to the held point.
+KEEP_OUT_LEFT = 0.5 * (1.0 + KEEP_OUT_EXIT)
+
 
 class Mode(enum.IntEnum):
     """Mission modes, with the integer each is reported as."""
@@ -280,31 +284,28 @@ class DebrisMission(Mission):
             inside = np.flatnonzero(distances < radii)
             if not len(inside):
                 break
-            i = inside[0]  # away from its centre (along x from the centre itself)
+            i = inside[0]  # away from its centre (along x from the centre itself: unit())
             point = centres[i] + KEEP_OUT_EXIT * radii[i] * unit(offsets[i])
         return point
 
     def _may_plan(self) -> bool:
         """Whether a path may be asked for now: not before the retry time and, after a
         refusal, not while the robot is still inside an obstacle's keep-out on its way
-        to a held point clear of them all (a planner would refuse that start again; it
-        counts as out half-way from the keep-out's edge to the held point's distance,
-        beyond the estimate's jitter). It
-        waits no longer than its refusals would have taken (``max_plan_attempts`` times
-        ``path_retry``), nor at all when keep-outs crowd the held point."""
-        if self.time < self.retry_at or self.refusals == 0:
-            return self.time >= self.retry_at
+        to a held point clear of them all (a planner would refuse that start again). It
+        counts as out at :data:`KEEP_OUT_LEFT` times a keep-out's radius, beyond the
+        estimate's jitter; it waits no longer than its refusals would have taken
+        (``max_plan_attempts`` times ``path_retry``), nor at all when keep-outs crowd
+        the held point."""
+        if self.time < self.retry_at:
+            return False
         waited = self.time - self.retry_at
-        if (
-            self.hold is None
-            or waited >= self.settings.max_plan_attempts * self.settings.path_retry
-        ):
+        patience = self.settings.max_plan_attempts * self.settings.path_retry
+        if self.refusals == 0 or self.hold is None or waited >= patience:
             return True
         centres, radii = self._keep_outs()
         held_clear = bool(np.all(row_lengths(self.hold - centres) >= radii))
         distances = row_lengths(self.estimate.position - centres)
-        robot_clear = bool(np.all(distances >= 0.5 * (1.0 + KEEP_OUT_EXIT) * radii))
-        return robot_clear or not held_clear
+        return bool(np.all(distances >= KEEP_OUT_LEFT * radii)) or not held_clear
 
     def _new_target(self) -> ObjectTrack | None:
         return next((t for t in self._free_targets() if t.id not in self.planned), None)

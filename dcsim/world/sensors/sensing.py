@@ -10,7 +10,8 @@ exact tracks of the objects in sensor range (each with its true shape and motion
 
 A world with a tumbling body (a capture's target) shows it to the object sensor as one
 more object after the field's, with its attitude and catalogue inertia; under ideal
-object sensing the world adds its exact track itself.
+object sensing its exact track (rotation and inertia included) follows the field's
+tracks, wherever the robot is.
 """
 
 from __future__ import annotations
@@ -260,6 +261,8 @@ class Sensing:
         ranges = self.beacon_ranges(truth)
         if self.ideal_objects:
             tracks: tuple[ObjectTrack, ...] = tuple(self.object_tracks(time, position))
+            if self._capture is not None:  # the tumbling body's exact track, rotation too
+                tracks = (*tracks, self._capture.target_track(time))
             detections: tuple[Detection, ...] = ()
         else:
             tracks = ()
