@@ -23,7 +23,8 @@ Parameters
 Missions (docs/plugins.md, "Writing a mission")
     :class:`Mission` (the task side of a run), :class:`MissionSettings` (its scenario
     section), :class:`MissionWorld` (what a mission may use of the world, for its type
-    hints), :func:`register_mission` (a mission class made at run time; a
+    hints), :class:`RoleKind` (the plugin kind of a role not named after one),
+    :func:`register_mission` (a mission class made at run time; a
     distribution declares its missions in the ``dcsim.missions`` entry point group).
 Messages
     The robot: :class:`RobotState`, :class:`StateEstimate`, :class:`Prior`,
@@ -186,7 +187,7 @@ from dcsim.minimum_jerk import (
     shortest_duration,
 )
 from dcsim.missions import Mission, register_mission
-from dcsim.missions.base import MissionWorld
+from dcsim.missions.base import MissionWorld, RoleKind
 from dcsim.motion import (
     ClohessyWiltshireMotion,
     LinearMotion,
@@ -356,6 +357,7 @@ __all__ = [
     "Mission",
     "MissionWorld",
     "MissionSettings",
+    "RoleKind",
     "MotionInput",
     "MotionModel",
     "NoPath",

@@ -23,7 +23,7 @@ import importlib.metadata as md
 import warnings
 
 from dcsim.errors import PluginLoadWarning
-from dcsim.missions.base import Mission
+from dcsim.missions.base import Mission, RoleKind
 from dcsim.registry.discovery import BUILTIN_DISTRIBUTION
 from dcsim.registry.interfaces import PLUGIN_KINDS
 from dcsim.scenario.model import Scenario
@@ -99,19 +99,29 @@ def mission_types() -> dict[str, type[Mission]]:
     return {**_installed(), **_REGISTERED}
 
 
-def scenario_roles(scenario: Scenario) -> tuple[str, ...]:
-    """The plugin roles a scenario's run uses, in data-flow order.
+def scenario_roles(scenario: Scenario) -> dict[str, RoleKind]:
+    """The plugin roles a scenario's run uses, in data-flow order, each with the plugin
+    kind it takes and the robot type its plugin must support.
 
     Those its mission uses for which the scenario names a plugin (a role the mission's
     ``role_defaults`` list may be null: none), and the tracker when an object sensor
-    has a model.
+    has a model. Roles of one kind keep the mission's order.
     """
     mission = mission_class(scenario.mission.type)
-    roles = {*mission.roles, *mission.Settings.role_defaults}
-    used = {role for role in roles if getattr(scenario, role, None) is not None}
+    roles = dict.fromkeys((*mission.roles, *mission.Settings.role_defaults))
+    used = [role for role in roles if getattr(scenario, role, None) is not None]
     if sensor_choices(scenario.sensors)["objects"] is not None:
-        used.add("tracker")  # detections become tracks
-    return tuple(role for role in PLUGIN_KINDS if role in used)
+        used.append("tracker")  # detections become tracks
+    kinds = {role: role_kind(mission, role, scenario.robot.type) for role in used}
+    order = list(PLUGIN_KINDS)
+    return dict(sorted(kinds.items(), key=lambda item: order.index(item[1].kind)))
+
+
+def role_kind(mission: type[Mission], role: str, robot: str) -> RoleKind:
+    """The plugin kind of ``mission``'s ``role`` and the robot type its plugin must
+    support (``robot``, the scenario's, unless the mission names another)."""
+    kind = mission.role_kinds.get(role, RoleKind(role))
+    return RoleKind(kind.kind, kind.robot or robot)
 
 
 def mission_class(mission_type: str) -> type[Mission]:
@@ -128,8 +138,10 @@ def mission_class(mission_type: str) -> type[Mission]:
 __all__ = [
     "MISSION_GROUP",
     "Mission",
+    "RoleKind",
     "mission_class",
     "mission_types",
     "register_mission",
+    "role_kind",
     "scenario_roles",
 ]

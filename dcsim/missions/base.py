@@ -18,7 +18,7 @@ import warnings
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, ClassVar, Protocol
+from typing import TYPE_CHECKING, Any, ClassVar, NamedTuple, Protocol
 
 import numpy as np
 
@@ -98,6 +98,27 @@ class MissionWorld(Protocol):
         ...
 
 
+class RoleKind(NamedTuple):
+    """The plugin kind a mission's role takes, and the robot type its plugin must support.
+
+    A role named after a plugin kind (``path_planner``, ``controller``...) takes that
+    kind for the scenario's robot. A mission names its other roles in
+    :attr:`Mission.role_kinds`: a second path planner, say, that plans a manipulator's
+    base as a free flyer (``RoleKind("path_planner", "free-flyer")``).
+
+    Attributes
+    ----------
+    kind : str
+        A plugin kind (a key of :data:`~dcsim.registry.interfaces.PLUGIN_KINDS`).
+    robot : str or None
+        The robot type (``robot.type``) the role's plugin must support; None: the
+        scenario's robot.
+    """
+
+    kind: str
+    robot: str | None = None
+
+
 class Mission(ABC):
     """Base of every mission type.
 
@@ -123,7 +144,10 @@ class Mission(ABC):
     roles : tuple of str
         Plugin roles the mission needs, in data-flow order; a role its ``Settings``
         make optional (``role_defaults`` of None) is used when the scenario names a
-        plugin for it (without a localiser the mission is fed the true state).
+        plugin for it (without a localiser the mission is fed the true state). A role
+        is a plugin kind's name, or a name of :attr:`role_kinds`.
+    role_kinds : mapping of str to RoleKind
+        The kind of each role that is not named after a plugin kind (none by default).
     modes : tuple of str
         The mission's modes; :attr:`mode` is one of them (telemetry records its name,
         FMU outputs its index).
@@ -146,6 +170,7 @@ class Mission(ABC):
     summary: ClassVar[str]
     Settings: ClassVar[builtins.type[MissionSettings]]
     roles: ClassVar[tuple[str, ...]]
+    role_kinds: ClassVar[Mapping[str, RoleKind]] = {}
     modes: ClassVar[tuple[str, ...]]
     columns: ClassVar[tuple[str, ...]] = ()
     units: ClassVar[Mapping[str, str]] = {}

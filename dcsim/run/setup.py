@@ -58,8 +58,8 @@ class RunSetup:
         from dcsim.missions import scenario_roles  # missions load the world engine
 
         sources = {
-            role: registry.get(role, getattr(scenario, role).plugin)
-            for role in scenario_roles(scenario)
+            role: registry.get(kind, getattr(scenario, role).plugin)
+            for role, (kind, _) in scenario_roles(scenario).items()
         }
         plugins = {
             role: entry.cls(

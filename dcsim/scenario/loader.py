@@ -231,10 +231,10 @@ def resolve_plugins(
             f"(it supports: {', '.join(mission.robots)})"
         )
         problems.append(doc.problem(("mission", "type"), message))
-    for role in scenario_roles(scenario):
+    for role, (kind, plans_for) in scenario_roles(scenario).items():
         choice = getattr(scenario, role)
         try:
-            cls = registry.get(role, choice.plugin).cls
+            cls = registry.get(kind, choice.plugin).cls
             params = cls.Params.parse(choice.plugin, choice.params)
         except PluginParameterError as exc:
             problems += [doc.problem((role, "params", p.path), p.message) for p in exc.problems]
@@ -242,12 +242,13 @@ def resolve_plugins(
         except DcsimError as exc:
             problems.append(doc.problem((role, "plugin"), str(exc)))
             continue
-        if robot not in cls.robots:
+        if plans_for not in cls.robots:
+            which = "" if plans_for == robot else f", which the {role} plans for"
             problems.append(
                 doc.problem(
                     (role, "plugin"),
-                    f"{role} plugin '{choice.plugin}' does not support robot type '{robot}' "
-                    f"(it supports: {', '.join(cls.robots)})",
+                    f"{role} plugin '{choice.plugin}' does not support robot type "
+                    f"'{plans_for}'{which} (it supports: {', '.join(cls.robots)})",
                 )
             )
             continue

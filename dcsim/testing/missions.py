@@ -124,8 +124,9 @@ def _fly(setup: RunSetup, out: Path) -> dict[str, Any]:
 @mission_check(
     "declares_its_seam",
     "`type` is a lower-case name its settings' `type` defaults to, `summary` one line, "
-    "`Settings` a MissionSettings subclass, `roles` plugin kinds, `modes` at least one "
-    "name, `units` only for its `columns`, `robots` known robot types",
+    "`Settings` a MissionSettings subclass, `roles` plugin kinds or roles its `role_kinds` "
+    "give a kind, `modes` at least one name, `units` only for its `columns`, `robots` known "
+    "robot types",
 )
 def check_declarations(mission: type[Mission], scenario: ScenarioSource) -> None:
     settings = getattr(mission, "Settings", None)
@@ -137,9 +138,18 @@ def check_declarations(mission: type[Mission], scenario: ScenarioSource) -> None
     summary = getattr(mission, "summary", "")
     if not isinstance(summary, str) or not summary.strip() or "\n" in summary:
         fail(f"summary must be one line of text, got {summary!r}")
-    unknown_roles = set(mission.roles) - set(PLUGIN_KINDS)
+    role_kinds = getattr(mission, "role_kinds", {})
+    unknown_roles = set(mission.roles) - set(PLUGIN_KINDS) - set(role_kinds)
     if unknown_roles:
-        fail(f"roles {sorted(unknown_roles)} are not plugin kinds ({', '.join(PLUGIN_KINDS)})")
+        fail(
+            f"roles {sorted(unknown_roles)} are neither plugin kinds ({', '.join(PLUGIN_KINDS)}) "
+            "nor named in its role_kinds"
+        )
+    unknown_kinds = {
+        role: kind for role, (kind, _) in role_kinds.items() if kind not in PLUGIN_KINDS
+    }
+    if unknown_kinds:
+        fail(f"role_kinds {unknown_kinds} name no plugin kind ({', '.join(PLUGIN_KINDS)})")
     if not mission.modes or not all(isinstance(m, str) for m in mission.modes):
         fail(f"modes must be a non-empty tuple of names, got {mission.modes!r}")
     unknown_robots = set(mission.robots) - set(ROBOT_TYPES)

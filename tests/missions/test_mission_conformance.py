@@ -14,7 +14,7 @@ import pytest
 import yaml
 from pydantic import ConfigDict, Field
 
-from dcsim.api import Mission, MissionSettings, Reference, register_mission
+from dcsim.api import Mission, MissionSettings, Reference, RoleKind, register_mission
 from dcsim.missions import mission_class
 from dcsim.testing.missions import MISSION_CHECKS, MissionContract, check_mission
 from tests.conftest import REPO
@@ -101,6 +101,27 @@ class MislabelledMission(StillMission):
     type = "mislabelled"  # its Settings' type is still "still"
 
 
+class UnnamedRoleSettings(StillSettings):
+    type: Literal["unnamed-role"] = "unnamed-role"
+
+
+class UnnamedRoleMission(StillMission):
+    type = "unnamed-role"
+    Settings = UnnamedRoleSettings
+    roles = ("controller", "docking_planner")  # not a kind, and no role_kinds entry
+
+
+class UnknownKindSettings(StillSettings):
+    type: Literal["unknown-kind"] = "unknown-kind"
+
+
+class UnknownKindMission(StillMission):
+    type = "unknown-kind"
+    Settings = UnknownKindSettings
+    roles = ("controller", "docking_planner")
+    role_kinds = {"docking_planner": RoleKind("docking_planner")}  # no such kind
+
+
 STILL = {"world": {"frame": "geocentric", "duration": 3}, "mission": {"type": "still"}}
 
 
@@ -134,8 +155,29 @@ def scenario(mission_type: str = "still", **settings) -> dict:
             {"declares_its_seam"},
             "its Settings' type defaults to 'still', not to its type 'mislabelled'",
         ),
+        (
+            UnnamedRoleMission,
+            scenario("unnamed-role"),
+            {"declares_its_seam"},
+            "roles ['docking_planner'] are neither plugin kinds",
+        ),
+        (
+            UnknownKindMission,
+            scenario("unknown-kind"),
+            {"declares_its_seam"},
+            "role_kinds {'docking_planner': 'docking_planner'} name no plugin kind",
+        ),
     ],
-    ids=["keeps", "unseeded", "stray-mode", "lenient", "faulty", "mislabelled"],
+    ids=[
+        "keeps",
+        "unseeded",
+        "stray-mode",
+        "lenient",
+        "faulty",
+        "mislabelled",
+        "unnamed-role",
+        "unknown-kind",
+    ],
 )
 def test_a_broken_mission_is_caught_by_the_check_naming_what_it_did(mission, data, failing, said):
     results = {r.check: r for r in check_mission(mission, data)}
