@@ -101,7 +101,7 @@ def _builtin_missions() -> list[type[MissionSettings]]:
 
 def _sections() -> dict[type[BaseModel], list[str]]:
     """Every model class reachable from the default scenario and the other built-in
-    missions' sections, with the key paths it appears at."""
+    missions' sections, with the key paths it appears at (a plugin role at its key)."""
     default, *missions = _builtin_missions()
     root = scenario_model(default)
     paths: dict[type[BaseModel], list[str]] = {root: [""]}
@@ -120,6 +120,8 @@ def _sections() -> dict[type[BaseModel], list[str]]:
                     queue.append((child, cls))
                 if child not in paths[cls]:  # two robot types' sections share a path
                     paths[cls].append(child)
+    for section in missions:  # the roles only another mission names (capture's approach)
+        paths[PluginChoice] += [r for r in section.role_defaults if r not in paths[PluginChoice]]
     return paths
 
 

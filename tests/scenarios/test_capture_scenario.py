@@ -6,13 +6,27 @@ simulated time instead of 105; then the capture's refusals and aborts."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 import pytest
 import yaml
 
-from dcsim.api import RunResult, ScenarioError, load_scenario, run
+from dcsim.api import (
+    NoPath,
+    PathPlanner,
+    PathProblem,
+    RunResult,
+    ScenarioError,
+    ShapeKind,
+    close_run,
+    load_scenario,
+    manipulator_model,
+    open_run,
+    run,
+)
 from tests.conftest import CAPTURE, short_capture
+from tests.test_runner import registry_with
 
 OBSERVATION = 0.5
 """Observation time (s) of the short run."""
@@ -40,7 +54,9 @@ def test_the_capture_passes_every_mode_in_order(capture):
     modes = [e["mode"] for e in named(capture, "mode")]
     assert [named(capture, "mode")[0]["previous"], *modes] == list(MODES)
     order = [e["event"] for e in capture.events if e["event"] != "mode"]
-    assert order == ["path", "gripper_closing", "contact", "latched", "detumbled"]
+    # the short run starts at its standoff, inside the approach planner's keep-out
+    expected = ["approach_within_keep_out", "path", "gripper_closing", "contact", "latched"]
+    assert order == [*expected, "detumbled"]
     assert capture.status == "completed"
     assert capture.summary["reason"] == "target captured and detumbled"
     assert capture.summary["sim_time_s"] < DURATION
@@ -103,10 +119,11 @@ def test_a_capture_in_the_lvlh_frame_is_refused_by_the_cli(dcsim_cli):
 
 
 def test_a_body_striking_the_base_is_named_in_an_event_and_counted():
-    """The target drifting into the back of the base (the shipped start at [-7, 0, 0],
+    """The target drifting into the back of the base (the shipped start, on the x axis,
     a 1 m cube; the cylinder's side 5 cm off it): the mission names the base once in an
     ``arm_contact`` event and the summary counts one link struck."""
-    start = [-7.0 - 0.5 - 1.2 - 0.05, 0.0, 0.0]
+    base = load_scenario(CAPTURE).robot.initial.position[0]
+    start = [base - 0.5 - 1.2 - 0.05, 0.0, 0.0]
     overrides = {
         "mission.target.position": start,
         "mission.target.velocity": [0.1, 0.0, 0.0],
@@ -118,6 +135,7 @@ def test_a_body_striking_the_base_is_named_in_an_event_and_counted():
     assert result.summary["arm_links_struck"] == 1
 
 
+@pytest.mark.filterwarnings("ignore::dcsim.errors.PlanOutlastsRunWarning")  # cut short
 def test_the_standoff_waits_for_the_tracker_and_an_exact_track_does_not():
     """Under the shipped object sensor the robot holds at its start for the acquisition
     time while the tracker learns the tumble; with the truth as the track it leaves at
@@ -136,7 +154,7 @@ def test_the_standoff_waits_for_the_tracker_and_an_exact_track_does_not():
 
 
 def test_a_target_the_sensor_cannot_see_aborts_the_capture_before_the_approach():
-    """An object sensor of 1 m range never detects the body 7 m away: the capture aborts
+    """An object sensor of 1 m range never detects the body 8 m away: the capture aborts
     at the end of the acquisition, naming why, and the base never leaves its start."""
     overrides = {
         "robot.sensor_range": 1.0,
@@ -167,3 +185,126 @@ def test_the_sensed_detumble_is_the_world_s(capture):
     # and the world's target crosses the limit when the sensed rates do, within 0.05 s
     before = (times > detumbled["t"] - 1.05) & (times <= detumbled["t"] - 1.0 + 1e-9)
     assert telemetry.loc[before, "target_rate_radps"].max() > limit
+
+
+FAR_SIDE = [9.0, 0.0, 0.0]
+"""A start on the far side of the target from its standoff (m): the shipped target's
+angular momentum, and so the standoff, points along -x."""
+
+
+def test_an_approach_through_the_tumble_is_refused_before_the_base_moves():
+    """From the far side the straight approach would fly through the tumbling body (it
+    struck the base at 110 s when the approach was a straight move); the approach
+    planner refuses it and the capture aborts, naming why, before the base moves."""
+    overrides = {"robot.initial.position": FAR_SIDE, "sensors.objects": None}
+    result = run(CAPTURE, {**overrides, "world.duration": 0.5}, plots=False)
+    (refusal,) = named(result, "no_path")
+    assert (refusal["t"], refusal["role"]) == (0.0, "approach_planner")
+    assert refusal["reason"].startswith("the straight path passes")
+    (abort,) = named(result, "abort")
+    assert abort["reason"] == f"no approach path: {refusal['reason']}"
+    moved = result.telemetry[["x_m", "y_m", "z_m"]].to_numpy() - np.asarray(FAR_SIDE)
+    assert np.abs(moved).max() < 1e-6
+    assert result.status == "stopped"
+
+
+@pytest.mark.filterwarnings("ignore::dcsim.errors.PlanOutlastsRunWarning")  # cut short
+def test_a_planned_approach_keeps_the_arm_clear_of_the_tumble_s_sweep():
+    """An approach planner that goes round obstacles (ant-colony) takes the base from
+    the far side to the gate with its held arm clear of the sphere the tumbling body
+    sweeps, by the approach clearance; the straight line it replaces passes within a
+    metre of the body's centre."""
+    overrides = {
+        "robot.initial.position": FAR_SIDE,
+        "sensors.objects": None,
+        "approach_planner.plugin": "ant-colony",
+        "world.duration": 1.0,
+    }
+    runner = open_run(CAPTURE, overrides, plots=False)
+    try:
+        path, gate = runner.mission.approach_path, runner.mission.standoff.gate
+    finally:
+        close_run(runner)
+    scenario = load_scenario(CAPTURE)
+    target, robot = scenario.mission.target, scenario.robot
+    model = manipulator_model(robot.dh_robot())
+    ready = np.concatenate(
+        [FAR_SIDE, [0.0, 0.0, 0.0, 1.0], np.radians(robot.initial.joint_angles_deg)]
+    )
+    kinematics = model.kinematics(ready)
+    arm = np.linalg.norm(kinematics.end_effector - kinematics.base_position) + robot.gripper.reach
+    keep_out = target.shape.build().bounding_radius + arm + scenario.mission.approach_clearance
+    times = np.linspace(path.times[0], path.times[-1], 20_001)
+    positions, _ = path.sample(times)
+    centre = np.asarray(target.position)
+    assert np.linalg.norm(positions - centre, axis=1).min() >= keep_out
+    assert np.linalg.norm(positions[-1] - gate) < 1e-6
+    line = np.linspace(0.0, 1.0, 1001)[:, None] * (gate - FAR_SIDE) + FAR_SIDE
+    assert np.linalg.norm(line - centre, axis=1).min() < 1.0
+
+
+def test_the_approach_planner_plans_a_free_flyer_and_must_be_named():
+    """The approach planner plans the base as a free flyer: a manipulator-only planner
+    is refused there, naming the role; a capture without one is refused too."""
+    data = yaml.safe_load(CAPTURE.read_text(encoding="utf-8"))
+    with pytest.raises(ScenarioError) as wrong:
+        load_scenario({**data, "approach_planner": {"plugin": "fixture-intercept"}})
+    assert (
+        "approach_planner.plugin: approach_planner plugin 'fixture-intercept' does not support "
+        "robot type 'free-flyer', which the approach_planner plans for (it supports: "
+        "manipulator)"
+    ) in str(wrong.value)
+    with pytest.raises(ScenarioError) as missing:
+        load_scenario({**data, "approach_planner": None})
+    assert "approach_planner: a capture needs an approach planner" in str(missing.value)
+
+
+class RecordingPlanner(PathPlanner):
+    """Records the problems it is given and refuses them (test)."""
+
+    name = "recording"
+    summary = "Records its problems and refuses them (test)"
+    robots = ("free-flyer", "manipulator")
+    problems: ClassVar[list[PathProblem]] = []
+
+    def plan(self, problem: PathProblem) -> NoPath:
+        self.problems.append(problem)
+        return NoPath("recorded")
+
+
+def test_the_approach_problem_keeps_the_held_arm_clear_of_the_tumble():
+    """The approach planner is asked for the base's flight to the gate with the target as
+    a sphere of its bounding radius (all it sweeps while it tumbles) at rest where its
+    track puts it (as the standoff and the gate take it), the robot as a
+    sphere holding its base and its held arm with the gripper, and the approach
+    clearance as the safety margin; the gate lies on the standoff's line, twice the
+    clearance beyond touching, and as far below the target's centre as the standoff."""
+    RecordingPlanner.problems.clear()
+    overrides = {"approach_planner.plugin": "recording", "sensors.objects": None}
+    result = run(
+        CAPTURE,
+        {**overrides, "world.duration": 0.5},
+        plots=False,
+        registry=registry_with(RecordingPlanner),
+    )
+    assert named(result, "abort")[0]["reason"] == "no approach path: recorded"
+    (problem,) = RecordingPlanner.problems
+    scenario = load_scenario(CAPTURE)
+    target, robot, mission = scenario.mission.target, scenario.robot, scenario.mission
+    (obstacle,) = problem.obstacles
+    radius = target.shape.build().bounding_radius
+    assert obstacle.shape.kind is ShapeKind.SPHERE and obstacle.radius == pytest.approx(radius)
+    assert np.allclose(obstacle.position, target.position)
+    assert not np.any(obstacle.velocity) and obstacle.motion is None  # at rest, as the gate
+    start = np.concatenate(
+        [robot.initial.position, [0.0, 0.0, 0.0, 1.0], np.radians(robot.initial.joint_angles_deg)]
+    )
+    kinematics = manipulator_model(robot.dh_robot()).kinematics(start)
+    arm = np.linalg.norm(kinematics.end_effector - kinematics.base_position)
+    assert problem.robot_radius > arm + robot.gripper.reach
+    assert problem.safety_margin == mission.approach_clearance
+    assert problem.model is None  # the base, as a free flyer
+    out = radius + problem.robot_radius + 2.0 * mission.approach_clearance  # along the axis
+    below = mission.standoff_height  # along the base's z axis, square to it
+    distance = np.linalg.norm(problem.goal.position - target.position)
+    assert distance == pytest.approx(np.hypot(out, below), rel=1e-12)

@@ -351,11 +351,12 @@ def test_the_latch_holds_the_target_to_the_palm():
 # ---------------------------------------------------------------- the arm strikes the body
 def test_a_body_drifting_into_the_base_strikes_it_and_the_reading_names_the_base():
     """The arm's base and its links other than the gripper's collide with the tumbling
-    body: a body drifting at 0.1 m/s into the base (the shipped base at [-7, 0, 0], a
-    1 m cube; the cylinder's side 5 cm off its back face) stops being free, pushes with a
+    body: a body drifting at 0.1 m/s into the base (the shipped base, a 1 m cube, on the
+    x axis; the cylinder's side 5 cm off its back face) stops being free, pushes with a
     recorded force, and the period's reading names the base and only it."""
     gap = 0.05
-    start = [-7.0 - 0.5 - 1.2 - gap, 0.0, 0.0]  # behind the base, away from the arm
+    base = SHIPPED["robot"]["initial"]["position"][0]
+    start = [base - 0.5 - 1.2 - gap, 0.0, 0.0]  # behind the base, away from the arm
     with capture_world(position=start, velocity=[0.1, 0.0, 0.0]) as w:
         rig = w.capture
         struck: set[int] = set()

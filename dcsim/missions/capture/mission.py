@@ -6,17 +6,22 @@ Modes::
         ─watched, path planned─► INTERCEPT ─end effector on the fixture─► GRASP
         ─grip held─► DETUMBLE ─stack still─► CAPTURED
 
-    ACQUIRE (target not tracked), OBSERVE (no path), GRASP (grip not held) ─► ABORT
+    ACQUIRE (target not tracked, no approach path), OBSERVE (no path),
+    GRASP (grip not held) ─► ABORT
 
 - **ACQUIRE**: the robot holds at its start while the tracker follows the target, for
   ``acquisition_time`` (no wait for an exact track, under ideal object sensing); then
-  the standoff point is chosen from the target's track. A target whose rotation is not
-  tracked by then aborts the capture.
-- **APPROACH**: the base flies from its start to the standoff point, ``standoff`` from
-  the target's centre of mass along its angular momentum as the track gives it (the
-  fixture's side) and ``standoff_height`` below it along the base's z axis, by a
-  minimum-jerk move within ``approach_speed`` and ``approach_acceleration``, turning its
-  arm side to face the target; the arm holds its start configuration.
+  the standoff point is chosen from the target's track, and the approach planner is
+  asked for the base's flight to the gate. A target whose rotation is not tracked by
+  then, or a refused flight, aborts the capture.
+- **APPROACH**: the standoff point is ``standoff`` from the target's centre of mass
+  along its angular momentum as the track gives it (the fixture's side) and
+  ``standoff_height`` below it along the base's z axis. The base flies the approach
+  planner's path to the gate on the same line, clear of the sphere the tumbling body
+  sweeps by ``approach_clearance`` (a robot that starts inside that keep-out is not
+  planned for), then moves straight in along the axis to the standoff by a minimum-jerk
+  move within ``approach_speed`` and ``approach_acceleration``, turning its arm side to
+  face the target; the arm holds its start configuration.
 - **OBSERVE**: the base holds there for ``observation_time`` while the target's track
   is watched; then the path planner is asked for the end effector's trajectory onto
   the fixture (a :class:`~dcsim.messages.PathProblem` with a
@@ -46,6 +51,7 @@ base's angular rates and the base's turn from its attitude at the standoff.
 
 from __future__ import annotations
 
+import dataclasses
 import time as wallclock
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -70,16 +76,19 @@ from dcsim.messages import (
     PathProblem,
     Reference,
     RobotState,
+    Shape,
+    ShapeKind,
     StateEstimate,
+    Trajectory,
 )
 from dcsim.minimum_jerk import minimum_jerk_profile, shortest_duration
-from dcsim.missions.base import Emit, Mission, MissionWorld
+from dcsim.missions.base import Emit, Mission, MissionWorld, RoleKind
 from dcsim.missions.capture.settings import CaptureMissionSection
 from dcsim.registry.interfaces import Plugin
 from dcsim.robots.kinematics import rotation_matrix
 from dcsim.robots.manipulator import ManipulatorModel
 from dcsim.robots.pose_path import PosePath
-from dcsim.scenario.model import FixtureSpec, ManipulatorSection, Scenario
+from dcsim.scenario.model import GripperSpec, ManipulatorSection, Scenario
 
 TARGET_POSE_COLUMNS = (
     "target_x",
@@ -109,7 +118,9 @@ class CaptureMission(Mission):
     world : MissionWorld
         The world; it has a :class:`~dcsim.world.capture_rig.CaptureRig` (``capture``).
     plugins : mapping of str to Plugin
-        The path planner and the controller (and a localiser, if the scenario names one).
+        The approach planner (a path planner for the base as a free flyer), the path
+        planner of the arm's intercept and the controller (and a localiser, if the
+        scenario names one).
     emit : callable
         ``emit(event_name, **data)`` records an event.
     """
@@ -117,7 +128,8 @@ class CaptureMission(Mission):
     type = "capture"
     summary = "grasp a tumbling body with a space manipulator and detumble it"
     Settings = CaptureMissionSection
-    roles = ("path_planner", "controller")
+    roles = ("approach_planner", "path_planner", "controller")
+    role_kinds = {"approach_planner": RoleKind("path_planner", "free-flyer")}
     modes = (
         "ACQUIRE",
         "APPROACH",
@@ -195,10 +207,13 @@ class CaptureMission(Mission):
         robot = scenario.robot
         assert isinstance(robot, ManipulatorSection) and robot.gripper is not None
         self.gripper = robot.gripper
+        self.base_size = robot.size
         self.state = "ACQUIRE"
         self.start = world.robot_state()
         self.mount = np.array(robot.mount)
-        self.approach: _Approach | None = None
+        self.standoff: _Standoff | None = None
+        self.approach_path: Trajectory | None = None
+        self.final_move: _StraightMove | None = None
         self.held_since: float | None = None
         self.still_since: float | None = None
         self.hold_reference: Reference | None = None
@@ -248,30 +263,105 @@ class CaptureMission(Mission):
             if track is None:
                 self._abort(missing)
             else:
-                self.approach = _Approach(
-                    estimate.as_state(),
-                    track,
-                    self.settings.target.fixture,
-                    self.mount,
-                    self.settings,
-                )
-                self._go("APPROACH")
+                self._plan_approach(time, estimate.as_state(), track)
         return self._hold(self.start)
 
+    def _plan_approach(self, time: float, start: RobotState, track: ObjectTrack) -> None:
+        """Choose the standoff from the target's track and ask the approach planner for
+        the flight to its gate, clear of the target's bounding sphere.
+
+        The target's centre of mass is taken at rest where the track puts it now, as the
+        standoff and the gate are: the capture does not follow a drifting body."""
+        held = _held_radius(self._model(), start, self.base_size, self.gripper)
+        clearance = self.settings.approach_clearance
+        gate = max(self.settings.standoff, track.radius + held + 2.0 * clearance)
+        self.standoff = standoff = _Standoff(start, track, self.settings, self.mount, gate)
+        distance = float(np.linalg.norm(start.position - track.position))
+        keep_out = track.radius + held + clearance
+        if distance < keep_out:
+            self.emit("approach_within_keep_out", distance=distance, keep_out=keep_out)
+            self._go("APPROACH")
+            return
+        keep_out_track = dataclasses.replace(
+            track,
+            velocity=np.zeros(3),  # at rest, as the standoff and the gate take it
+            motion=None,
+            shape=Shape(ShapeKind.SPHERE, radius=track.radius),  # all a tumbling body sweeps
+        )
+        problem = PathProblem(
+            start=start,
+            goal=GoalRegion(position=standoff.gate, attitude=standoff.attitude),
+            obstacles=(keep_out_track,),
+            frame=self.scenario.frame_dynamics,
+            robot_radius=held,
+            robot_mass=self.world.robot_spec().mass,
+            max_speed=self.settings.approach_speed,
+            max_acceleration=self.settings.approach_acceleration,
+            time_budget=self.settings.planning_budget,
+            safety_margin=clearance,
+        )
+        result = self._ask("approach_planner", problem)
+        if isinstance(result, NoPath):
+            self._abort(f"no approach path: {result.reason}")
+            return
+        self.approach_path = result
+        self.emit("approach_path", duration=result.duration, length=result.length)
+        self.note_plan_end(time, float(result.times[-1]))
+        self._go("APPROACH")
+
+    def _ask(self, role: str, problem: PathProblem) -> Trajectory | NoPath:
+        """One of the path planners' answer, its wall time added to the planning time; a
+        refusal is recorded as a ``no_path`` event naming the role."""
+        began = wallclock.perf_counter()
+        result = self.call(role, "plan", problem)
+        self.planning_time += wallclock.perf_counter() - began
+        if isinstance(result, NoPath):
+            self.emit("no_path", role=role, reason=result.reason)
+        assert isinstance(result, Trajectory | NoPath)  # checked at the plugin boundary
+        return result
+
     def _approach(self, time: float, estimate: StateEstimate) -> Reference:
-        assert self.approach is not None  # chosen on the way out of ACQUIRE
-        reference = self.approach.reference(time)
-        if time >= self.approach.end_time:
+        """The planned flight to the gate (none from within the keep-out), then the
+        straight move in to the standoff."""
+        assert self.standoff is not None  # chosen on the way out of ACQUIRE
+        path = self.approach_path
+        if self.final_move is None:
+            if path is not None and time < path.times[-1]:
+                return self._follow_approach(path, time)
+            origin = (
+                self._hold(estimate.as_state())
+                if path is None
+                else self._follow_approach(path, float(path.times[-1]))
+            )
+            self.final_move = _StraightMove(
+                origin, self.standoff.point, self.standoff.attitude, self.settings
+            )
+        reference = self.final_move.reference(time)
+        if time >= self.final_move.end_time:
             self.times["observe"] = time
             self.standoff_attitude = estimate.attitude
             self._go("OBSERVE")
         return reference
 
+    def _follow_approach(self, path: Trajectory, time: float) -> Reference:
+        """The approach path's state at ``time``, the arm held; a path that leaves the
+        attitude free holds the start's."""
+        assert self.standoff is not None  # chosen with the path
+        state = path.state_at(time)
+        return Reference(
+            time=time,
+            position=state.position,
+            velocity=state.velocity,
+            attitude=self.standoff.start_attitude if path.attitudes is None else state.attitude,
+            angular_velocity=state.angular_velocity,
+            joint_positions=self.start.joint_positions,
+        )
+
     def _observe(
         self, time: float, estimate: StateEstimate, observations: Observations
     ) -> Reference:
-        assert self.approach is not None  # chosen on the way out of ACQUIRE
-        reference = self.approach.reference(time)
+        assert self.final_move is not None  # flown in APPROACH
+        reference = self.final_move.reference(time)
         observed = self.times["observe"]
         assert observed is not None
         if time - observed >= self.settings.observation_time:
@@ -285,12 +375,8 @@ class CaptureMission(Mission):
             self._abort(missing)
             return
         start = estimate.as_state()
-        problem = self._problem(start, track)
-        began = wallclock.perf_counter()
-        result = self.call("path_planner", "plan", problem)
-        self.planning_time += wallclock.perf_counter() - began
+        result = self._ask("path_planner", self._problem(start, track))
         if isinstance(result, NoPath):
-            self.emit("no_path", reason=result.reason)
             self._abort(f"no path: {result.reason}")
             return
         try:
@@ -538,27 +624,52 @@ def _joint_columns(scenario: Scenario) -> tuple[str, ...]:
     return tuple(f"joint_{i}" for i in range(1, len(links) + 1))
 
 
-class _Approach:
-    """The base's flight to the standoff point: a minimum-jerk move at rest at both ends,
-    turning the base's arm side (its mount's direction) to face the target.
+def _held_radius(
+    model: ManipulatorModel, state: RobotState, size: Sequence[float], gripper: GripperSpec
+) -> float:
+    """Radius of a sphere about the base's centre of mass holding the base and the arm in
+    ``state``'s configuration, m: the base's corners, the arm's frames, and the gripper's
+    pads ahead of the last one."""
+    kinematics = model.kinematics(state.configuration)
+    frames = float(np.max(np.linalg.norm(kinematics.origins - kinematics.base_position, axis=1)))
+    pads = gripper.reach + 0.5 * (gripper.opening + float(np.linalg.norm(gripper.pad_size)))
+    return max(0.5 * float(np.linalg.norm(size)), frames + pads)
+
+
+class _Standoff:
+    """Where the base stops to reach for the fixture, and the gate its planned flight
+    ends at.
 
     The standoff point lies on the target's angular momentum axis through its centre of
     mass, on the fixture's side: points of a tumbling body near that axis move least.
     A body that does not turn gives no axis; the fixture's approach axis stands in. The
-    target is as its track gives it (position, attitude, angular velocity and inertia):
-    ``track.attitude``, ``track.angular_velocity`` and ``track.inertia`` are set.
+    gate lies on the same line, ``gate_distance`` out; from it the base moves straight
+    in along the axis, where the body does not sweep. The target is as its track gives
+    it (position, attitude, angular velocity and inertia): ``track.attitude``,
+    ``track.angular_velocity`` and ``track.inertia`` are set.
+
+    Attributes
+    ----------
+    point, gate : ndarray (3,)
+        The standoff point and the gate, world frame, m.
+    attitude : ndarray (4,)
+        The base's attitude there: its arm side (the mount's direction) facing the
+        target, turned the least from ``start``'s.
+    start_attitude : ndarray (4,)
+        The attitude the approach starts from.
     """
 
     def __init__(
         self,
         start: RobotState,
         track: ObjectTrack,
-        fixture: FixtureSpec,
-        mount: np.ndarray,
         settings: CaptureMissionSection,
+        mount: np.ndarray,
+        gate_distance: float,
     ) -> None:
         assert track.attitude is not None and track.angular_velocity is not None
         assert track.inertia is not None  # _target_track answers only such tracks
+        fixture = settings.target.fixture
         rotation = rotation_matrix(track.attitude)
         momentum = rotation @ track.inertia @ rotation.T @ track.angular_velocity
         out = rotation @ np.array(fixture.position)
@@ -566,15 +677,32 @@ class _Approach:
         axis = momentum if np.linalg.norm(momentum) > 1e-9 else approach_axis
         axis = axis / np.linalg.norm(axis)
         axis = axis if axis @ out >= 0.0 else -axis
-        self.origin = start.position
         facing = rotate(start.attitude, mount) if np.linalg.norm(mount) > 0 else -axis
-        self.attitude = quaternion_multiply(quaternion_between(facing, -axis), start.attitude)
-        up = rotate(self.attitude, [0.0, 0.0, 1.0])
-        self.goal = track.position + settings.standoff * axis - settings.standoff_height * up
         self.start_attitude = start.attitude
-        self.joints = start.joint_positions
-        length = float(np.linalg.norm(self.goal - self.origin))
-        self.start_time = start.time
+        self.attitude = quaternion_multiply(quaternion_between(facing, -axis), start.attitude)
+        below = settings.standoff_height * rotate(self.attitude, [0.0, 0.0, 1.0])
+        self.point = track.position + settings.standoff * axis - below
+        self.gate = track.position + gate_distance * axis - below
+
+
+class _StraightMove:
+    """The base's move in from the gate to the standoff point: a minimum-jerk move at rest
+    at both ends within ``approach_speed`` and ``approach_acceleration``, turning onto
+    the standoff's attitude, the joints held as ``origin``'s."""
+
+    def __init__(
+        self,
+        origin: Reference,
+        goal: np.ndarray,
+        attitude: np.ndarray,
+        settings: CaptureMissionSection,
+    ) -> None:
+        assert origin.attitude is not None and origin.joint_positions is not None
+        self.origin, self.goal = origin.position, goal
+        self.start_attitude, self.attitude = origin.attitude, attitude
+        self.joints = origin.joint_positions
+        length = float(np.linalg.norm(goal - origin.position))
+        self.start_time = origin.time
         self.duration = max(
             shortest_duration(length, settings.approach_speed, settings.approach_acceleration),
             1e-9,
@@ -582,7 +710,7 @@ class _Approach:
         self.end_time = self.start_time + self.duration
 
     def reference(self, time: float) -> Reference:
-        """The base on its move at ``time`` (s), the joints as at the start."""
+        """The base on its move at ``time`` (s), the joints held."""
         tau = (time - self.start_time) / self.duration
         shape, rate, curve = minimum_jerk_profile(tau, self.duration)
         offset = self.goal - self.origin

@@ -26,18 +26,16 @@ def frame_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
     ]
 
 
-def path_planner_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
-    """A capture plans its arm's intercept: it needs a path planner."""
-    if get("path_planner") is not None:
-        return []
-    return [
-        (
-            ("path_planner",),
-            "a capture needs a path planner for the arm's intercept of the fixture: "
-            "`fixture-intercept` (the default) or one of your own",
-        )
-    ]
+def planner_rule(get: ScenarioValues) -> list[tuple[KeyPath, str]]:
+    """A capture plans its base's approach and its arm's intercept: it needs both planners."""
+    needs = {
+        "approach_planner": "a capture needs an approach planner for its base's flight to the "
+        "approach gate: `straight-line` (the default), `ompl-geometric` or one of your own",
+        "path_planner": "a capture needs a path planner for the arm's intercept of the "
+        "fixture: `fixture-intercept` (the default) or one of your own",
+    }
+    return [((role,), message) for role, message in needs.items() if get(role) is None]
 
 
-RULES = (gripper_rule, frame_rule, path_planner_rule)
+RULES = (gripper_rule, frame_rule, planner_rule)
 """The capture mission's rules, in the order their messages are listed."""

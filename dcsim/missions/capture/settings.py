@@ -19,6 +19,7 @@ class CaptureMissionSection(MissionSettings):
     body_key: ClassVar[str | None] = "target"
     role_defaults: ClassVar[dict[str, PluginChoice | None]] = {
         "localiser": None,
+        "approach_planner": PluginChoice(plugin="straight-line"),
         "path_planner": PluginChoice(plugin="fixture-intercept"),
         "controller": PluginChoice(plugin="capture-detumble"),
     }
@@ -47,6 +48,15 @@ class CaptureMissionSection(MissionSettings):
         description="Time the tracker follows the target from the start before the standoff "
         "is chosen from its track (no wait when the track is exact, under ideal object "
         "sensing).",
+    )
+    approach_clearance: float = quantity(
+        0.5,
+        unit="m",
+        gt=0,
+        description="Least gap the approach planner keeps between the robot's sphere (its "
+        "base and its arm as held) and the target's bounding sphere; the approach gate, where "
+        "the planned flight ends and the straight move in along the momentum axis begins, "
+        "lies twice this gap out.",
     )
     approach_speed: float = quantity(
         0.1, unit="m/s", gt=0, description="Largest speed of the base's approach."
