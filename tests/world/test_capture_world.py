@@ -275,7 +275,8 @@ def momentum_errors(physics_step: float) -> tuple[float, float, float]:
     reason="PyBullet's multibody step: at the scenario's 0.5 ms, while the pads close on "
     "the bar, the linear momentum moves by 1.3e-4, the angular by 2.2e-5 (about the "
     "origin) and 1.9e-6 (about the centre of mass); at 0.25 ms 6.3e-5, 1.1e-5, 1.2e-6; "
-    "at 0.1 ms 2.5e-5, 4.5e-6, 1.0e-6. The step's part falls to first order; about the "
+    "at 0.1 ms 2.5e-5, 4.5e-6, 1.0e-6. The step's part falls to first order and is not "
+    "the contact's: joint torques alone move the momentum so (the test below); about the "
     "centre of mass a floor of about 1e-6 stays: PyBullet applies a contact's friction at "
     "the pad's and the bar's own contact points, 1-2e-5 m apart (the penetration); once "
     "the grip has settled, at 0.1 ms, that offset's torque accounts for the change to "
@@ -290,6 +291,35 @@ def test_contact_keeps_the_momentum_to_the_step_accuracy():
     """What PyBullet achieves at the scenario's step: 3e-4 of the momentum (a missing
     part or a wrong sign in the sums would give errors of order 1)."""
     assert max(momentum_errors(5e-4)) <= 3e-4
+
+
+def linear_momentum_drift(physics_step: float, joint_torques: np.ndarray, grip: bool) -> float:
+    """Largest change (N·s) of the system's linear momentum over 1 s with the target
+    100 m away (no contact), under constant joint torques and, with ``grip``, the pads
+    closing: every force internal."""
+    with capture_world(physics_step=physics_step, position=[0.0, 100.0, 0.0]) as w:
+        start = momentum(w, np.zeros(3))[:3]
+        if grip:
+            w.capture.gripper.command(True)
+        worst = 0.0
+        for _ in range(100):
+            w.step(WorldInputs(joint_torques=joint_torques))
+            worst = max(worst, float(np.linalg.norm(momentum(w, np.zeros(3))[:3] - start)))
+        return worst
+
+
+def test_the_momentum_drift_is_pybullet_s_step_under_joint_torques_not_the_contact():
+    """Why the contact target is missed: with nothing touching, the arm's joint torques
+    alone move the linear momentum at first order in the step (PyBullet integrates the
+    floating arm in joint coordinates by an Euler step: 9.3e-3 N·s over 1 s at 0.5 ms,
+    1.9e-3 at 0.1 ms; the closing on the bar moves it by 1.2e-3 N·s, 1.3e-4 of the
+    target's mass times its bar's 6.7 mm/s), while the pads closing alone, driven by the
+    same engine's motors, keep it to 1e-13."""
+    torques = np.array([5.0, -3.0, 2.0, 1.0, -1.0, 0.5])  # N·m
+    coarse = linear_momentum_drift(5e-4, torques, grip=False)
+    fine = linear_momentum_drift(1e-4, torques, grip=False)
+    assert 1e-3 < coarse and 4.0 < coarse / fine < 6.0  # first order: five times less
+    assert linear_momentum_drift(5e-4, np.zeros(6), grip=True) < 1e-10
 
 
 # ---------------------------------------------------------------- recorded impulse
