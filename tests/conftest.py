@@ -32,9 +32,53 @@ SHARES_DEFAULT_RUN = pytest.mark.xdist_group("default-run")
 SHARES_WHEEL = pytest.mark.xdist_group("wheel")
 
 CAPTURE = REPO / "scenarios" / "debris_capture.yaml"
-CAPTURE_TURNED_AT = 104.0
+CAPTURE_TURNED_AT = 111.2
 """Time (s) into the shipped capture whose target attitude a short capture starts from:
 its earliest grasp then meets the bar turned about as the shipped run grasps it."""
+
+
+@dataclass
+class ApproachLine:
+    """The line a capture's base approaches its target's untouched tumble along, from the
+    scenario's initial state (what the mission takes from an exact track at t = 0).
+
+    Attributes
+    ----------
+    centre : ndarray (3,)
+        The target's centre of mass, m.
+    axis : ndarray (3,)
+        Unit angular momentum, on the fixture's side.
+    facing : ndarray (4,)
+        The base's attitude with its mount facing the target, turned least from the
+        unturned start.
+    below : ndarray (3,)
+        The standoff height along the base's z axis, m: how far below the axis the line
+        runs.
+    """
+
+    centre: np.ndarray
+    axis: np.ndarray
+    facing: np.ndarray
+    below: np.ndarray
+
+    def point(self, distance: float) -> np.ndarray:
+        """The point ``distance`` (m) out along the axis, below it as the standoff is."""
+        return self.centre + distance * self.axis - self.below
+
+
+def capture_approach_line(path: Path) -> ApproachLine:
+    """The approach line of the capture scenario at ``path``, its robot unturned."""
+    scenario = load_scenario(path)
+    target, mount = scenario.mission.target, np.array(scenario.robot.mount)
+    rotation = rotation_matrix(target.unit_attitude())
+    rate = rotation @ np.radians(target.angular_velocity_deg_s)  # world frame, rad/s
+    axis = rotation @ target.inertia_tensor() @ rotation.T @ rate
+    axis /= np.linalg.norm(axis)
+    if axis @ (rotation @ np.array(target.fixture.position)) < 0.0:
+        axis = -axis
+    facing = quaternion_between(mount, -axis)
+    below = scenario.mission.standoff_height * rotation_matrix(facing)[:, 2]
+    return ApproachLine(np.array(target.position), axis, facing, below)
 
 
 def short_capture(observation: float, duration: float) -> dict[str, object]:
@@ -43,7 +87,8 @@ def short_capture(observation: float, duration: float) -> dict[str, object]:
     The base starts where the approach ends: ``standoff`` from the target's centre of
     mass on its angular momentum axis (fixed while it tumbles free) and
     ``standoff_height`` below it, its mount facing the target (the shipped base starts
-    unturned). The target starts turned as it is :data:`CAPTURE_TURNED_AT` less
+    unturned). That is inside the approach planner's keep-out, on the approach line: the
+    mission plans no flight and its move in is of zero length. The target starts turned as it is :data:`CAPTURE_TURNED_AT` less
     ``observation`` into the shipped run. The object sensor reports the truth: a watch
     of well under the shipped 5 s is too short for the tracker to learn the tumble (the
     shipped run's tracker watches it through its acquisition and the whole approach).
@@ -61,23 +106,14 @@ def short_capture(observation: float, duration: float) -> dict[str, object]:
         Scenario key paths and their values, for ``dcsim.api.run``'s ``overrides``.
     """
     scenario = load_scenario(CAPTURE)
-    target, mount = scenario.mission.target, np.array(scenario.robot.mount)
+    target, line = scenario.mission.target, capture_approach_line(CAPTURE)
     attitude = target.unit_attitude()
-    rotation = rotation_matrix(attitude)
-    rate = rotation @ np.radians(target.angular_velocity_deg_s)  # world frame, rad/s
-    axis = rotation @ target.inertia_tensor() @ rotation.T @ rate
-    axis /= np.linalg.norm(axis)
-    if axis @ (rotation @ np.array(target.fixture.position)) < 0.0:
-        axis = -axis
-    facing = quaternion_between(mount, -axis)
-    up = rotation_matrix(facing)[:, 2]
-    mission = scenario.mission
-    standoff = np.array(target.position) + mission.standoff * axis - mission.standoff_height * up
+    rate = rotation_matrix(attitude) @ np.radians(target.angular_velocity_deg_s)
     tumble = TorqueFreeRotation(target.inertia_tensor(), attitude, rate)
     tumble.advance(CAPTURE_TURNED_AT - observation)
     return {
-        "robot.initial.position": standoff.tolist(),
-        "robot.initial.attitude": facing.tolist(),
+        "robot.initial.position": line.point(scenario.mission.standoff).tolist(),
+        "robot.initial.attitude": line.facing.tolist(),
         "mission.target.attitude": list(tumble.attitude),
         "mission.observation_time": observation,
         "world.duration": duration,

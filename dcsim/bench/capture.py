@@ -9,8 +9,9 @@ success is a case that captured the target and detumbled the stack to the missio
 the base turned at most ``max_base_excursion_deg`` from its attitude at the standoff,
 and no link of the arm other than the gripper's, nor the base, striking the target.
 Every other case is a failure, with each of its causes: the mission's reason for
-stopping (no path, a grip that did not hold, a run that failed), a detumble not
-reached, a force or a turn above its limit, the arm striking the target.
+stopping (no approach path, no path for the arm, a grip that did not hold, a run that
+failed), a detumble not reached, a force or a turn above its limit, the arm striking
+the target.
 """
 
 from __future__ import annotations
@@ -218,14 +219,16 @@ def _faults(row: dict[str, Any], figures: dict[str, float], limits: Limits) -> I
 
 
 def cause(fault: str) -> str:
-    """A fault without its numbers in brackets, so that like faults group together.
+    """A fault without its brackets and its numbers, so that like faults group together.
 
     ``no path: near a singularity (9x, last det(J Jᵀ) 1.68e-09)`` gives
-    ``no path: near a singularity``.
+    ``no path: near a singularity``; ``no approach path: the straight path passes 6.33 m
+    from obstacle 1 at t = 25.8 s`` gives ``no approach path: the straight path passes …
+    m from obstacle … at t = … s``.
     """
     while (shorter := re.sub(r"\s*\([^()]*\)", "", fault)) != fault:
         fault = shorter  # innermost brackets first: they nest, as in det(J Jᵀ)
-    return fault.strip()
+    return re.sub(r"(?<![\w.])-?\d+(?:\.\d+)?(?:e[-+]?\d+)?(?![\w.])", "…", fault).strip()
 
 
 def markdown(judged: Sequence[CaptureCase], limits: Limits) -> str:

@@ -100,12 +100,16 @@ def mission_types() -> dict[str, type[Mission]]:
 
 
 def scenario_roles(scenario: Scenario) -> dict[str, RoleKind]:
-    """The plugin roles a scenario's run uses, in data-flow order, each with the plugin
-    kind it takes and the robot type its plugin must support.
+    """The plugin roles a scenario's run uses, in data-flow order.
 
     Those its mission uses for which the scenario names a plugin (a role the mission's
     ``role_defaults`` list may be null: none), and the tracker when an object sensor
     has a model. Roles of one kind keep the mission's order.
+
+    Returns
+    -------
+    dict of str to RoleKind
+        Each role's plugin kind and the robot type its plugin must support.
     """
     mission = mission_class(scenario.mission.type)
     roles = dict.fromkeys((*mission.roles, *mission.Settings.role_defaults))
@@ -118,8 +122,23 @@ def scenario_roles(scenario: Scenario) -> dict[str, RoleKind]:
 
 
 def role_kind(mission: type[Mission], role: str, robot: str) -> RoleKind:
-    """The plugin kind of ``mission``'s ``role`` and the robot type its plugin must
-    support (``robot``, the scenario's, unless the mission names another)."""
+    """The plugin kind of a mission's role and the robot type its plugin must support.
+
+    Parameters
+    ----------
+    mission : type of Mission
+        The mission class.
+    role : str
+        One of its roles: a plugin kind's name, or a name of its ``role_kinds``.
+    robot : str
+        The scenario's robot type, which the role's plugin supports unless the mission
+        names another.
+
+    Returns
+    -------
+    RoleKind
+        The kind, and the robot type (never None).
+    """
     kind = mission.role_kinds.get(role, RoleKind(role))
     return RoleKind(kind.kind, kind.robot or robot)
 

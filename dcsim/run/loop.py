@@ -475,7 +475,10 @@ class Runner:
         world_model = self.scenario.frame_dynamics.model
         if world_model is None:
             return
-        for role in ("task_planner", "path_planner"):
+        from dcsim.missions import scenario_roles  # missions load the world engine
+
+        roles = scenario_roles(self.scenario)
+        for role in (r for r, (kind, _) in roles.items() if kind.endswith("_planner")):
             plugin = self.plugins.get(role)
             models = getattr(plugin, "orbit_models", None)
             if plugin is None or models is None or world_model in models:

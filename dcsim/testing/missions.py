@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from dcsim.errors import ScenarioError
-from dcsim.missions import Mission, mission_types, register_mission
+from dcsim.missions import Mission, RoleKind, mission_types, register_mission
 from dcsim.registry.discovery import PluginRegistry
 from dcsim.registry.interfaces import PLUGIN_KINDS
 from dcsim.run.loop import Runner
@@ -145,11 +145,7 @@ def check_declarations(mission: type[Mission], scenario: ScenarioSource) -> None
             f"roles {sorted(unknown_roles)} are neither plugin kinds ({', '.join(PLUGIN_KINDS)}) "
             "nor named in its role_kinds"
         )
-    unknown_kinds = {
-        role: kind for role, (kind, _) in role_kinds.items() if kind not in PLUGIN_KINDS
-    }
-    if unknown_kinds:
-        fail(f"role_kinds {unknown_kinds} name no plugin kind ({', '.join(PLUGIN_KINDS)})")
+    _check_role_kinds(mission, role_kinds)
     if not mission.modes or not all(isinstance(m, str) for m in mission.modes):
         fail(f"modes must be a non-empty tuple of names, got {mission.modes!r}")
     unknown_robots = set(mission.robots) - set(ROBOT_TYPES)
@@ -160,6 +156,32 @@ def check_declarations(mission: type[Mission], scenario: ScenarioSource) -> None
     stray = set(mission.telemetry_units(validated)) - set(columns)
     if stray:
         fail(f"units are given for {sorted(stray)}, which are not among its columns {columns}")
+
+
+def _check_role_kinds(mission: type[Mission], role_kinds: Mapping[str, RoleKind]) -> None:
+    """Each role of ``role_kinds`` names a plugin kind and a robot type and has a
+    scenario key (a ``role_defaults`` entry); every ``role_defaults`` key is a role."""
+    unknown_kinds = {
+        role: kind for role, (kind, _) in role_kinds.items() if kind not in PLUGIN_KINDS
+    }
+    if unknown_kinds:
+        fail(f"role_kinds {unknown_kinds} name no plugin kind ({', '.join(PLUGIN_KINDS)})")
+    unknown_robots = {
+        role: robot
+        for role, (_, robot) in role_kinds.items()
+        if robot is not None and robot not in ROBOT_TYPES
+    }
+    if unknown_robots:
+        fail(f"role_kinds {unknown_robots} name no robot type ({', '.join(ROBOT_TYPES)})")
+    keyless = sorted(set(role_kinds) - set(mission.Settings.role_defaults))
+    if keyless:
+        fail(
+            f"roles {keyless} of its role_kinds have no scenario key: give each a default "
+            "plugin (or None) in its Settings' role_defaults"
+        )
+    strays = sorted(set(mission.Settings.role_defaults) - set(PLUGIN_KINDS) - set(role_kinds))
+    if strays:
+        fail(f"role_defaults {strays} are neither plugin kinds nor named in its role_kinds")
 
 
 @mission_check(

@@ -122,6 +122,17 @@ class UnknownKindMission(StillMission):
     role_kinds = {"docking_planner": RoleKind("docking_planner")}  # no such kind
 
 
+class KeylessRoleSettings(StillSettings):
+    type: Literal["keyless-role"] = "keyless-role"
+
+
+class KeylessRoleMission(StillMission):
+    type = "keyless-role"
+    Settings = KeylessRoleSettings  # no role_defaults entry: the role has no scenario key
+    roles = ("controller", "docking_planner")
+    role_kinds = {"docking_planner": RoleKind("path_planner", "free-flyer")}
+
+
 STILL = {"world": {"frame": "geocentric", "duration": 3}, "mission": {"type": "still"}}
 
 
@@ -167,6 +178,12 @@ def scenario(mission_type: str = "still", **settings) -> dict:
             {"declares_its_seam"},
             "role_kinds {'docking_planner': 'docking_planner'} name no plugin kind",
         ),
+        (
+            KeylessRoleMission,
+            scenario("keyless-role"),
+            {"declares_its_seam"},
+            "roles ['docking_planner'] of its role_kinds have no scenario key",
+        ),
     ],
     ids=[
         "keeps",
@@ -177,6 +194,7 @@ def scenario(mission_type: str = "still", **settings) -> dict:
         "mislabelled",
         "unnamed-role",
         "unknown-kind",
+        "keyless-role",
     ],
 )
 def test_a_broken_mission_is_caught_by_the_check_naming_what_it_did(mission, data, failing, said):

@@ -1,7 +1,8 @@
 """The capture scenario (scenarios/debris_capture.yaml) cut short: the base starts at its
 standoff and the target is turned as it is when the shipped run asks its planner, so
 the whole capture (observe, intercept, grasp, latch, detumble) flies in about 20 s of
-simulated time instead of 105; then the capture's refusals and aborts."""
+simulated time instead of 113; then the approach, and the capture's refusals and
+aborts."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from typing import ClassVar
 import numpy as np
 import pytest
 import yaml
+from dcsim_plugins.path_planners.ant_colony.planner import AntColonyPlanner
 
 from dcsim.api import (
     NoPath,
@@ -19,13 +21,14 @@ from dcsim.api import (
     RunResult,
     ScenarioError,
     ShapeKind,
+    Trajectory,
     close_run,
     load_scenario,
     manipulator_model,
     open_run,
     run,
 )
-from tests.conftest import CAPTURE, short_capture
+from tests.conftest import CAPTURE, capture_approach_line, short_capture
 from tests.test_runner import registry_with
 
 OBSERVATION = 0.5
@@ -120,15 +123,15 @@ def test_a_capture_in_the_lvlh_frame_is_refused_by_the_cli(dcsim_cli):
 
 def test_a_body_striking_the_base_is_named_in_an_event_and_counted():
     """The target drifting into the back of the base (the shipped start, on the x axis,
-    a 1 m cube; the cylinder's side 5 cm off it): the mission names the base once in an
-    ``arm_contact`` event and the summary counts one link struck."""
+    a 1 m cube; the cylinder's side 5 cm off it) while the robot watches it (ACQUIRE):
+    the mission names the base once in an ``arm_contact`` event and the summary counts
+    one link struck."""
     base = load_scenario(CAPTURE).robot.initial.position[0]
     start = [base - 0.5 - 1.2 - 0.05, 0.0, 0.0]
     overrides = {
         "mission.target.position": start,
         "mission.target.velocity": [0.1, 0.0, 0.0],
         "world.duration": 1.0,
-        "sensors.objects": None,
     }
     result = run(CAPTURE, overrides, plots=False)
     assert [e["links"] for e in named(result, "arm_contact")] == [["base"]]
@@ -208,39 +211,46 @@ def test_an_approach_through_the_tumble_is_refused_before_the_base_moves():
     assert result.status == "stopped"
 
 
+class RecordingAntColony(AntColonyPlanner):
+    """ant-colony, keeping the problems it is given and its answers (test)."""
+
+    name = "recording-ant-colony"
+    summary = "ant-colony, keeping its problems and answers (test)"
+    answers: ClassVar[list[tuple[PathProblem, Trajectory | NoPath]]] = []
+
+    def plan(self, problem: PathProblem) -> Trajectory | NoPath:
+        answer = super().plan(problem)
+        self.answers.append((problem, answer))
+        return answer
+
+
 @pytest.mark.filterwarnings("ignore::dcsim.errors.PlanOutlastsRunWarning")  # cut short
 def test_a_planned_approach_keeps_the_arm_clear_of_the_tumble_s_sweep():
     """An approach planner that goes round obstacles (ant-colony) takes the base from
-    the far side to the gate with its held arm clear of the sphere the tumbling body
-    sweeps, by the approach clearance; the straight line it replaces passes within a
+    the far side to the gate with the robot's sphere clear of the sphere the tumbling
+    body sweeps by the approach clearance; the straight line it replaces passes within a
     metre of the body's centre."""
+    RecordingAntColony.answers.clear()
     overrides = {
         "robot.initial.position": FAR_SIDE,
         "sensors.objects": None,
-        "approach_planner.plugin": "ant-colony",
-        "world.duration": 1.0,
+        "approach_planner.plugin": "recording-ant-colony",
+        "world.duration": 0.5,
     }
-    runner = open_run(CAPTURE, overrides, plots=False)
-    try:
-        path, gate = runner.mission.approach_path, runner.mission.standoff.gate
-    finally:
-        close_run(runner)
-    scenario = load_scenario(CAPTURE)
-    target, robot = scenario.mission.target, scenario.robot
-    model = manipulator_model(robot.dh_robot())
-    ready = np.concatenate(
-        [FAR_SIDE, [0.0, 0.0, 0.0, 1.0], np.radians(robot.initial.joint_angles_deg)]
-    )
-    kinematics = model.kinematics(ready)
-    arm = np.linalg.norm(kinematics.end_effector - kinematics.base_position) + robot.gripper.reach
-    keep_out = target.shape.build().bounding_radius + arm + scenario.mission.approach_clearance
+    result = run(CAPTURE, overrides, plots=False, registry=registry_with(RecordingAntColony))
+    ((problem, path),) = RecordingAntColony.answers
+    (flight,) = named(result, "approach_path")
+    assert isinstance(path, Trajectory)
+    (obstacle,) = problem.obstacles
+    keep_out = obstacle.radius + problem.robot_radius + problem.safety_margin
     times = np.linspace(path.times[0], path.times[-1], 20_001)
     positions, _ = path.sample(times)
-    centre = np.asarray(target.position)
-    assert np.linalg.norm(positions - centre, axis=1).min() >= keep_out
-    assert np.linalg.norm(positions[-1] - gate) < 1e-6
+    assert np.linalg.norm(positions - obstacle.position, axis=1).min() >= keep_out
+    assert np.linalg.norm(positions[-1] - problem.goal.position) < 1e-6
+    gate = problem.goal.position
     line = np.linspace(0.0, 1.0, 1001)[:, None] * (gate - FAR_SIDE) + FAR_SIDE
-    assert np.linalg.norm(line - centre, axis=1).min() < 1.0
+    assert np.linalg.norm(line - obstacle.position, axis=1).min() < 1.0
+    assert flight["length"] > np.linalg.norm(gate - FAR_SIDE)  # it went round
 
 
 def test_the_approach_planner_plans_a_free_flyer_and_must_be_named():
@@ -304,7 +314,61 @@ def test_the_approach_problem_keeps_the_held_arm_clear_of_the_tumble():
     assert problem.robot_radius > arm + robot.gripper.reach
     assert problem.safety_margin == mission.approach_clearance
     assert problem.model is None  # the base, as a free flyer
+    line = capture_approach_line(CAPTURE)
     out = radius + problem.robot_radius + 2.0 * mission.approach_clearance  # along the axis
-    below = mission.standoff_height  # along the base's z axis, square to it
-    distance = np.linalg.norm(problem.goal.position - target.position)
-    assert distance == pytest.approx(np.hypot(out, below), rel=1e-12)
+    assert np.allclose(problem.goal.position, line.point(out), rtol=0.0, atol=1e-9)
+    assert abs(problem.goal.attitude @ line.facing) == pytest.approx(1.0, abs=1e-12)
+
+
+def test_the_base_flies_its_path_to_the_gate_then_straight_in_to_the_standoff():
+    """From just beyond the gate on the approach line (faster limits, so that it takes
+    about 22 s): the references follow the planned flight, hand over to the move in
+    without a jump and end at rest at the standoff, where the base arrives and OBSERVE
+    holds it."""
+    scenario = load_scenario(CAPTURE)
+    line, mission = capture_approach_line(CAPTURE), scenario.mission
+    speed = 0.3  # m/s
+    overrides = {
+        "robot.initial.position": line.point(7.2).tolist(),
+        "robot.initial.attitude": line.facing.tolist(),
+        "sensors.objects": None,
+        "mission.approach_speed": speed,
+        "mission.approach_acceleration": 0.05,  # the base's 100 N give it 0.09 m/s^2
+        "world.duration": 30.0,
+    }
+    runner = open_run(CAPTURE, overrides, plots=False)
+    try:
+        references = []
+        while runner.mode in ("ACQUIRE", "APPROACH"):
+            references.append(runner.reference)
+            runner.advance()
+        references.append(runner.reference)  # the first of OBSERVE: held at the standoff
+        arrived = runner.world.robot_state().position
+        path, standoff = runner.mission.approach_path, runner.mission.standoff
+    finally:
+        close_run(runner)
+    positions = np.array([r.position for r in references])
+    steps = np.linalg.norm(np.diff(positions, axis=0), axis=1)
+    period = scenario.world.control_period
+    assert steps.max() <= speed * period * (1 + 1e-9)  # no jump, the hand-over included
+    handed = np.searchsorted([r.time for r in references], path.times[-1])
+    assert 0 < handed < len(references) - 1  # both legs were flown
+    assert np.allclose(positions[-1], standoff.point, rtol=0.0, atol=1e-9)
+    assert not np.any(references[-1].velocity)
+    assert np.allclose(standoff.point, line.point(mission.standoff), rtol=0.0, atol=1e-9)
+    assert np.linalg.norm(arrived - standoff.point) < 0.02  # m
+
+
+def test_a_start_inside_the_keep_out_off_the_approach_line_is_refused():
+    """Inside the keep-out but beside the approach line a straight move in could cross
+    the tumble: the capture aborts, saying where the robot is and what to change."""
+    line = capture_approach_line(CAPTURE)
+    side = np.cross(line.axis, [0.0, 0.0, 1.0])
+    start = line.point(4.5) + 1.5 * side / np.linalg.norm(side)
+    overrides = {"robot.initial.position": start.tolist(), "sensors.objects": None}
+    result = run(CAPTURE, {**overrides, "world.duration": 0.5}, plots=False)
+    (abort,) = named(result, "abort")
+    assert abort["t"] == 0.0
+    assert "inside the approach planner's keep-out of 6.39 m" in abort["reason"]
+    assert "off the approach line between the standoff and the gate" in abort["reason"]
+    assert not named(result, "no_path") and result.status == "stopped"

@@ -6,8 +6,8 @@ Modes::
         ─watched, path planned─► INTERCEPT ─end effector on the fixture─► GRASP
         ─grip held─► DETUMBLE ─stack still─► CAPTURED
 
-    ACQUIRE (target not tracked, no approach path), OBSERVE (no path),
-    GRASP (grip not held) ─► ABORT
+    ACQUIRE (target not tracked, no approach path, a start inside the keep-out off the
+    approach line), OBSERVE (no path), GRASP (grip not held) ─► ABORT
 
 - **ACQUIRE**: the robot holds at its start while the tracker follows the target, for
   ``acquisition_time`` (no wait for an exact track, under ideal object sensing); then
@@ -18,10 +18,12 @@ Modes::
   along its angular momentum as the track gives it (the fixture's side) and
   ``standoff_height`` below it along the base's z axis. The base flies the approach
   planner's path to the gate on the same line, clear of the sphere the tumbling body
-  sweeps by ``approach_clearance`` (a robot that starts inside that keep-out is not
-  planned for), then moves straight in along the axis to the standoff by a minimum-jerk
-  move within ``approach_speed`` and ``approach_acceleration``, turning its arm side to
-  face the target; the arm holds its start configuration.
+  sweeps by ``approach_clearance``, turning its arm side to face the target (if the
+  path gives attitudes), then moves straight in along the axis to the standoff by a
+  minimum-jerk move within ``approach_speed`` and ``approach_acceleration``, finishing
+  the turn; the arm holds its start configuration. A robot that starts inside the
+  keep-out is not planned for: on the line between standoff and gate it moves straight
+  in, anywhere else the capture is aborted.
 - **OBSERVE**: the base holds there for ``observation_time`` while the target's track
   is watched; then the path planner is asked for the end effector's trajectory onto
   the fixture (a :class:`~dcsim.messages.PathProblem` with a
@@ -256,7 +258,7 @@ class CaptureMission(Mission):
         self, time: float, estimate: StateEstimate, observations: Observations
     ) -> Reference:
         """Hold at the start until the target's track has been watched long enough, then
-        choose the standoff from it and leave from where the robot is."""
+        choose the standoff from it and plan the approach from where the robot is."""
         track, missing = self._target_track(observations)
         exact = track is not None and track.covariance is None
         if exact or time - self.start.time >= self.settings.acquisition_time:
@@ -271,42 +273,69 @@ class CaptureMission(Mission):
         the flight to its gate, clear of the target's bounding sphere.
 
         The target's centre of mass is taken at rest where the track puts it now, as the
-        standoff and the gate are: the capture does not follow a drifting body."""
+        standoff and the gate are: the capture does not follow a drifting body. A robot
+        that starts inside the keep-out is not planned for: on the approach line it
+        moves straight in, anywhere else the capture is aborted."""
         held = _held_radius(self._model(), start, self.base_size, self.gripper)
         clearance = self.settings.approach_clearance
         gate = max(self.settings.standoff, track.radius + held + 2.0 * clearance)
         self.standoff = standoff = _Standoff(start, track, self.settings, self.mount, gate)
-        distance = float(np.linalg.norm(start.position - track.position))
         keep_out = track.radius + held + clearance
+        distance = float(np.linalg.norm(start.position - track.position))
         if distance < keep_out:
-            self.emit("approach_within_keep_out", distance=distance, keep_out=keep_out)
-            self._go("APPROACH")
+            self._start_within_keep_out(time, start.position, distance, keep_out)
             return
-        keep_out_track = dataclasses.replace(
+        result = self._ask("approach_planner", self._approach_problem(start, track, held))
+        if isinstance(result, NoPath):
+            self._abort(f"no approach path: {result.reason}")
+            return
+        self.approach_path = result
+        self.emit("approach_path", duration=result.duration, length=result.length)
+        move_in = _move_duration(standoff.point - result.positions[-1], self.settings)
+        self.note_plan_end(time, float(result.times[-1]) + move_in)
+        self._go("APPROACH")
+
+    def _approach_problem(self, start: RobotState, track: ObjectTrack, held: float) -> PathProblem:
+        """The base's flight to the gate, as a free flyer of radius ``held`` (m), clear of
+        the target's bounding sphere at rest by the approach clearance."""
+        assert self.standoff is not None  # chosen first
+        keep_out = dataclasses.replace(
             track,
             velocity=np.zeros(3),  # at rest, as the standoff and the gate take it
             motion=None,
             shape=Shape(ShapeKind.SPHERE, radius=track.radius),  # all a tumbling body sweeps
         )
-        problem = PathProblem(
+        return PathProblem(
             start=start,
-            goal=GoalRegion(position=standoff.gate, attitude=standoff.attitude),
-            obstacles=(keep_out_track,),
+            goal=GoalRegion(position=self.standoff.gate, attitude=self.standoff.attitude),
+            obstacles=(keep_out,),
             frame=self.scenario.frame_dynamics,
             robot_radius=held,
             robot_mass=self.world.robot_spec().mass,
             max_speed=self.settings.approach_speed,
             max_acceleration=self.settings.approach_acceleration,
             time_budget=self.settings.planning_budget,
-            safety_margin=clearance,
+            safety_margin=self.settings.approach_clearance,
         )
-        result = self._ask("approach_planner", problem)
-        if isinstance(result, NoPath):
-            self._abort(f"no approach path: {result.reason}")
+
+    def _start_within_keep_out(
+        self, time: float, position: np.ndarray, distance: float, keep_out: float
+    ) -> None:
+        """Move straight in from a start inside the keep-out on the approach line; abort
+        from anywhere else inside it, where a straight move could cross the tumble."""
+        assert self.standoff is not None  # chosen first
+        clearance = self.settings.approach_clearance
+        if not self.standoff.on_approach_line(position, clearance):
+            self._abort(
+                f"the robot starts {distance:.2f} m from the target's centre, inside the "
+                f"approach planner's keep-out of {keep_out:.2f} m and more than {clearance:g} m "
+                "off the approach line between the standoff and the gate: start it farther "
+                "out, or on that line"
+            )
             return
-        self.approach_path = result
-        self.emit("approach_path", duration=result.duration, length=result.length)
-        self.note_plan_end(time, float(result.times[-1]))
+        self.emit("approach_within_keep_out", distance=distance, keep_out=keep_out)
+        move_in = _move_duration(self.standoff.point - position, self.settings)
+        self.note_plan_end(time, time + move_in)
         self._go("APPROACH")
 
     def _ask(self, role: str, problem: PathProblem) -> Trajectory | NoPath:
@@ -315,21 +344,26 @@ class CaptureMission(Mission):
         began = wallclock.perf_counter()
         result = self.call(role, "plan", problem)
         self.planning_time += wallclock.perf_counter() - began
+        assert isinstance(result, Trajectory | NoPath)  # checked at the plugin boundary
         if isinstance(result, NoPath):
             self.emit("no_path", role=role, reason=result.reason)
-        assert isinstance(result, Trajectory | NoPath)  # checked at the plugin boundary
         return result
 
     def _approach(self, time: float, estimate: StateEstimate) -> Reference:
-        """The planned flight to the gate (none from within the keep-out), then the
-        straight move in to the standoff."""
+        """The planned flight to the gate (none from the approach line inside the
+        keep-out), then the straight move in to the standoff, from rest."""
         assert self.standoff is not None  # chosen on the way out of ACQUIRE
         path = self.approach_path
         if self.final_move is None:
             if path is not None and time < path.times[-1]:
                 return self._follow_approach(path, time)
             origin = (
-                self._hold(estimate.as_state())
+                Reference(
+                    time=time,
+                    position=estimate.position,
+                    attitude=estimate.attitude,
+                    joint_positions=self.start.joint_positions,
+                )
                 if path is None
                 else self._follow_approach(path, float(path.times[-1]))
             )
@@ -344,8 +378,9 @@ class CaptureMission(Mission):
         return reference
 
     def _follow_approach(self, path: Trajectory, time: float) -> Reference:
-        """The approach path's state at ``time``, the arm held; a path that leaves the
-        attitude free holds the start's."""
+        """The approach path's state at ``time``, the arm held. A path that leaves the
+        attitude free holds the start's, and the move in turns the base (the transfer
+        mission holds the goal's instead: a transfer has no move after its path)."""
         assert self.standoff is not None  # chosen with the path
         state = path.state_at(time)
         return Reference(
@@ -684,11 +719,34 @@ class _Standoff:
         self.point = track.position + settings.standoff * axis - below
         self.gate = track.position + gate_distance * axis - below
 
+    def on_approach_line(self, position: np.ndarray, tolerance: float) -> bool:
+        """Whether ``position`` (m, world frame) lies within ``tolerance`` (m) of the
+        segment from the standoff point to the gate."""
+        line = self.gate - self.point
+        length = float(np.linalg.norm(line))
+        along = (
+            0.0
+            if length == 0.0
+            else float(np.clip((position - self.point) @ line / length**2, 0.0, 1.0))
+        )
+        return float(np.linalg.norm(position - (self.point + along * line))) <= tolerance
+
+
+def _move_duration(offset: np.ndarray, settings: CaptureMissionSection) -> float:
+    """Duration (s) of the base's minimum-jerk move by ``offset`` (m), from rest to rest
+    within ``approach_speed`` and ``approach_acceleration``."""
+    length = float(np.linalg.norm(offset))
+    return max(
+        shortest_duration(length, settings.approach_speed, settings.approach_acceleration),
+        1e-9,
+    )
+
 
 class _StraightMove:
-    """The base's move in from the gate to the standoff point: a minimum-jerk move at rest
-    at both ends within ``approach_speed`` and ``approach_acceleration``, turning onto
-    the standoff's attitude, the joints held as ``origin``'s."""
+    """The base's move in to the standoff point from where its planned flight ended (the
+    gate) or from its start on the approach line: a minimum-jerk move at rest at both
+    ends within ``approach_speed`` and ``approach_acceleration``, turning onto the
+    standoff's attitude if the flight has not, the joints held as ``origin``'s."""
 
     def __init__(
         self,
@@ -701,12 +759,8 @@ class _StraightMove:
         self.origin, self.goal = origin.position, goal
         self.start_attitude, self.attitude = origin.attitude, attitude
         self.joints = origin.joint_positions
-        length = float(np.linalg.norm(goal - origin.position))
         self.start_time = origin.time
-        self.duration = max(
-            shortest_duration(length, settings.approach_speed, settings.approach_acceleration),
-            1e-9,
-        )
+        self.duration = _move_duration(goal - origin.position, settings)
         self.end_time = self.start_time + self.duration
 
     def reference(self, time: float) -> Reference:

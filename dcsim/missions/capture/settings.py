@@ -56,7 +56,9 @@ class CaptureMissionSection(MissionSettings):
         description="Least gap the approach planner keeps between the robot's sphere (its "
         "base and its arm as held) and the target's bounding sphere; the approach gate, where "
         "the planned flight ends and the straight move in along the momentum axis begins, "
-        "lies twice this gap out.",
+        "lies twice this gap out (or at the standoff, if that is farther). A robot that "
+        "starts inside the keep-out must be within this distance of the line from the "
+        "standoff to the gate.",
     )
     approach_speed: float = quantity(
         0.1, unit="m/s", gt=0, description="Largest speed of the base's approach."
@@ -112,5 +114,8 @@ class CaptureMissionSection(MissionSettings):
         "as held.",
     )
     planning_budget: float = quantity(
-        5.0, unit="s", gt=0, description="Wall time given to the path planner."
+        5.0,
+        unit="s",
+        gt=0,
+        description="Wall time given to each planner: the approach's and the intercept's.",
     )
