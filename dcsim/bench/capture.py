@@ -218,17 +218,24 @@ def _faults(row: dict[str, Any], figures: dict[str, float], limits: Limits) -> I
         yield f"the arm struck the target ({_number(row['arm_links_struck']):.0f} links)"
 
 
+_NUMBER = re.compile(r"(?<![\w.])-?\d+(?:\.\d+)?(?:e[-+]?\d+)?(?!\w|\.\d)", re.IGNORECASE)
+"""A number in a fault's reason: an integer, a decimal or scientific notation."""
+
+
 def cause(fault: str) -> str:
-    """A fault without its brackets and its numbers, so that like faults group together.
+    """A fault without its brackets, and the reason it quotes without its numbers, so
+    that like faults group together.
 
     ``no path: near a singularity (9x, last det(J Jᵀ) 1.68e-09)`` gives
-    ``no path: near a singularity``; ``no approach path: the straight path passes 6.33 m
-    from obstacle 1 at t = 25.8 s`` gives ``no approach path: the straight path passes …
-    m from obstacle … at t = … s``.
+    ``no path: near a singularity``; ``not captured: no approach path: the straight path
+    passes 6.33 m from obstacle 1`` gives ``not captured: no approach path: the straight
+    path passes … m from obstacle …``. The bench's own words before the first colon
+    keep their numbers (the limits: the same in every case).
     """
     while (shorter := re.sub(r"\s*\([^()]*\)", "", fault)) != fault:
         fault = shorter  # innermost brackets first: they nest, as in det(J Jᵀ)
-    return re.sub(r"(?<![\w.])-?\d+(?:\.\d+)?(?:e[-+]?\d+)?(?![\w.])", "…", fault).strip()
+    head, colon, reason = fault.partition(": ")
+    return (head + colon + _NUMBER.sub("…", reason)).strip()
 
 
 def markdown(judged: Sequence[CaptureCase], limits: Limits) -> str:

@@ -87,6 +87,8 @@ SUMMARY_FIGURES = (
 )
 """The numeric fields of every run's summary; a mission adds its ``summary_names``."""
 
+_PLANNER_KINDS = ("task_planner", "path_planner")
+"""Plugin kinds that plan, and may model another orbit than the world's."""
 _NO_COMMAND = Command()
 """The command of a period in which nothing is applied."""
 
@@ -475,15 +477,11 @@ class Runner:
         world_model = self.scenario.frame_dynamics.model
         if world_model is None:
             return
-        from dcsim.missions import scenario_roles  # missions load the world engine
-
-        roles = scenario_roles(self.scenario)
-        for role in (r for r, (kind, _) in roles.items() if kind.endswith("_planner")):
-            plugin = self.plugins.get(role)
-            models = getattr(plugin, "orbit_models", None)
-            if plugin is None or models is None or world_model in models:
+        for role, source in self.setup.sources.items():
+            models = getattr(self.plugins[role], "orbit_models", None)
+            if source.kind not in _PLANNER_KINDS or models is None or world_model in models:
                 continue
-            name = self.setup.sources[role].name
+            name = source.name
             self._event(
                 "planner_model_differs",
                 role=role,

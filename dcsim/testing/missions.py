@@ -125,8 +125,9 @@ def _fly(setup: RunSetup, out: Path) -> dict[str, Any]:
     "declares_its_seam",
     "`type` is a lower-case name its settings' `type` defaults to, `summary` one line, "
     "`Settings` a MissionSettings subclass, `roles` plugin kinds or roles its `role_kinds` "
-    "give a kind, `modes` at least one name, `units` only for its `columns`, `robots` known "
-    "robot types",
+    "give a plugin kind, a known robot type and a scenario key (in its Settings' "
+    "`role_defaults`, whose every key is a role), `modes` at least one name, `units` only "
+    "for its `columns`, `robots` known robot types",
 )
 def check_declarations(mission: type[Mission], scenario: ScenarioSource) -> None:
     settings = getattr(mission, "Settings", None)

@@ -71,12 +71,18 @@ def test_like_faults_group_without_their_numbers():
     assert cause("no path: near a singularity (9x, last det(J Jᵀ) 1.68e-09); x (1x, 5 s)") == (
         "no path: near a singularity; x"
     )
-    refusal = "no approach path: the straight path passes {} m from obstacle 1 at t = {} s"
-    assert cause(refusal.format(6.33, 25.8)) == cause(refusal.format(6.2, 1e-3))
-    assert cause(refusal.format(6.33, 25.8)) == (
-        "no approach path: the straight path passes … m from obstacle … at t = … s"
+    refusal = "not captured: no approach path: the straight path passes {} m from obstacle {}."
+    assert cause(refusal.format(6.33, 1)) == cause(refusal.format(6.2, 12))
+    assert cause(refusal.format(6.33, 1)) == (
+        "not captured: no approach path: the straight path passes … m from obstacle …."
     )
-    assert cause("the arm struck the target") == "the arm struck the target"
+    assert cause("failed: joint_1 at -1.5E-3 rad, v1.2") == "failed: joint_1 at … rad, v1.2"
+    assert cause("contact force above the gripper's 1500 N") == (
+        "contact force above the gripper's 1500 N"  # the bench's own limit is kept
+    )
+    assert cause("not detumbled to 0.1 deg/s (target at 0.40 deg/s): run 3 ended") == (
+        "not detumbled to 0.1 deg/s: run … ended"
+    )
 
 
 def test_every_limit_is_judged_and_every_failure_says_why(shipped):

@@ -7,14 +7,20 @@ import copy
 import importlib
 import re
 import sys
-from typing import Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 import pytest
 import yaml
 from pydantic import ConfigDict, Field
 
-from dcsim.api import Mission, MissionSettings, Reference, RoleKind, register_mission
+from dcsim.api import (
+    Mission,
+    MissionSettings,
+    Reference,
+    RoleKind,
+    register_mission,
+)
 from dcsim.missions import mission_class
 from dcsim.testing.missions import MISSION_CHECKS, MissionContract, check_mission
 from tests.conftest import REPO
@@ -133,6 +139,28 @@ class KeylessRoleMission(StillMission):
     role_kinds = {"docking_planner": RoleKind("path_planner", "free-flyer")}
 
 
+class UnknownRobotSettings(StillSettings):
+    type: Literal["unknown-robot"] = "unknown-robot"
+    role_defaults: ClassVar[dict[str, Any]] = {"docking_planner": None}
+
+
+class UnknownRobotMission(StillMission):
+    type = "unknown-robot"
+    Settings = UnknownRobotSettings
+    roles = ("controller", "docking_planner")
+    role_kinds = {"docking_planner": RoleKind("path_planner", "rover")}  # no such robot
+
+
+class StrayDefaultSettings(StillSettings):
+    type: Literal["stray-default"] = "stray-default"
+    role_defaults: ClassVar[dict[str, Any]] = {"docking_planner": None}
+
+
+class StrayDefaultMission(StillMission):
+    type = "stray-default"
+    Settings = StrayDefaultSettings  # a scenario key for a role it never names
+
+
 STILL = {"world": {"frame": "geocentric", "duration": 3}, "mission": {"type": "still"}}
 
 
@@ -184,6 +212,18 @@ def scenario(mission_type: str = "still", **settings) -> dict:
             {"declares_its_seam"},
             "roles ['docking_planner'] of its role_kinds have no scenario key",
         ),
+        (
+            UnknownRobotMission,
+            scenario("unknown-robot"),
+            {"declares_its_seam"},
+            "role_kinds {'docking_planner': 'rover'} name no robot type",
+        ),
+        (
+            StrayDefaultMission,
+            scenario("stray-default"),
+            {"declares_its_seam"},
+            "role_defaults ['docking_planner'] are neither plugin kinds nor named",
+        ),
     ],
     ids=[
         "keeps",
@@ -195,6 +235,8 @@ def scenario(mission_type: str = "still", **settings) -> dict:
         "unnamed-role",
         "unknown-kind",
         "keyless-role",
+        "unknown-robot",
+        "stray-default",
     ],
 )
 def test_a_broken_mission_is_caught_by_the_check_naming_what_it_did(mission, data, failing, said):

@@ -27,7 +27,9 @@ from dcsim.api import (
     manipulator_model,
     open_run,
     run,
+    shortest_duration,
 )
+from dcsim.errors import PlanOutlastsRunWarning
 from tests.conftest import CAPTURE, capture_approach_line, short_capture
 from tests.test_runner import registry_with
 
@@ -354,7 +356,7 @@ def test_the_base_flies_its_path_to_the_gate_then_straight_in_to_the_standoff():
     handed = np.searchsorted([r.time for r in references], path.times[-1])
     assert 0 < handed < len(references) - 1  # both legs were flown
     assert np.allclose(positions[-1], standoff.point, rtol=0.0, atol=1e-9)
-    assert not np.any(references[-1].velocity)
+    assert references[-1].velocity is not None and not np.any(references[-1].velocity)
     assert np.allclose(standoff.point, line.point(mission.standoff), rtol=0.0, atol=1e-9)
     assert np.linalg.norm(arrived - standoff.point) < 0.02  # m
 
@@ -372,3 +374,23 @@ def test_a_start_inside_the_keep_out_off_the_approach_line_is_refused():
     assert "inside the approach planner's keep-out of 6.39 m" in abort["reason"]
     assert "off the approach line between the standoff and the gate" in abort["reason"]
     assert not named(result, "no_path") and result.status == "stopped"
+
+
+def test_a_run_cut_short_of_the_approach_says_when_the_approach_would_end():
+    """The warning of a plan outlasting the run names the whole approach's end: the
+    planned flight's end and the move in from where it ends to the standoff."""
+    overrides = {"sensors.objects": None, "world.duration": 1.0}
+    with pytest.warns(PlanOutlastsRunWarning, match=r"ends at t = \d+\.\d s, after"):
+        runner = open_run(CAPTURE, overrides, plots=False)
+    try:
+        path, standoff = runner.mission.approach_path, runner.mission.standoff
+        while not runner.ended:
+            runner.advance()
+    finally:
+        result = close_run(runner)
+    settings = load_scenario(CAPTURE).mission
+    length = np.linalg.norm(standoff.point - path.positions[-1])
+    move_in = shortest_duration(length, settings.approach_speed, settings.approach_acceleration)
+    (outlasts,) = named(result, "plan_outlasts_run")
+    assert outlasts["plan_end"] == pytest.approx(path.times[-1] + move_in, rel=1e-12)
+    assert outlasts["plan_end"] > path.times[-1] + 30.0  # s: the move in is most of it

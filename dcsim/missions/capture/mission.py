@@ -335,7 +335,7 @@ class CaptureMission(Mission):
             return
         self.emit("approach_within_keep_out", distance=distance, keep_out=keep_out)
         move_in = _move_duration(self.standoff.point - position, self.settings)
-        self.note_plan_end(time, time + move_in)
+        self.note_plan_end(time, time + self.scenario.world.control_period + move_in)
         self._go("APPROACH")
 
     def _ask(self, role: str, problem: PathProblem) -> Trajectory | NoPath:
@@ -357,7 +357,7 @@ class CaptureMission(Mission):
         if self.final_move is None:
             if path is not None and time < path.times[-1]:
                 return self._follow_approach(path, time)
-            origin = (
+            origin = (  # the joints as at the start, as the planned flight holds them
                 Reference(
                     time=time,
                     position=estimate.position,
