@@ -116,12 +116,12 @@ def scenario_roles(scenario: Scenario) -> dict[str, RoleKind]:
     used = [role for role in roles if getattr(scenario, role, None) is not None]
     if sensor_choices(scenario.sensors)["objects"] is not None:
         used.append("tracker")  # detections become tracks
-    kinds = {role: role_kind(mission, role, scenario.robot.type) for role in used}
+    kinds = {role: _role_kind(mission, role, scenario.robot.type) for role in used}
     order = list(PLUGIN_KINDS)
     return dict(sorted(kinds.items(), key=lambda item: order.index(item[1].kind)))
 
 
-def role_kind(mission: type[Mission], role: str, robot: str) -> RoleKind:
+def _role_kind(mission: type[Mission], role: str, robot: str) -> RoleKind:
     """The plugin kind of a mission's role and the robot type its plugin must support.
 
     Parameters
@@ -161,6 +161,5 @@ __all__ = [
     "mission_class",
     "mission_types",
     "register_mission",
-    "role_kind",
     "scenario_roles",
 ]

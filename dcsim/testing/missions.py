@@ -139,7 +139,7 @@ def check_declarations(mission: type[Mission], scenario: ScenarioSource) -> None
     summary = getattr(mission, "summary", "")
     if not isinstance(summary, str) or not summary.strip() or "\n" in summary:
         fail(f"summary must be one line of text, got {summary!r}")
-    role_kinds = getattr(mission, "role_kinds", {})
+    role_kinds = mission.role_kinds
     unknown_roles = set(mission.roles) - set(PLUGIN_KINDS) - set(role_kinds)
     if unknown_roles:
         fail(

@@ -138,6 +138,7 @@ class DebrisMission(Mission):
         self.refusal = ""
         self.pickup_refused = False
         self.time = 0.0
+        self._keep_outs_now: tuple[float, np.ndarray, np.ndarray] | None = None
         self.attitude = _held_attitude(scenario, self.settings.attitude)
         self._handlers: dict[Mode, Callable[[], Reference]] = {
             Mode.LOCALIZE: self._localize,
@@ -265,11 +266,15 @@ class DebrisMission(Mission):
     def _keep_outs(self) -> tuple[np.ndarray, np.ndarray]:
         """Centres (k, 3) (m) and radii (k,) (m) now of the seen obstacles' keep-outs:
         each one's bounding sphere, the robot's radius and the safety distance (no
-        smaller than a planner's keep-out of the obstacle's own shape)."""
-        obstacles = self._obstacles()
-        clearance = self.world.robot_spec().radius + self.settings.safety_distance
-        centres = np.array([t.predict(self.time)[0] for t in obstacles]).reshape(-1, 3)
-        return centres, np.array([t.radius + clearance for t in obstacles])
+        smaller than a planner's keep-out of the obstacle's own shape); worked out once a
+        tick (the wait's check and its held point both read them)."""
+        if self._keep_outs_now is None or self._keep_outs_now[0] != self.time:
+            obstacles = self._obstacles()
+            clearance = self.world.robot_spec().radius + self.settings.safety_distance
+            centres = np.array([t.predict(self.time)[0] for t in obstacles]).reshape(-1, 3)
+            radii = np.array([t.radius + clearance for t in obstacles])
+            self._keep_outs_now = (self.time, centres, radii)
+        return self._keep_outs_now[1], self._keep_outs_now[2]
 
     def _clear_of_obstacles(self, point: np.ndarray) -> np.ndarray:
         """``point`` (m) as it is, or moved straight away from the centre of each
