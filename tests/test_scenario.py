@@ -16,6 +16,7 @@ from dcsim.scenario import (
     default_scenario_path,
     dump_scenario,
     format_key_path,
+    loader,
     parse_key_path,
     read_scenario,
     validate,
@@ -467,6 +468,7 @@ def test_the_mission_section_is_read_as_its_mission_s_settings_class_or_refused(
 @pytest.mark.parametrize("path", SCENARIOS, ids=lambda p: p.stem)
 def test_the_resolved_scenario_is_written_as_pyyaml_s_own_dumper_writes_it(path):
     """libyaml's dumper, where there is one, gives PyYAML's text to the byte."""
+    assert loader._DUMPER is yaml.CSafeDumper  # the fast one is the one in use
     scenario = read_scenario(path)
     data = scenario.model_dump(mode="json")
     expected = yaml.dump(data, Dumper=yaml.SafeDumper, sort_keys=False, allow_unicode=True)

@@ -122,3 +122,9 @@ def test_the_fmu_grasps_latches_and_detumbles_as_dcsim_run_does(tmp_path):
     captured = CaptureMission.modes.index("CAPTURED")
     assert rows[-1]["mode"] == captured and result["mode"][-1] == captured
     assert result["run_status"][len(rows) - 1] == 1  # completed: captured and detumbled
+
+
+def test_the_shipped_capture_exports_as_it_is(tmp_path):
+    """The scenario exactly as shipped (no overrides) exports to a valid FMU."""
+    fmu = export_fmu(CAPTURE, tmp_path / "shipped.fmu")
+    assert validate_fmu(str(fmu)) == []

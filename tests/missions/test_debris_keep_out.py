@@ -7,9 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from dcsim.registry.discovery import PluginRegistry
-from dcsim.run.loop import Runner
-from dcsim.run.setup import setup_run
+from tests.test_runner import run
 
 OBSTACLE = np.array([0.0, 22.0, -12.0])
 """Obstacle 10 of the default scenario at the start, m (radius 1 m)."""
@@ -26,8 +24,7 @@ def started_inside():
         f"robot.initial.position={start.tolist()}",
         "world.duration=60",
     ]
-    runner = Runner(setup_run(None, overrides, registry=PluginRegistry.discover()))
-    return runner, runner.run()
+    return run(None, overrides)
 
 
 def test_the_collector_backs_out_and_then_gets_its_path(started_inside):
@@ -57,8 +54,7 @@ def test_a_refused_way_to_the_drop_point_is_waited_out_not_flown_straight():
         "obstacles[+]={id: 13, radius: 1.0, mass: 50.0, "
         "motion: {type: static, position: [-5.0, 0.0, 0.0]}}",
     ]
-    runner = Runner(setup_run(None, overrides, registry=PluginRegistry.discover()))
-    summary = runner.run()
+    runner, summary = run(None, overrides)
     refusals = [e for e in runner.recorder.events if e["event"] == "no_path"]
     assert [e["reason"] for e in refusals] == ["the goal region is inside obstacle 13"] * 3
     assert summary["status"] == "stopped" and summary["collisions"] == 0
@@ -81,9 +77,10 @@ def test_between_two_keep_outs_it_finds_the_way_out_and_asks_once_out():
         "motion: {type: static, position: [0.0, -1.8, 0.0]}}",
         "world.duration=60",
     ]
-    runner = Runner(setup_run(None, overrides, registry=PluginRegistry.discover()))
-    summary = runner.run()
+    runner, summary = run(None, overrides)
     events = [e for e in runner.recorder.events if e["event"] in ("no_path", "path")]
     assert [e["event"] for e in events[:2]] == ["no_path", "path"]
     assert events[0]["reason"].startswith("the start is inside obstacle 13")
+    at_path = next(r for r in runner.recorder.rows if r["time"] >= events[1]["t"] - 1e-9)
+    assert at_path["nearest_obstacle"] >= 0.5  # m: out of both keep-outs when it planned
     assert summary["collisions"] == 0

@@ -10,10 +10,8 @@ from __future__ import annotations
 
 import pytest
 
-from dcsim.registry.discovery import PluginRegistry
-from dcsim.run.loop import Runner
-from dcsim.run.setup import setup_run
 from tests.conftest import REPO
+from tests.test_runner import run
 
 
 @pytest.mark.parametrize("shape_margin", [0.1, 0.4])
@@ -22,8 +20,7 @@ def test_the_first_grab_is_within_reach_whatever_the_tracker_s_margin(
 ):
     overrides = ["world.duration=150", f"tracker.params.shape_margin={shape_margin}"]
     scenario = REPO / "scenarios" / "default_sensed.yaml"
-    runner = Runner(setup_run(scenario, overrides, registry=PluginRegistry.discover()))
-    runner.run()
+    runner, _ = run(scenario, overrides)
     (grab,) = [e for e in runner.recorder.events if e["event"] == "grab"]
     # Empty-handed, the collector holds half its reach from the surface and grabs once
     # within the other half: the true gap is within reach, up to the estimates' errors.

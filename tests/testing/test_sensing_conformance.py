@@ -209,6 +209,11 @@ def test_broken_sensors_and_trackers_are_reported_by_the_right_check(plugin, fai
         assert f"plugin '{plugin.name}' breaks '{name}'" in failed[name]
 
 
+def test_the_overwide_tracker_is_told_its_margin_exceeds_the_radius():
+    message = failed_checks(OverwideTracker)["keeps_the_detected_objects"]
+    assert "has a shape margin of" in message and "for a radius of" in message
+
+
 def test_the_clairvoyant_sensor_is_told_what_it_cannot_see():
     message = failed_checks(ClairvoyantSensor)["reads_its_sensor"]
     assert "beyond 30 m" in message or "not free" in message
